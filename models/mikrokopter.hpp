@@ -1,0 +1,107 @@
+#pragma once
+// MikroKopter, SPEC §3.3. ϑ = (p, γ, v_b, ω, Ω) ∈ R¹⁶ with ZYX Euler angles γ = (φ, θ, ψ) and
+// rotor speeds Ω; u = τ rotor torques [N·m] ∈ R⁴. Parameters in the thesis's scaled units
+// (Ω in 10³ rad/s), used as these numbers.
+#include <cmath>
+
+#include <Eigen/Core>
+
+namespace mixpilot::models {
+
+struct MikroKopterParams {
+  double m = 1.04;       // [kg]
+  double l = 0.23;       // arm length [m]
+  double Jxx = 0.01;     // [kg·m²]
+  double Jyy = 0.01;
+  double Jzz = 0.07;
+  double C_T = 595.0;    // thrust coefficient (scaled)
+  double C_D = 10.0;     // drag coefficient (scaled)
+  double J_m = 0.08;     // rotor inertia (scaled; SPEC §3.3)
+  double D = 0.5;        // rotor viscous friction (scaled; SPEC §3.3)
+  double g = 9.81;       // [m/s²]
+  double omega_min = 0.0;  // Table 7.1 bounds
+  double omega_max = 0.09;
+  double tau_min = -0.1285;
+  double tau_max = 0.1285;
+};
+
+struct MikroKopter {
+  static constexpr int nx = 16;
+  static constexpr int nu = 4;
+  static constexpr const char* name = "mikrokopter";
+  using State = Eigen::Matrix<double, nx, 1>;
+  using Input = Eigen::Matrix<double, nu, 1>;
+
+  MikroKopterParams p{};
+
+  // ṗ = R(γ) v_b;  γ̇ = ZYX Euler kinematics (SPEC §2);
+  // v̇_b = (0,0,F_z/m) − R(γ)ᵀ(0,0,g) − ω × v_b;  ω̇ = J⁻¹(M − ω × Jω);
+  // Ω̇ = (τ − C_D Ω⊙Ω − D Ω)/J_m  (SPEC §3.3).
+  template <class T>
+  void dynamics(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Matrix<T, nu, 1>& u,
+                Eigen::Matrix<T, nx, 1>& xdot) const {
+    using std::cos;
+    using std::sin;
+    const T &phi = x(3), &theta = x(4), &psi = x(5);
+    const T &vx = x(6), &vy = x(7), &vz = x(8);
+    const T &wx = x(9), &wy = x(10), &wz = x(11);
+
+    const T cph = cos(phi), sph = sin(phi);
+    const T cth = cos(theta), sth = sin(theta);
+    const T cps = cos(psi), sps = sin(psi);
+
+    // R = Rz(ψ) Ry(θ) Rx(φ)
+    const T r00 = cps * cth, r01 = cps * sth * sph - sps * cph, r02 = cps * sth * cph + sps * sph;
+    const T r10 = sps * cth, r11 = sps * sth * sph + cps * cph, r12 = sps * sth * cph - cps * sph;
+    const T r20 = -sth, r21 = cth * sph, r22 = cth * cph;
+
+    xdot(0) = r00 * vx + r01 * vy + r02 * vz;
+    xdot(1) = r10 * vx + r11 * vy + r12 * vz;
+    xdot(2) = r20 * vx + r21 * vy + r22 * vz;
+
+    const T tth = sth / cth;
+    xdot(3) = wx + sph * tth * wy + cph * tth * wz;
+    xdot(4) = cph * wy - sph * wz;
+    xdot(5) = (sph * wy + cph * wz) / cth;
+
+    const T s1 = x(12) * x(12), s2 = x(13) * x(13), s3 = x(14) * x(14), s4 = x(15) * x(15);
+    const T fz = p.C_T * (s1 + s2 + s3 + s4);
+    const T mx = (p.C_T * p.l) * (s2 - s4);
+    const T my = (p.C_T * p.l) * (s3 - s1);
+    const T mz = p.C_D * (s1 - s2 + s3 - s4);
+
+    xdot(6) = -p.g * r20 - (wy * vz - wz * vy);
+    xdot(7) = -p.g * r21 - (wz * vx - wx * vz);
+    xdot(8) = fz / p.m - p.g * r22 - (wx * vy - wy * vx);
+
+    const T jwx = p.Jxx * wx, jwy = p.Jyy * wy, jwz = p.Jzz * wz;
+    xdot(9) = (mx - (wy * jwz - wz * jwy)) / p.Jxx;
+    xdot(10) = (my - (wz * jwx - wx * jwz)) / p.Jyy;
+    xdot(11) = (mz - (wx * jwy - wy * jwx)) / p.Jzz;
+
+    const double inv_jm = 1.0 / p.J_m;
+    xdot(12) = (u(0) - p.C_D * s1 - p.D * x(12)) * inv_jm;
+    xdot(13) = (u(1) - p.C_D * s2 - p.D * x(13)) * inv_jm;
+    xdot(14) = (u(2) - p.C_D * s3 - p.D * x(14)) * inv_jm;
+    xdot(15) = (u(3) - p.C_D * s4 - p.D * x(15)) * inv_jm;
+  }
+
+  // Ω = √(m g / 4 C_T) ≈ 0.0655 and the torque τ = C_D Ω² + D Ω ≈ 0.0756 that holds it.
+  double hover_speed() const { return std::sqrt(p.m * p.g / (4.0 * p.C_T)); }
+  double hover_torque() const {
+    const double w = hover_speed();
+    return p.C_D * w * w + p.D * w;
+  }
+
+  State hover_state(const Eigen::Vector3d& position) const {
+    State x = Eigen::Matrix<double, nx, 1>::Zero();
+    x.head<3>() = position;
+    x.tail<4>().setConstant(hover_speed());
+    return x;
+  }
+  Input hover_input() const {
+    return Eigen::Matrix<double, nu, 1>::Constant(hover_torque());
+  }
+};
+
+}  // namespace mixpilot::models

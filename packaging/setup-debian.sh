@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package mixpilot needs to build, test and run. Idempotent: packages
+# already installed are left alone, and nothing is done when all are present.
+# As root it calls apt-get; otherwise sudo apt-get.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkgconf git
+  # core maths: linear algebra, offline NLPs (reference trajectories, converged baselines)
+  libeigen3-dev coinor-libipopt-dev
+  # scenario files
+  libtomlplusplus-dev
+  # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
+  libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev
+  # gamepads
+  libsdl2-dev
+  # network peers (C API + idlc)
+  cyclonedds-dev cyclonedds-tools
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # tooling: independent MCAP reader in the recording tests
+  nodejs
+)
+# Debian's npm conflicts with a nodejs that already bundles npm; ask for it only when missing.
+command -v npm >/dev/null 2>&1 || packages+=(npm)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q '^install ok installed$'; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup-debian: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
+echo "setup-debian: installing ${#missing[@]} package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup-debian: done"

@@ -1,0 +1,56 @@
+// "Size once, never allocate in the control loop": hot-path calls run with Eigen's runtime
+// allocation check armed (EIGEN_RUNTIME_NO_MALLOC), which aborts on any Eigen heap allocation.
+#include <gtest/gtest.h>
+
+#include "core/integrator_erk4.hpp"
+#include "models/crazyflie.hpp"
+#include "models/mikrokopter.hpp"
+#include "models/pendubot.hpp"
+
+namespace mixpilot {
+namespace {
+
+// RAII guard: Eigen heap allocation is forbidden while it lives.
+struct NoMalloc {
+  NoMalloc() { Eigen::internal::set_is_malloc_allowed(false); }
+  ~NoMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
+};
+
+TEST(NoMallocGuard, CatchesAnAllocation) {
+  // The check is live in this build: an allocation under the guard aborts.
+  EXPECT_DEATH(
+      {
+        NoMalloc guard;
+        Eigen::VectorXd v(64);
+        v.setOnes();
+      },
+      "");
+}
+
+template <class M>
+void expect_erk4_allocation_free(const M& model, const Eigen::VectorXd& x,
+                                 const Eigen::VectorXd& u) {
+  const IntegratorErk4<M> erk4(model);
+  const Integrator& integ = erk4;
+  Eigen::VectorXd xn(M::nx);
+  Eigen::MatrixXd A(M::nx, M::nx), B(M::nx, M::nu);
+  NoMalloc guard;
+  EXPECT_EQ(integ.step(x, u, 0.01, xn), IntegratorStatus::success);
+  EXPECT_EQ(integ.step_sensitivities(x, u, 0.01, xn, A, B), IntegratorStatus::success);
+}
+
+TEST(NoMalloc, Erk4Pendubot) {
+  expect_erk4_allocation_free(models::Pendubot{}, Eigen::Vector4d(0.1, 0.2, 0.3, 0.4),
+                              Eigen::VectorXd::Constant(1, 0.1));
+}
+TEST(NoMalloc, Erk4Crazyflie) {
+  const models::Crazyflie cf;
+  expect_erk4_allocation_free(cf, cf.hover_state({0, 0, 1}), cf.hover_input());
+}
+TEST(NoMalloc, Erk4MikroKopter) {
+  const models::MikroKopter mk;
+  expect_erk4_allocation_free(mk, mk.hover_state({0, 0, 1}), mk.hover_input());
+}
+
+}  // namespace
+}  // namespace mixpilot
