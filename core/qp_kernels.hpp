@@ -1,0 +1,34 @@
+#pragma once
+// Small dense kernels of the Riccati recursion (core/qp_riccati_ipm.cpp), on column-major
+// storage with leading dimensions. Sizes are those of one stage (≲ 30), where general BLAS-style
+// blocking does not pay; see qp_kernels.cpp for the register-blocked versions.
+namespace mixpilot::kernels {
+
+// Y (n x m) = A (n x m) · L (m x m, lower triangular).
+void trmm_rl(int n, int m, const double* A, int lda, const double* L, int ldl, double* Y, int ldy);
+
+// C (n x n, lower triangle) += Y Yᵀ, Y n x m.
+void syrk_ln(int n, int m, const double* Y, int ldy, double* C, int ldc);
+
+// C (n x n, lower triangle) += alpha · y yᵀ.
+void syr_lower(int n, double alpha, const double* y, double* C, int ldc);
+
+// In-place lower Cholesky C = L Lᵀ (IPM blocks are ill-conditioned by design, so pivots are not
+// compared with a relative threshold). A pivot p ≤ 0 with p ≥ −psd_tol·|C_jj| zeroes the column
+// (inv_diag = 0, a pseudo-factor) when the column is a state column (j ≥ n_strict: a positive
+// semidefinite cost-to-go) or C_jj > 0 (an input column whose Schur complement vanished to
+// rounding error under huge barrier weights). Otherwise — negative curvature, or an input with no
+// curvature at all — returns false.
+bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol);
+
+// x ← L⁻¹ x (zero pivots give zero components).
+void trsv_ln(int n, const double* L, int ldl, const double* inv_diag, double* x);
+// x ← L⁻ᵀ x.
+void trsv_lt(int n, const double* L, int ldl, const double* inv_diag, double* x);
+
+// y += Lᵀ x  (L n x n lower).
+void trmv_lt_add(int n, const double* L, int ldl, const double* x, double* y);
+// y = L x.
+void trmv_ln(int n, const double* L, int ldl, const double* x, double* y);
+
+}  // namespace mixpilot::kernels

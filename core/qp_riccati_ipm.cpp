@@ -1,0 +1,653 @@
+#include "core/qp_riccati_ipm.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/qp_kernels.hpp"
+
+// Notation (per stage i; see core/ocp_qp.hpp for the problem).
+//   v = [u; x] (nv = nu + nx),  d(v) = [u[idxbu]; x[idxbx]; C x + D u] (nc constraints),
+//   inequalities, stacked per stage as [lb (nc); ub (nc); ls (ns); us (ns)] with slacks t ≥ 0:
+//     t_lb = d − lb + J_l s_l,  t_ub = ub − d + J_u s_u,  t_ls = s_l,  t_us = s_u,
+//   multipliers λ ≥ 0 of the same layout, complementarity t∘λ = μ.
+// Residuals at the iterate:
+//   r_v  = H v + g + [Bᵀ; Aᵀ] π_i − [0; π_{i−1}] + ∇dᵀ(λ_ub − λ_lb)
+//   r_sl = Zl s_l + zl − J_lᵀλ_lb − λ_ls,   r_su = Zu s_u + zu − J_uᵀλ_ub − λ_us
+//   r_π  = A x + B u + b − x_{i+1},          r_t = (constraint expression) − t
+// Newton step with complementarity right-hand side r_c (λ∘t for the predictor, Mehrotra's
+// λ∘t + Δλ_aff∘Δt_aff − σμ for the corrector): Δλ = −(r_c + λ∘Δt)/t. With W = λ/t and
+// ρ = r_c/t + W∘r_t this gives Δλ = −W∘(∇Δt-part) − ρ. Eliminating Δs_l (Ψ_l = Zl + W_lb + W_ls):
+//   Δs_l = Ψ_l⁻¹(−r_sl − ρ_lb − ρ_ls − W_lb ∇dΔv),   Δs_u = Ψ_u⁻¹(−r_su − ρ_ub − ρ_us + W_ub ∇dΔv)
+// and the stage system becomes (H + ∇dᵀW̃∇d) Δv + [dynamics multipliers] = −(r_v + ∇dᵀ g̃) with
+//   W̃ = W_lb + W_ub − W_lb²/Ψ_l − W_ub²/Ψ_u,
+//   g̃ = ρ_lb − ρ_ub + W_lb Ψ_l⁻¹(−r_sl − ρ_lb − ρ_ls) − W_ub Ψ_u⁻¹(−r_su − ρ_ub − ρ_us)
+// (soft terms only on softened constraints). Riccati, square-root form with P_{i+1} = Lx Lxᵀ:
+//   Y_i = [Bᵀ; Aᵀ] Lx_{i+1},  L_i L_iᵀ = H̃_i + Y_i Y_iᵀ,  Lx_i = trailing nx block of L_i,
+// backward gradient pass l_i = L_i⁻¹(g̃_i + Y_i (Lx_{i+1}ᵀ r_π,i + lx_{i+1})), and the forward pass
+//   Δu_i = −Luu⁻ᵀ(LxuᵀΔx_i + lu_i),  Δx_{i+1} = AΔx_i + BΔu_i + r_π,i,
+//   Δπ_i = Lx_{i+1}(Lx_{i+1}ᵀΔx_{i+1} + lx_{i+1}).
+// x_0 is fixed (Δx_0 = 0), so stage 0 factorizes only its uu block.
+
+namespace mixpilot {
+
+namespace {
+
+bool finite(const Eigen::MatrixXd& m) { return m.allFinite(); }
+bool finite(const Eigen::VectorXd& m) { return m.allFinite(); }
+
+// Bounds: NaN is invalid; ±inf or |b| ≥ inf_bound means the side is absent.
+bool bound_ok(const Eigen::VectorXd& b) {
+  for (Eigen::Index k = 0; k < b.size(); ++k)
+    if (std::isnan(b[k])) return false;
+  return true;
+}
+
+}  // namespace
+
+bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
+  settings_ = settings;
+  ready_ = dims.valid();
+  if (!ready_) return false;
+  Workspace& w = ws_;
+  w.dims = dims;
+  const int N = dims.N;
+  const std::size_t n1 = static_cast<std::size_t>(N) + 1;
+  w.nv.assign(n1, 0);
+  w.nc.assign(n1, 0);
+  w.off_v.assign(n1, 0);
+  w.off_pi.assign(n1, 0);
+  w.off_s.assign(n1, 0);
+  w.off_m.assign(n1, 0);
+  w.off_c.assign(n1, 0);
+  w.var_of_box.assign(n1, {});
+  w.soft_of.assign(n1, {});
+  w.BAt.assign(n1, {});
+  w.DCt.assign(n1, {});
+  w.L.assign(n1, {});
+  w.Y.assign(n1, {});
+  w.inv_diag.assign(n1, {});
+  w.tmp.assign(n1, {});
+  int ov = 0, op = 0, os = 0, om = 0, oc = 0;
+  for (int i = 0; i <= N; ++i) {
+    const int nx = dims.nx[i], nu = dims.nu[i], nx1 = i < N ? dims.nx[i + 1] : 0;
+    const int nv = nx + nu, nc = dims.nc(i), ns = dims.ns[i];
+    w.nv[i] = nv;
+    w.nc[i] = nc;
+    w.off_v[i] = ov;
+    w.off_pi[i] = op;
+    w.off_s[i] = os;
+    w.off_m[i] = om;
+    w.off_c[i] = oc;
+    ov += nv;
+    op += nx1;
+    os += 2 * ns;
+    om += 2 * nc + 2 * ns;
+    oc += nc;
+    w.var_of_box[i] = Eigen::VectorXi::Zero(dims.nbu[i] + dims.nbx[i]);
+    w.soft_of[i] = Eigen::VectorXi::Constant(nc, -1);
+    w.BAt[i] = Eigen::MatrixXd::Zero(nv, nx1);
+    w.DCt[i] = Eigen::MatrixXd::Zero(nv, dims.ng[i]);
+    w.L[i] = Eigen::MatrixXd::Zero(nv, nv);
+    w.Y[i] = Eigen::MatrixXd::Zero(nv, nx1);
+    w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
+    w.tmp[i] = Eigen::VectorXd::Zero(std::max({nv, nx1, nc, 1}));
+  }
+  for (Eigen::VectorXd* p : {&w.v, &w.dv, &w.res_v, &w.l, &w.gflat, &w.err_v, &w.cv})
+    *p = Eigen::VectorXd::Zero(ov);
+  for (Eigen::VectorXd* p : {&w.pi, &w.dpi, &w.res_pi, &w.bflat, &w.err_pi, &w.cpi})
+    *p = Eigen::VectorXd::Zero(op);
+  for (Eigen::VectorXd* p : {&w.s, &w.ds, &w.res_s, &w.zflat, &w.err_s, &w.cs})
+    *p = Eigen::VectorXd::Zero(os);
+  for (Eigen::VectorXd* p : {&w.t, &w.dt, &w.lam, &w.dlam, &w.res_t, &w.mask, &w.w, &w.rc,
+                             &w.rho, &w.dt_aff, &w.dlam_aff, &w.ct, &w.clam, &w.zero_m})
+    *p = Eigen::VectorXd::Zero(om);
+  for (Eigen::VectorXd* p : {&w.lbnd, &w.ubnd, &w.wc, &w.gc, &w.dd}) *p = Eigen::VectorXd::Zero(oc);
+  w.psi_l = Eigen::VectorXd::Zero(os / 2);
+  w.psi_u = Eigen::VectorXd::Zero(os / 2);
+  return true;
+}
+
+bool QpRiccatiIpm::data_finite(const OcpQp& qp) const {
+  if (!finite(qp.x0)) return false;
+  for (int i = 0; i <= qp.dims.N; ++i) {
+    const OcpQpStage& s = qp.stage[i];
+    if (!(finite(s.A) && finite(s.B) && finite(s.b) && finite(s.Q) && finite(s.S) &&
+          finite(s.R) && finite(s.q) && finite(s.r) && finite(s.C) && finite(s.D) &&
+          finite(s.Zl) && finite(s.Zu) && finite(s.zl) && finite(s.zu)))
+      return false;
+    if (!(bound_ok(s.lbu) && bound_ok(s.ubu) && bound_ok(s.lbx) && bound_ok(s.ubx) &&
+          bound_ok(s.lg) && bound_ok(s.ug)))
+      return false;
+  }
+  return true;
+}
+
+// Copies the stage data into the solver's layout; false if an index is out of range or a size
+// does not match.
+void QpRiccatiIpm::load(const OcpQp& qp) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  const double big = settings_.inf_bound;
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& s = qp.stage[i];
+    const int nu = d.nu[i], nx = d.nx[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i];
+    const int nc = w.nc[i], ns = d.ns[i];
+    if (i < d.N) {
+      w.BAt[i].topRows(nu) = s.B.transpose();
+      w.BAt[i].bottomRows(nx) = s.A.transpose();
+      w.bflat.segment(w.off_pi[i], d.nx[i + 1]) = s.b;
+    }
+    w.gflat.segment(w.off_v[i], nu) = s.r;
+    w.gflat.segment(w.off_v[i] + nu, nx) = s.q;
+    w.zflat.segment(w.off_s[i], ns) = s.zl;
+    w.zflat.segment(w.off_s[i] + ns, ns) = s.zu;
+    if (ng > 0) {
+      w.DCt[i].topRows(nu) = s.D.transpose();
+      w.DCt[i].bottomRows(nx) = s.C.transpose();
+    }
+    for (int k = 0; k < nbu; ++k) w.var_of_box[i][k] = s.idxbu[k];
+    for (int k = 0; k < nbx; ++k) w.var_of_box[i][nbu + k] = nu + s.idxbx[k];
+    w.soft_of[i].setConstant(-1);
+    for (int j = 0; j < ns; ++j) w.soft_of[i][s.idxs[j]] = j;
+    const int oc = w.off_c[i], om = w.off_m[i];
+    for (int k = 0; k < nc; ++k) {
+      double lo, hi;
+      if (k < nbu) {
+        lo = s.lbu[k];
+        hi = s.ubu[k];
+      } else if (k < nbu + nbx) {
+        lo = s.lbx[k - nbu];
+        hi = s.ubx[k - nbu];
+      } else {
+        lo = s.lg[k - nbu - nbx];
+        hi = s.ug[k - nbu - nbx];
+      }
+      const bool has_lo = std::isfinite(lo) && std::abs(lo) < big;
+      const bool has_hi = std::isfinite(hi) && std::abs(hi) < big;
+      w.lbnd[oc + k] = has_lo ? lo : 0.0;
+      w.ubnd[oc + k] = has_hi ? hi : 0.0;
+      w.mask[om + k] = has_lo ? 1.0 : 0.0;
+      w.mask[om + nc + k] = has_hi ? 1.0 : 0.0;
+    }
+    // s ≥ 0 is implied at the optimum when z = 0 < Z (stationarity gives s = λ/Z ≥ 0); imposing
+    // it would make s·λ_s = 0 degenerate (both → 0 like √μ) for every inactive ℓ2²-soft side.
+    for (int j = 0; j < ns; ++j) {
+      w.mask[om + 2 * nc + j] = (s.zl[j] != 0.0 || s.Zl[j] <= 0.0) ? 1.0 : 0.0;
+      w.mask[om + 2 * nc + ns + j] = (s.zu[j] != 0.0 || s.Zu[j] <= 0.0) ? 1.0 : 0.0;
+    }
+  }
+  w.m_total = static_cast<int>(w.mask.sum() + 0.5);
+}
+
+// Constraint values d(v) of stage i into dd (flat per constraint).
+static void eval_constraints(const QpRiccatiIpmWorkspace& w, int i, const Eigen::VectorXd& v,
+                             Eigen::VectorXd& dd) {
+  const int nb = w.dims.nbu[i] + w.dims.nbx[i], ng = w.dims.ng[i];
+  const int ov = w.off_v[i], oc = w.off_c[i];
+  for (int k = 0; k < nb; ++k) dd[oc + k] = v[ov + w.var_of_box[i][k]];
+  if (ng > 0)
+    dd.segment(oc + nb, ng).noalias() = w.DCt[i].transpose() * v.segment(ov, w.nv[i]);
+}
+
+void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  const bool primal = warm != QpWarmStart::cold;
+  const bool dual = warm == QpWarmStart::primal_dual;
+  const double thr = dual ? settings_.warm_start_floor : settings_.init_slack;
+  for (int i = 0; i <= d.N; ++i) {
+    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
+    const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
+    if (primal) {
+      w.v.segment(ov, nu) = sol.u[i];
+      w.v.segment(ov + nu, nx) = sol.x[i];
+      w.s.segment(os, ns) = sol.sl[i].cwiseMax(0.0);
+      w.s.segment(os + ns, ns) = sol.su[i].cwiseMax(0.0);
+    } else {
+      w.v.segment(ov, nu + nx).setZero();
+      w.s.segment(os, 2 * ns).setZero();
+    }
+    if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
+    if (i < d.N) {
+      if (dual)
+        w.pi.segment(w.off_pi[i], d.nx[i + 1]) = sol.pi[i];
+      else
+        w.pi.segment(w.off_pi[i], d.nx[i + 1]).setZero();
+    }
+    eval_constraints(w, i, w.v, w.dd);
+    for (int k = 0; k < nc; ++k) {
+      const int j = w.soft_of[i][k];
+      const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
+      w.t[om + k] = w.dd[oc + k] - w.lbnd[oc + k] + sl;
+      w.t[om + nc + k] = w.ubnd[oc + k] - w.dd[oc + k] + su;
+      if (dual) {
+        w.lam[om + k] = sol.lam_l[i][k];
+        w.lam[om + nc + k] = sol.lam_u[i][k];
+      }
+    }
+    w.t.segment(om + 2 * nc, 2 * ns) = w.s.segment(os, 2 * ns);
+    if (dual) {
+      w.lam.segment(om + 2 * nc, ns) = sol.lam_sl[i];
+      w.lam.segment(om + 2 * nc + ns, ns) = sol.lam_su[i];
+    }
+  }
+  const int m = static_cast<int>(w.t.size());
+  for (int k = 0; k < m; ++k) {
+    if (w.mask[k] == 0.0) {
+      w.t[k] = 1.0;
+      w.lam[k] = 0.0;
+      continue;
+    }
+    w.t[k] = std::max(w.t[k], thr);
+    w.lam[k] = dual ? std::max(w.lam[k], thr) : settings_.init_mu / w.t[k];
+  }
+}
+
+// Stationarity and dynamics residuals of the point (v, π, s, λ) with the linear terms (g, z, b):
+//   out_v  = H v + g + [Bᵀ; Aᵀ] π_i − [0; π_{i−1}] + ∇dᵀ(λ_ub − λ_lb),
+//   out_s  = [Zl s_l + zl − J_lᵀλ_lb − λ_ls; Zu s_u + zu − J_uᵀλ_ub − λ_us],
+//   out_pi = A x + B u + b − x_{i+1}.
+// With (g, z, b) from the QP this is the KKT residual of an iterate; with (r_v, r_s, r_π) and a
+// Newton direction it is the error of the linear solve (iterative refinement).
+void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
+                                   const Eigen::VectorXd& pi, const Eigen::VectorXd& s,
+                                   const Eigen::VectorXd& lam, const Eigen::VectorXd& g,
+                                   const Eigen::VectorXd& z, const Eigen::VectorXd& b,
+                                   Eigen::VectorXd& out_v, Eigen::VectorXd& out_s,
+                                   Eigen::VectorXd& out_pi) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
+    const int nb = d.nbu[i] + d.nbx[i];
+    const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i];
+    auto u = v.segment(ov, nu);
+    auto x = v.segment(ov + nu, nx);
+    auto ru = out_v.segment(ov, nu);
+    auto rx = out_v.segment(ov + nu, nx);
+    out_v.segment(ov, nu + nx) = g.segment(ov, nu + nx);
+    ru.noalias() += st.R * u;
+    ru.noalias() += st.S * x;
+    rx.noalias() += st.Q * x;
+    rx.noalias() += st.S.transpose() * u;
+    if (i < d.N)
+      out_v.segment(ov, nu + nx).noalias() += w.BAt[i] * pi.segment(w.off_pi[i], d.nx[i + 1]);
+    if (i > 0) rx -= pi.segment(w.off_pi[i - 1], nx);
+    for (int k = 0; k < nb; ++k) out_v[ov + w.var_of_box[i][k]] += lam[om + nc + k] - lam[om + k];
+    if (ng > 0) {
+      auto tmp = w.tmp[i].head(ng);
+      tmp = lam.segment(om + nc + nb, ng) - lam.segment(om + nb, ng);
+      out_v.segment(ov, nu + nx).noalias() += w.DCt[i] * tmp;
+    }
+    for (int j = 0; j < ns; ++j) {
+      const int k = st.idxs[j];
+      out_s[os + j] = st.Zl[j] * s[os + j] + z[os + j] - lam[om + k] - lam[om + 2 * nc + j];
+      out_s[os + ns + j] =
+          st.Zu[j] * s[os + ns + j] + z[os + ns + j] - lam[om + nc + k] - lam[om + 2 * nc + ns + j];
+    }
+    if (i < d.N) {
+      const int nx1 = d.nx[i + 1], op = w.off_pi[i];
+      auto rp = out_pi.segment(op, nx1);
+      rp = b.segment(op, nx1) - v.segment(w.off_v[i + 1] + d.nu[i + 1], nx1);
+      rp.noalias() += w.BAt[i].transpose() * v.segment(ov, nu + nx);
+    }
+  }
+}
+
+void QpRiccatiIpm::residuals(const OcpQp& qp) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  linear_residual(qp, w.v, w.pi, w.s, w.lam, w.gflat, w.zflat, w.bflat, w.res_v, w.res_s,
+                  w.res_pi);
+  for (int i = 0; i <= d.N; ++i) {
+    const int ns = d.ns[i], nc = w.nc[i];
+    const int os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
+    eval_constraints(w, i, w.v, w.dd);
+    for (int k = 0; k < nc; ++k) {
+      const int j = w.soft_of[i][k];
+      const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
+      w.res_t[om + k] = w.mask[om + k] * (w.dd[oc + k] - w.lbnd[oc + k] + sl - w.t[om + k]);
+      w.res_t[om + nc + k] =
+          w.mask[om + nc + k] * (w.ubnd[oc + k] - w.dd[oc + k] + su - w.t[om + nc + k]);
+    }
+    for (int j = 0; j < ns; ++j) {
+      w.res_t[om + 2 * nc + j] = w.mask[om + 2 * nc + j] * (w.s[os + j] - w.t[om + 2 * nc + j]);
+      w.res_t[om + 2 * nc + ns + j] =
+          w.mask[om + 2 * nc + ns + j] * (w.s[os + ns + j] - w.t[om + 2 * nc + ns + j]);
+    }
+  }
+  res_stat_ = stationarity_norm(w.res_v, w.res_s);
+  res_eq_ = w.res_pi.size() > 0 ? w.res_pi.lpNorm<Eigen::Infinity>() : 0.0;
+  res_ineq_ = w.res_t.size() > 0 ? w.res_t.lpNorm<Eigen::Infinity>() : 0.0;
+  mu_ = w.m_total > 0 ? w.lam.dot(w.t) / w.m_total : 0.0;
+}
+
+// ∞-norm of the stationarity residual, without stage 0's x-part (the x_0 multiplier).
+double QpRiccatiIpm::stationarity_norm(const Eigen::VectorXd& rv, const Eigen::VectorXd& rs) const {
+  const Workspace& w = ws_;
+  double r = 0.0;
+  const int nu0 = w.dims.nu[0], n0 = w.nv[0];
+  if (nu0 > 0) r = rv.head(nu0).lpNorm<Eigen::Infinity>();
+  if (rv.size() > n0) r = std::max(r, rv.tail(rv.size() - n0).lpNorm<Eigen::Infinity>());
+  if (rs.size() > 0) r = std::max(r, rs.lpNorm<Eigen::Infinity>());
+  return r;
+}
+
+bool QpRiccatiIpm::factorize(const OcpQp& qp) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  w.w = w.mask.cwiseProduct(w.lam).cwiseQuotient(w.t);
+  for (int i = d.N; i >= 0; --i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
+    const int nb = d.nbu[i] + d.nbx[i];
+    const int om = w.off_m[i], oc = w.off_c[i], os2 = w.off_s[i] / 2;
+    // Effective constraint weights after eliminating the slacks.
+    for (int k = 0; k < nc; ++k) w.wc[oc + k] = w.w[om + k] + w.w[om + nc + k];
+    for (int j = 0; j < ns; ++j) {
+      const int k = st.idxs[j];
+      const double wl = w.w[om + k], wu = w.w[om + nc + k];
+      const double pl = 1.0 / (st.Zl[j] + wl + w.w[om + 2 * nc + j]);
+      const double pu = 1.0 / (st.Zu[j] + wu + w.w[om + 2 * nc + ns + j]);
+      w.psi_l[os2 + j] = pl;
+      w.psi_u[os2 + j] = pu;
+      w.wc[oc + k] -= wl * wl * pl + wu * wu * pu;
+    }
+    // H̃ = [R S; Sᵀ Q] + ∇dᵀ W̃ ∇d (lower triangle).
+    Eigen::MatrixXd& L = w.L[i];
+    const int n = nu + nx;
+    const int nf = i == 0 ? nu : n;  // stage 0: x_0 fixed, only the uu block
+    L.topLeftCorner(nu, nu).triangularView<Eigen::Lower>() = st.R;
+    if (i > 0) {
+      L.bottomLeftCorner(nx, nu) = st.S.transpose();
+      L.bottomRightCorner(nx, nx).triangularView<Eigen::Lower>() = st.Q;
+    }
+    for (int k = 0; k < nb; ++k) {
+      const int p = w.var_of_box[i][k];
+      if (p < nf) L(p, p) += w.wc[oc + k];
+    }
+    for (int k = 0; k < ng; ++k) {
+      const double wk = w.wc[oc + nb + k];
+      if (wk != 0.0)
+        kernels::syr_lower(nf, wk, w.DCt[i].col(k).data(), L.data(), static_cast<int>(L.rows()));
+    }
+    if (i < d.N) {
+      const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
+      const Eigen::MatrixXd& L1 = w.L[i + 1];
+      const int ld1 = static_cast<int>(L1.rows());
+      // Y = BAt · Lx_{i+1};  L += Y Yᵀ.
+      kernels::trmm_rl(nf, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
+                       L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
+                       w.Y[i].data(), static_cast<int>(w.Y[i].rows()));
+      kernels::syrk_ln(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()), L.data(),
+                       static_cast<int>(L.rows()));
+    }
+    if (!kernels::potrf_l(nf, nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(),
+                          settings_.psd_tol))
+      return false;
+  }
+  return true;
+}
+
+void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
+                                   const Eigen::VectorXd& rs, const Eigen::VectorXd& rpi,
+                                   const Eigen::VectorXd& rt, const Eigen::VectorXd& rc,
+                                   Eigen::VectorXd& dv, Eigen::VectorXd& dpi, Eigen::VectorXd& ds,
+                                   Eigen::VectorXd& dt, Eigen::VectorXd& dlam) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  w.rho = w.mask.cwiseProduct(rc + w.lam.cwiseProduct(rt)).cwiseQuotient(w.t);
+  // Reduced gradients g̃ and the backward pass l_i = L_i⁻¹(g̃_i + Y_i y).
+  for (int i = d.N; i >= 0; --i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
+    const int nb = d.nbu[i] + d.nbx[i];
+    const int ov = w.off_v[i], om = w.off_m[i], oc = w.off_c[i], os = w.off_s[i];
+    const int os2 = os / 2, n = nu + nx, nf = i == 0 ? nu : n;
+    for (int k = 0; k < nc; ++k) w.gc[oc + k] = w.rho[om + k] - w.rho[om + nc + k];
+    for (int j = 0; j < ns; ++j) {
+      const int k = st.idxs[j];
+      const double al =
+          (-rs[os + j] - w.rho[om + k] - w.rho[om + 2 * nc + j]) * w.psi_l[os2 + j];
+      const double au =
+          (-rs[os + ns + j] - w.rho[om + nc + k] - w.rho[om + 2 * nc + ns + j]) *
+          w.psi_u[os2 + j];
+      w.gc[oc + k] += w.w[om + k] * al - w.w[om + nc + k] * au;
+    }
+    auto g = w.l.segment(ov, n);
+    g = rv.segment(ov, n);
+    for (int k = 0; k < nb; ++k) g[w.var_of_box[i][k]] += w.gc[oc + k];
+    if (ng > 0) g.noalias() += w.DCt[i] * w.gc.segment(oc + nb, ng);
+    if (i < d.N) {
+      const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
+      const Eigen::MatrixXd& L1 = w.L[i + 1];
+      auto y = w.tmp[i].head(nx1);
+      y = w.l.segment(w.off_v[i + 1] + nu1, nx1);
+      const int ld1 = static_cast<int>(L1.rows());
+      kernels::trmv_lt_add(nx1, L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
+                           rpi.data() + w.off_pi[i], y.data());
+      g.head(nf).noalias() += w.Y[i].topRows(nf) * y;
+    }
+    kernels::trsv_ln(nf, w.L[i].data(), static_cast<int>(w.L[i].rows()), w.inv_diag[i].data(),
+                     g.data());
+  }
+  // Forward pass.
+  for (int i = 0; i <= d.N; ++i) {
+    const int nu = d.nu[i], nx = d.nx[i];
+    const int ov = w.off_v[i];
+    const Eigen::MatrixXd& L = w.L[i];
+    auto du = dv.segment(ov, nu);
+    auto dx = dv.segment(ov + nu, nx);
+    if (i == 0) dx.setZero();
+    if (nu > 0) {
+      du = w.l.segment(ov, nu);
+      if (i > 0) du.noalias() += L.bottomLeftCorner(nx, nu).transpose() * dx;
+      kernels::trsv_lt(nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(), du.data());
+      du = -du;
+    }
+    if (i < d.N) {
+      const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
+      auto dx1 = dv.segment(w.off_v[i + 1] + nu1, nx1);
+      dx1 = rpi.segment(w.off_pi[i], nx1);
+      dx1.noalias() += w.BAt[i].transpose() * dv.segment(ov, nu + nx);
+      const Eigen::MatrixXd& L1 = w.L[i + 1];
+      const int ld1 = static_cast<int>(L1.rows());
+      const double* Lx = L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1;
+      auto y = w.tmp[i].head(nx1);
+      y = w.l.segment(w.off_v[i + 1] + nu1, nx1);
+      kernels::trmv_lt_add(nx1, Lx, ld1, dx1.data(), y.data());
+      kernels::trmv_ln(nx1, Lx, ld1, y.data(), dpi.data() + w.off_pi[i]);
+    }
+  }
+  // Slack, inequality-slack and multiplier directions.
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int ns = d.ns[i], nc = w.nc[i];
+    const int om = w.off_m[i], oc = w.off_c[i], os = w.off_s[i], os2 = os / 2;
+    eval_constraints(w, i, dv, w.dd);  // ∇d Δv
+    for (int k = 0; k < nc; ++k) {
+      dt[om + k] = w.dd[oc + k] + rt[om + k];
+      dt[om + nc + k] = -w.dd[oc + k] + rt[om + nc + k];
+    }
+    for (int j = 0; j < ns; ++j) {
+      const int k = st.idxs[j];
+      const double dsl = (-rs[os + j] - w.rho[om + k] - w.rho[om + 2 * nc + j] -
+                          w.w[om + k] * w.dd[oc + k]) *
+                         w.psi_l[os2 + j];
+      const double dsu = (-rs[os + ns + j] - w.rho[om + nc + k] -
+                          w.rho[om + 2 * nc + ns + j] + w.w[om + nc + k] * w.dd[oc + k]) *
+                         w.psi_u[os2 + j];
+      ds[os + j] = dsl;
+      ds[os + ns + j] = dsu;
+      dt[om + k] += dsl;
+      dt[om + nc + k] += dsu;
+      dt[om + 2 * nc + j] = dsl + rt[om + 2 * nc + j];
+      dt[om + 2 * nc + ns + j] = dsu + rt[om + 2 * nc + ns + j];
+    }
+  }
+  dt = dt.cwiseProduct(w.mask);
+  dlam = -w.mask.cwiseProduct(rc + w.lam.cwiseProduct(dt)).cwiseQuotient(w.t);
+}
+
+void QpRiccatiIpm::newton_direction(const OcpQp& qp, int refinement_steps) {
+  Workspace& w = ws_;
+  solve_direction(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, w.dv, w.dpi, w.ds, w.dt, w.dlam);
+  // Iterative refinement: Δλ = −W ∇dΔv − ρ cancels to O(λ) from terms of O(W), so rounding in Δv
+  // is amplified by W = λ/t → ∞; the error of the unreduced Newton equations is computed and
+  // solved for with the same factorization. The t and λ equations hold exactly by construction.
+  for (int r = 0; r < refinement_steps; ++r) {
+    linear_residual(qp, w.dv, w.dpi, w.ds, w.dlam, w.res_v, w.res_s, w.res_pi, w.err_v, w.err_s,
+                    w.err_pi);
+    const double e = std::max(stationarity_norm(w.err_v, w.err_s),
+                              w.err_pi.size() > 0 ? w.err_pi.lpNorm<Eigen::Infinity>() : 0.0);
+    if (!(e > settings_.refine_tol)) break;
+    solve_direction(qp, w.err_v, w.err_s, w.err_pi, w.zero_m, w.zero_m, w.cv, w.cpi, w.cs, w.ct,
+                    w.clam);
+    w.dv += w.cv;
+    w.dpi += w.cpi;
+    w.ds += w.cs;
+    w.dt += w.ct;
+    w.dlam += w.clam;
+  }
+}
+
+namespace {
+// Largest α ∈ (0, 1] with z + α dz ≥ 0 componentwise (z > 0).
+double max_step(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alpha) {
+  const Eigen::Index m = z.size();
+  for (Eigen::Index k = 0; k < m; ++k)
+    if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k];
+  return alpha;
+}
+}  // namespace
+
+QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
+  Workspace& w = ws_;
+  auto fail_invalid = [&] {
+    for (auto* vs : {&sol.x, &sol.u, &sol.pi, &sol.lam_l, &sol.lam_u, &sol.sl, &sol.su,
+                     &sol.lam_sl, &sol.lam_su})
+      for (auto& v : *vs) v.setZero();
+    sol.lam_x0.setZero();
+    sol.iterations = 0;
+    sol.objective = sol.res_stat = sol.res_eq = sol.res_ineq = sol.res_comp = 0.0;
+    sol.status = QpStatus::invalid_data;
+    return sol.status;
+  };
+  if (!ready_ || qp.dims.N != w.dims.N || qp.dims.nx != w.dims.nx || qp.dims.nu != w.dims.nu ||
+      qp.dims.nbx != w.dims.nbx || qp.dims.nbu != w.dims.nbu || qp.dims.ng != w.dims.ng ||
+      qp.dims.ns != w.dims.ns)
+    return fail_invalid();
+  for (int i = 0; i <= w.dims.N; ++i) {
+    const OcpQpStage& s = qp.stage[i];
+    for (int k = 0; k < w.dims.nbu[i]; ++k)
+      if (s.idxbu[k] < 0 || s.idxbu[k] >= w.dims.nu[i]) return fail_invalid();
+    for (int k = 0; k < w.dims.nbx[i]; ++k)
+      if (s.idxbx[k] < 0 || s.idxbx[k] >= w.dims.nx[i]) return fail_invalid();
+    for (int j = 0; j < w.dims.ns[i]; ++j)
+      if (s.idxs[j] < 0 || s.idxs[j] >= w.nc[i]) return fail_invalid();
+  }
+  if (settings_.check_data && !data_finite(qp)) return fail_invalid();
+  load(qp);
+  initialize(qp, sol, warm);
+
+  const Settings& cfg = settings_;
+  QpStatus status = QpStatus::max_iterations;
+  int it = 0;
+  for (;; ++it) {
+    residuals(qp);
+    if (!(std::isfinite(res_stat_) && std::isfinite(res_eq_) && std::isfinite(res_ineq_) &&
+          std::isfinite(mu_))) {
+      status = QpStatus::nan_detected;  // cannot happen from finite data; kept as a guard
+      break;
+    }
+    if (res_stat_ <= cfg.tol_stat && res_eq_ <= cfg.tol_eq && res_ineq_ <= cfg.tol_ineq &&
+        mu_ <= cfg.tol_comp) {
+      status = QpStatus::success;
+      break;
+    }
+    if (it >= cfg.max_iterations) {
+      status = QpStatus::max_iterations;
+      break;
+    }
+    if (!factorize(qp)) {
+      status = QpStatus::factorization_failed;
+      break;
+    }
+    // Predictor (affine scaling) direction.
+    w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t));
+    newton_direction(qp, cfg.refinement_steps);
+    if (w.m_total > 0) {
+      double a_aff = max_step(w.t, w.dt, 1.0);
+      a_aff = max_step(w.lam, w.dlam, a_aff);
+      const double mu_aff =
+          (w.lam + a_aff * w.dlam).dot(w.t + a_aff * w.dt) / static_cast<double>(w.m_total);
+      const double ratio = mu_ > 0.0 ? mu_aff / mu_ : 0.0;
+      const double sigma = std::clamp(ratio * ratio * ratio, 0.0, 1.0);
+      // Corrector: Mehrotra's second-order term and centring, same factorization.
+      w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
+                                 Eigen::VectorXd::Constant(w.t.size(), sigma * mu_));
+      newton_direction(qp, cfg.refinement_steps);
+    }
+    const double check = w.dv.sum() + w.dpi.sum() + w.ds.sum() + w.dt.sum() + w.dlam.sum();
+    if (!std::isfinite(check)) {
+      status = QpStatus::nan_detected;
+      break;
+    }
+    double alpha = max_step(w.t, w.dt, 1.0 / cfg.step_fraction);
+    alpha = std::min(1.0, cfg.step_fraction * max_step(w.lam, w.dlam, alpha));
+    if (alpha < cfg.min_step) {
+      status = QpStatus::min_step;
+      break;
+    }
+    w.v += alpha * w.dv;
+    w.pi += alpha * w.dpi;
+    w.s += alpha * w.ds;
+    w.t += alpha * w.dt;
+    w.lam += alpha * w.dlam;
+  }
+  sol.iterations = it;
+  write_solution(qp, sol);
+  sol.status = status;
+  return status;
+}
+
+void QpRiccatiIpm::write_solution(const OcpQp& qp, OcpQpSolution& sol) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  double f = 0.0;
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
+    const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i];
+    sol.u[i] = w.v.segment(ov, nu);
+    sol.x[i] = w.v.segment(ov + nu, nx);
+    if (i < d.N) sol.pi[i] = w.pi.segment(w.off_pi[i], d.nx[i + 1]);
+    sol.lam_l[i] = w.lam.segment(om, nc);
+    sol.lam_u[i] = w.lam.segment(om + nc, nc);
+    sol.sl[i] = w.s.segment(os, ns);
+    sol.su[i] = w.s.segment(os + ns, ns);
+    sol.lam_sl[i] = w.lam.segment(om + 2 * nc, ns);
+    sol.lam_su[i] = w.lam.segment(om + 2 * nc + ns, ns);
+    auto tmp = w.tmp[i].head(std::max(nu, nx));
+    if (nu > 0) {
+      tmp.head(nu).noalias() = st.R * sol.u[i];
+      tmp.head(nu).noalias() += 2.0 * st.S * sol.x[i];
+      f += 0.5 * sol.u[i].dot(tmp.head(nu)) + st.r.dot(sol.u[i]);
+    }
+    if (nx > 0) {
+      tmp.head(nx).noalias() = st.Q * sol.x[i];
+      f += 0.5 * sol.x[i].dot(tmp.head(nx)) + st.q.dot(sol.x[i]);
+    }
+    f += 0.5 * sol.sl[i].dot(st.Zl.cwiseProduct(sol.sl[i])) + st.zl.dot(sol.sl[i]);
+    f += 0.5 * sol.su[i].dot(st.Zu.cwiseProduct(sol.su[i])) + st.zu.dot(sol.su[i]);
+  }
+  sol.lam_x0 = w.res_v.segment(d.nu[0], d.nx[0]);
+  sol.objective = f;
+  sol.res_stat = res_stat_;
+  sol.res_eq = res_eq_;
+  sol.res_ineq = res_ineq_;
+  sol.res_comp = mu_;
+}
+
+}  // namespace mixpilot

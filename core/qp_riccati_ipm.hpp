@@ -1,0 +1,143 @@
+#pragma once
+// Structure-exploiting OCP-QP solver (SPEC §4): primal-dual interior point with Mehrotra's
+// predictor-corrector, one Riccati factorization per iteration (HPIPM-style square-root form,
+// Frison & Diehl 2020), soft-constraint slacks eliminated stage-wise.
+//
+// Newton system of one iteration. With t the inequality slacks and λ their multipliers,
+// W = λ/t, the inequality and slack directions are eliminated per stage (see the .cpp), leaving
+// the equality-constrained QP in (Δx, Δu)
+//   min Σ ½ Δvᵢᵀ H̃ᵢ Δvᵢ + g̃ᵢᵀΔvᵢ   s.t. Δx_{i+1} = AᵢΔxᵢ + BᵢΔuᵢ + r_dyn,ᵢ,  Δx_0 = 0,
+// H̃ᵢ = Hᵢ + ∇dᵢᵀ W̃ᵢ ∇dᵢ, which the Riccati recursion solves in O(N (nx+nu)³) without ever forming
+// the banded KKT matrix. The factorization is reused for predictor and corrector.
+//
+// setup() sizes every buffer; solve() allocates nothing.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/ocp_qp.hpp"
+#include "core/types.hpp"
+
+namespace mixpilot {
+
+struct QpRiccatiIpmSettings {
+  int max_iterations = qp_defaults::kMaxIterations;
+  double tol_stat = qp_defaults::kTolStationarity;
+  double tol_eq = qp_defaults::kTolEquality;
+  double tol_ineq = qp_defaults::kTolInequality;
+  double tol_comp = qp_defaults::kTolComplementarity;
+  double step_fraction = qp_defaults::kStepFraction;
+  double min_step = qp_defaults::kMinStep;
+  double init_slack = qp_defaults::kInitSlack;
+  double init_mu = qp_defaults::kInitMu;
+  double warm_start_floor = qp_defaults::kWarmStartFloor;
+  double psd_tol = qp_defaults::kPsdTol;
+  double inf_bound = qp_defaults::kInfBound;
+  // Iterative-refinement steps per Newton direction, done while the linear-solve error exceeds
+  // refine_tol (∞-norm).
+  int refinement_steps = qp_defaults::kRefinementSteps;
+  double refine_tol = qp_defaults::kRefineTol;
+  bool check_data = true;  // scan the QP data for NaN/Inf before solving
+};
+
+enum class QpWarmStart {
+  cold,         // x = 0 (x_0 = x0), u = 0, slacks and multipliers from init_slack / init_mu
+  primal,       // x, u, s_l, s_u taken from the solution argument; multipliers cold
+  primal_dual,  // also π, λ taken from the solution argument (clipped to be interior)
+};
+
+// Per-stage and flat buffers of the solver; sized by QpRiccatiIpm::setup(). Flat vectors hold
+// all stages back to back at the offsets below.
+struct QpRiccatiIpmWorkspace {
+  OcpQpDims dims;
+  // Per-stage sizes and offsets into the flat vectors.
+  std::vector<int> nv;    // nu_i + nx_i (stage variable v_i = [u_i; x_i])
+  std::vector<int> nc;    // nbu + nbx + ng
+  std::vector<int> off_v;    // into v, dv, res_v, grad
+  std::vector<int> off_pi;   // into pi, dpi, res_pi (stages 0..N-1)
+  std::vector<int> off_s;    // into s, ds, res_s: [s_l (ns); s_u (ns)]
+  std::vector<int> off_m;    // into t, lam, ...: [lb (nc); ub (nc); ls (ns); us (ns)]
+  std::vector<int> off_c;    // into flat per-constraint vectors (nc)
+  std::vector<Eigen::VectorXi> var_of_box;  // nbu+nbx: index into v_i of each box constraint
+  std::vector<Eigen::VectorXi> soft_of;     // nc: slack index j of constraint k, or -1
+  std::vector<Eigen::MatrixXd> BAt;         // (nu+nx) x nx_{i+1}: [Bᵀ; Aᵀ]
+  std::vector<Eigen::MatrixXd> DCt;         // (nu+nx) x ng: [Dᵀ; Cᵀ]
+  std::vector<Eigen::MatrixXd> L;           // (nu+nx) x (nu+nx): H̃ + BAt P BAtᵀ, then its
+                                            // lower Cholesky factor (stage 0: uu block only)
+  std::vector<Eigen::MatrixXd> Y;           // (nu+nx) x nx_{i+1}: BAt · Lx_{i+1}
+  std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L), 0 for zero pivots
+  std::vector<Eigen::VectorXd> tmp;         // max(nx_{i+1}, nc): scratch per stage
+
+  // Iterate and direction (flat).
+  Eigen::VectorXd v, dv, pi, dpi, s, ds, t, dt, lam, dlam;
+  // Residuals: stationarity in v and s, dynamics, inequalities (constraint − t).
+  Eigen::VectorXd res_v, res_s, res_pi, res_t;
+  // Linear terms of the QP, flat: g = [r; q] per stage, z = [zl; zu], b.
+  Eigen::VectorXd gflat, zflat, bflat;
+  // Iterative refinement: error of a computed direction, the correction, zero right-hand sides.
+  Eigen::VectorXd err_v, err_s, err_pi, cv, cpi, cs, ct, clam, zero_m;
+  Eigen::VectorXd lbnd, ubnd;   // per constraint (flat nc): bound values, 0 where absent
+  Eigen::VectorXd mask;         // per inequality (flat m): 1 present, 0 absent
+  Eigen::VectorXd w;            // per inequality: λ/t (0 where absent)
+  Eigen::VectorXd rc;           // per inequality: complementarity right-hand side
+  Eigen::VectorXd rho;          // per inequality: r_c/t + W r_t
+  Eigen::VectorXd wc;           // per constraint: effective weight W̃ after slack elimination
+  Eigen::VectorXd gc;           // per constraint: effective gradient term
+  Eigen::VectorXd dd;           // per constraint: ∇d Δv (and d at the iterate)
+  Eigen::VectorXd psi_l, psi_u;  // per slack: Zl + W_lb + W_ls etc. (inverted)
+  Eigen::VectorXd l;            // per stage variable: L⁻¹(gradient) of the backward pass
+  Eigen::VectorXd dt_aff, dlam_aff;
+  int m_total = 0;  // number of present inequalities (for the mean complementarity)
+};
+
+class QpRiccatiIpm {
+ public:
+  using Settings = QpRiccatiIpmSettings;
+  using Workspace = QpRiccatiIpmWorkspace;
+
+  QpRiccatiIpm() = default;
+  explicit QpRiccatiIpm(const OcpQpDims& dims, const Settings& settings = {}) {
+    setup(dims, settings);
+  }
+
+  // Sizes every buffer for dims. Returns false (and solve() then returns invalid_data) when the
+  // dims are not valid().
+  bool setup(const OcpQpDims& dims, const Settings& settings = {});
+
+  // Solves qp (whose dims must equal the setup dims) into sol (sized with the same dims; read
+  // as the warm start when requested). Never allocates, throws or prints. On any status other
+  // than success, sol holds the last finite iterate (or zeros for invalid_data) and no NaN.
+  QpStatus solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm = QpWarmStart::cold);
+
+  Settings& settings() { return settings_; }
+  const Settings& settings() const { return settings_; }
+  const OcpQpDims& dims() const { return ws_.dims; }
+
+ private:
+  bool data_finite(const OcpQp& qp) const;
+  void load(const OcpQp& qp);
+  void initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm);
+  void linear_residual(const OcpQp& qp, const Eigen::VectorXd& v, const Eigen::VectorXd& pi,
+                       const Eigen::VectorXd& s, const Eigen::VectorXd& lam,
+                       const Eigen::VectorXd& g, const Eigen::VectorXd& z,
+                       const Eigen::VectorXd& b, Eigen::VectorXd& out_v, Eigen::VectorXd& out_s,
+                       Eigen::VectorXd& out_pi);
+  void residuals(const OcpQp& qp);
+  double stationarity_norm(const Eigen::VectorXd& rv, const Eigen::VectorXd& rs) const;
+  bool factorize(const OcpQp& qp);
+  // Newton direction for the right-hand side (r_v, r_s, r_π, r_t, r_c) into (dv, dπ, ds, dt, dλ).
+  void solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv, const Eigen::VectorXd& rs,
+                       const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
+                       const Eigen::VectorXd& rc, Eigen::VectorXd& dv, Eigen::VectorXd& dpi,
+                       Eigen::VectorXd& ds, Eigen::VectorXd& dt, Eigen::VectorXd& dlam);
+  // Direction for the current residuals and w.rc, with iterative refinement.
+  void newton_direction(const OcpQp& qp, int refinement_steps);
+  void write_solution(const OcpQp& qp, OcpQpSolution& sol);
+
+  Settings settings_{};
+  Workspace ws_{};
+  bool ready_ = false;
+  double res_stat_ = 0, res_eq_ = 0, res_ineq_ = 0, mu_ = 0;
+};
+
+}  // namespace mixpilot

@@ -1,0 +1,38 @@
+#pragma once
+// Settings defaults shared across core/. One place for every tunable constant with a default;
+// each component's Settings struct takes its defaults from here.
+#include <limits>
+
+namespace mixpilot {
+
+// Defaults of the OCP-QP interior-point solver (core/qp_riccati_ipm.hpp), SPEC §4.
+namespace qp_defaults {
+inline constexpr int kMaxIterations = 50;
+// Termination: ‖stationarity‖∞ ≤ tol_stat, ‖equality residual‖∞ ≤ tol_eq,
+// ‖inequality residual‖∞ ≤ tol_ineq, mean complementarity tᵀλ/m ≤ tol_comp.
+inline constexpr double kTolStationarity = 1e-6;
+inline constexpr double kTolEquality = 1e-8;
+inline constexpr double kTolInequality = 1e-8;
+inline constexpr double kTolComplementarity = 1e-8;
+// Fraction-to-boundary factor: the step keeps t, λ > 0 by stopping at this fraction of the way.
+inline constexpr double kStepFraction = 0.995;
+// The solve stops with min_step when the step length falls below this.
+inline constexpr double kMinStep = 1e-10;
+// Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
+inline constexpr double kInitSlack = 1e-1;
+inline constexpr double kInitMu = 1e-1;
+// Warm start from primal and dual: slacks and multipliers are clipped from below at this value
+// so the iterate is strictly interior.
+inline constexpr double kWarmStartFloor = 1e-4;
+// Riccati Cholesky: input pivots must be > 0; a state pivot in [−kPsdTol·|diagonal|, 0] is a
+// zero eigenvalue of a positive semidefinite cost-to-go (allowed), anything below is indefinite.
+inline constexpr double kPsdTol = 1e-10;
+// Iterative refinement of each Newton direction (needed once λ/t spans many orders of
+// magnitude near convergence): at most kRefinementSteps, while the solve error exceeds kRefineTol.
+inline constexpr int kRefinementSteps = 2;
+inline constexpr double kRefineTol = 1e-12;
+// A bound whose magnitude is ≥ kInfBound is absent (one-sided constraints).
+inline constexpr double kInfBound = 1e20;
+}  // namespace qp_defaults
+
+}  // namespace mixpilot

@@ -1,0 +1,416 @@
+// OCP-QP solver (core/qp_riccati_ipm): agreement with a certified dense reference on random
+// feasible OCP-QPs, KKT residuals of the returned solution checked independently of the solver,
+// warm starts, and clear failure statuses without NaN output (SPEC §4, issue 3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/qp_riccati_ipm.hpp"
+#include "qp_dense_reference.hpp"
+#include "qp_random.hpp"
+
+namespace mixpilot {
+namespace {
+
+using testing_qp::RandomQpSpec;
+
+// KKT residuals of (x, u, s, π, λ) for the OCP-QP, from the problem data alone
+// (conventions of core/ocp_qp.hpp).
+struct Kkt {
+  double stat = 0, dyn = 0, primal = 0, dual = 0, comp = 0, x0 = 0;
+  double max() const { return std::max({stat, dyn, primal, dual, comp, x0}); }
+};
+
+Kkt kkt_residuals(const OcpQp& qp, const OcpQpSolution& s) {
+  const OcpQpDims& d = qp.dims;
+  Kkt k;
+  auto upd = [](double& r, double v) { r = std::max(r, std::abs(v)); };
+  auto present = [](double b) { return std::isfinite(b) && std::abs(b) < 1e20; };
+  k.x0 = (s.x[0] - qp.x0).lpNorm<Eigen::Infinity>();
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int nu = d.nu[i], nbu = d.nbu[i], nbx = d.nbx[i], nc = d.nc(i), ns = d.ns[i];
+    Eigen::VectorXd gu = st.R * s.u[i] + st.S * s.x[i] + st.r;
+    Eigen::VectorXd gx = st.Q * s.x[i] + st.S.transpose() * s.u[i] + st.q;
+    if (i < d.N) {
+      gu += st.B.transpose() * s.pi[i];
+      gx += st.A.transpose() * s.pi[i];
+      const Eigen::VectorXd r = st.A * s.x[i] + st.B * s.u[i] + st.b - s.x[i + 1];
+      if (r.size()) upd(k.dyn, r.lpNorm<Eigen::Infinity>());
+    }
+    if (i > 0) gx -= s.pi[i - 1];
+    const Eigen::VectorXd dl = s.lam_u[i] - s.lam_l[i];
+    for (int j = 0; j < nbu; ++j) gu[st.idxbu[j]] += dl[j];
+    for (int j = 0; j < nbx; ++j) gx[st.idxbx[j]] += dl[nbu + j];
+    gu += st.D.transpose() * dl.tail(d.ng[i]);
+    gx += st.C.transpose() * dl.tail(d.ng[i]);
+    if (i == 0) gx -= s.lam_x0;
+    for (Eigen::Index j = 0; j < gu.size(); ++j) upd(k.stat, gu[j]);
+    for (Eigen::Index j = 0; j < gx.size(); ++j) upd(k.stat, gx[j]);
+    // Constraint values, slacks and multipliers.
+    Eigen::VectorXd dv(nc), lo(nc), hi(nc), sl = Eigen::VectorXd::Zero(nc),
+        su = Eigen::VectorXd::Zero(nc);
+    for (int j = 0; j < nbu; ++j) {
+      dv[j] = s.u[i][st.idxbu[j]];
+      lo[j] = st.lbu[j];
+      hi[j] = st.ubu[j];
+    }
+    for (int j = 0; j < nbx; ++j) {
+      dv[nbu + j] = s.x[i][st.idxbx[j]];
+      lo[nbu + j] = st.lbx[j];
+      hi[nbu + j] = st.ubx[j];
+    }
+    if (d.ng[i]) {
+      dv.tail(d.ng[i]) = st.C * s.x[i] + st.D * s.u[i];
+      lo.tail(d.ng[i]) = st.lg;
+      hi.tail(d.ng[i]) = st.ug;
+    }
+    for (int j = 0; j < ns; ++j) {
+      const int c = st.idxs[j];
+      sl[c] = s.sl[i][j];
+      su[c] = s.su[i][j];
+      upd(k.stat, st.Zl[j] * s.sl[i][j] + st.zl[j] - s.lam_l[i][c] - s.lam_sl[i][j]);
+      upd(k.stat, st.Zu[j] * s.su[i][j] + st.zu[j] - s.lam_u[i][c] - s.lam_su[i][j]);
+      k.primal = std::max({k.primal, -s.sl[i][j], -s.su[i][j]});
+      upd(k.comp, s.lam_sl[i][j] * s.sl[i][j]);
+      upd(k.comp, s.lam_su[i][j] * s.su[i][j]);
+      k.dual = std::max({k.dual, -s.lam_sl[i][j], -s.lam_su[i][j]});
+    }
+    for (int j = 0; j < nc; ++j) {
+      k.dual = std::max({k.dual, -s.lam_l[i][j], -s.lam_u[i][j]});
+      if (present(lo[j])) {
+        const double g = dv[j] - lo[j] + sl[j];
+        k.primal = std::max(k.primal, -g);
+        upd(k.comp, s.lam_l[i][j] * g);
+      } else {
+        upd(k.dual, s.lam_l[i][j]);
+      }
+      if (present(hi[j])) {
+        const double g = hi[j] - dv[j] + su[j];
+        k.primal = std::max(k.primal, -g);
+        upd(k.comp, s.lam_u[i][j] * g);
+      } else {
+        upd(k.dual, s.lam_u[i][j]);
+      }
+    }
+  }
+  return k;
+}
+
+bool all_finite(const OcpQpSolution& s) {
+  auto ok = [](const std::vector<Eigen::VectorXd>& vs) {
+    for (const auto& v : vs)
+      if (!v.allFinite()) return false;
+    return true;
+  };
+  return ok(s.x) && ok(s.u) && ok(s.pi) && ok(s.lam_l) && ok(s.lam_u) && ok(s.sl) && ok(s.su) &&
+         ok(s.lam_sl) && ok(s.lam_su) && s.lam_x0.allFinite() && std::isfinite(s.objective);
+}
+
+QpRiccatiIpmSettings tight() {
+  QpRiccatiIpmSettings s;
+  // An order of magnitude below the 1e-8 required of the KKT residuals.
+  s.tol_stat = 1e-9;
+  s.tol_eq = 1e-9;
+  s.tol_ineq = 1e-9;
+  s.tol_comp = 1e-11;
+  return s;
+}
+
+struct Case {
+  RandomQpSpec spec;
+  unsigned seed;
+};
+
+class RandomQp : public ::testing::TestWithParam<Case> {};
+
+TEST_P(RandomQp, MatchesCertifiedDenseReference) {
+  const Case& c = GetParam();
+  const OcpQp qp = testing_qp::random_qp(c.spec, c.seed);
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(qp);
+  ASSERT_TRUE(ref.certified) << "dense reference failed to certify its optimum";
+
+  QpRiccatiIpm solver(qp.dims, tight());
+  OcpQpSolution sol(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success)
+      << "iterations " << sol.iterations << " res " << sol.res_stat << " " << sol.res_eq << " "
+      << sol.res_ineq << " " << sol.res_comp;
+  EXPECT_LE(sol.iterations, 40);
+
+  const testing_qp::DenseQp D = testing_qp::densify(qp);
+  const Eigen::VectorXd z = testing_qp::to_dense(D, qp.dims, sol);
+  const double zs = std::max(1.0, ref.z.lpNorm<Eigen::Infinity>());
+  EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>() / zs, 1e-7);
+  EXPECT_LE(std::abs(sol.objective - ref.objective) / std::max(1.0, std::abs(ref.objective)), 1e-7);
+  EXPECT_NEAR(sol.objective, qp.objective(sol.x, sol.u, sol.sl, sol.su),
+              1e-10 * std::max(1.0, std::abs(sol.objective)));
+
+  const Kkt k = kkt_residuals(qp, sol);
+  EXPECT_LE(k.stat, 1e-8);
+  EXPECT_LE(k.dyn, 1e-8);
+  EXPECT_LE(k.primal, 1e-8);
+  EXPECT_LE(k.dual, 1e-8);
+  EXPECT_LE(k.comp, 1e-8);
+  EXPECT_EQ(k.x0, 0.0);
+
+  // The test exercises what it claims: some constraints are active at the optimum.
+  int active = 0;
+  for (int i = 0; i <= qp.dims.N; ++i)
+    active += (sol.lam_l[i].array() > 1e-6).count() + (sol.lam_u[i].array() > 1e-6).count();
+  EXPECT_GT(active, 0);
+}
+
+RandomQpSpec spec(int N, int nx_min, int nx_max, int nu, int ng_max, double soft,
+                  bool all_bounds = false) {
+  RandomQpSpec s;
+  s.all_bounds = all_bounds;
+  s.N = N;
+  s.nx_min = nx_min;
+  s.nx_max = nx_max;
+  s.nu = nu;
+  s.ng_max = ng_max;
+  s.soft_fraction = soft;
+  return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Sizes, RandomQp,
+    ::testing::Values(Case{spec(1, 2, 2, 1, 1, 0.5), 1}, Case{spec(1, 16, 16, 4, 2, 0.3, true), 2},
+                      Case{spec(2, 3, 3, 2, 0, 0.0), 3}, Case{spec(5, 4, 4, 1, 1, 0.4), 4},
+                      Case{spec(10, 6, 6, 3, 2, 0.3), 5}, Case{spec(10, 2, 8, 2, 1, 0.3), 6},
+                      Case{spec(20, 16, 16, 4, 1, 0.2), 7}, Case{spec(30, 4, 4, 2, 1, 0.3), 8},
+                      Case{spec(40, 8, 8, 3, 2, 0.3), 9}, Case{spec(60, 3, 5, 1, 1, 0.3), 10},
+                      Case{spec(60, 6, 6, 2, 0, 0.5), 11}, Case{spec(15, 12, 16, 4, 2, 0.5), 12},
+                      Case{spec(25, 5, 5, 4, 3, 1.0), 13}, Case{spec(60, 4, 4, 2, 1, 0.0), 14}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      const RandomQpSpec& s = info.param.spec;
+      return "N" + std::to_string(s.N) + "_nx" + std::to_string(s.nx_max) + "_nu" +
+             std::to_string(s.nu) + "_seed" + std::to_string(info.param.seed);
+    });
+
+TEST(QpRiccatiIpm, UnconstrainedIsOneNewtonStep) {
+  RandomQpSpec s = spec(8, 5, 5, 2, 0, 0.0);
+  OcpQp qp = testing_qp::random_qp(s, 21);
+  OcpQpDims d = qp.dims;
+  std::fill(d.nbx.begin(), d.nbx.end(), 0);
+  std::fill(d.nbu.begin(), d.nbu.end(), 0);
+  std::fill(d.ns.begin(), d.ns.end(), 0);
+  OcpQp un(d);
+  un.x0 = qp.x0;
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& a = qp.stage[i];
+    OcpQpStage& b = un.stage[i];
+    b.A = a.A, b.B = a.B, b.b = a.b, b.Q = a.Q, b.S = a.S, b.R = a.R, b.q = a.q, b.r = a.r;
+  }
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(un);
+  ASSERT_TRUE(ref.certified);
+  QpRiccatiIpm solver(d, tight());
+  OcpQpSolution sol(d);
+  ASSERT_EQ(solver.solve(un, sol), QpStatus::success);
+  EXPECT_EQ(sol.iterations, 1);
+  const Eigen::VectorXd z = testing_qp::to_dense(testing_qp::densify(un), d, sol);
+  EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>(), 1e-9 * std::max(1.0, ref.z.lpNorm<Eigen::Infinity>()));
+  EXPECT_LE(kkt_residuals(un, sol).max(), 1e-9);
+}
+
+TEST(QpRiccatiIpm, WarmStartReproducesColdSolutionInFewerIterations) {
+  const OcpQp qp = testing_qp::random_qp(spec(30, 6, 6, 2, 1, 0.3), 31);
+  QpRiccatiIpm solver(qp.dims, tight());
+  OcpQpSolution cold(qp.dims);
+  ASSERT_EQ(solver.solve(qp, cold), QpStatus::success);
+  // Re-solve a slightly perturbed problem (new x0, as in the RTI feedback phase).
+  OcpQp qp2 = qp;
+  qp2.x0 += 1e-3 * Eigen::VectorXd::Ones(qp.x0.size());
+  OcpQpSolution c2(qp.dims);
+  ASSERT_EQ(solver.solve(qp2, c2), QpStatus::success);
+  for (QpWarmStart mode : {QpWarmStart::primal, QpWarmStart::primal_dual}) {
+    OcpQpSolution w = cold;
+    ASSERT_EQ(solver.solve(qp2, w, mode), QpStatus::success);
+    double dx = 0;
+    for (int i = 0; i <= qp.dims.N; ++i) dx = std::max(dx, (w.x[i] - c2.x[i]).lpNorm<Eigen::Infinity>());
+    EXPECT_LE(dx, 1e-7);
+    if (mode == QpWarmStart::primal_dual) EXPECT_LT(w.iterations, c2.iterations);
+  }
+}
+
+TEST(QpRiccatiIpm, DimsMayDifferPerStage) {
+  // Stage-varying nx (as in a multi-phase problem), nu_N = 0, bounds only on 1..N.
+  const OcpQp qp = testing_qp::random_qp(spec(12, 2, 7, 3, 1, 0.3), 41);
+  bool varies = false;
+  for (int i = 1; i <= qp.dims.N; ++i) varies |= qp.dims.nx[i] != qp.dims.nx[0];
+  ASSERT_TRUE(varies);
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(qp);
+  ASSERT_TRUE(ref.certified);
+  QpRiccatiIpm solver(qp.dims, tight());
+  OcpQpSolution sol(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
+  const Eigen::VectorXd z = testing_qp::to_dense(testing_qp::densify(qp), qp.dims, sol);
+  EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>() / std::max(1.0, ref.z.lpNorm<Eigen::Infinity>()), 1e-7);
+}
+
+// --- Failure modes: a clear status, never a crash, never NaN in the outputs. ---
+
+OcpQp small_qp() {
+  RandomQpSpec s = spec(6, 3, 3, 2, 1, 0.0);
+  s.all_bounds = true;
+  s.absent_side = 0.0;
+  return testing_qp::random_qp(s, 51);
+}
+
+TEST(QpRiccatiIpmFailure, InfeasibleHardConstraints) {
+  OcpQp qp = small_qp();
+  // All input bounds hard and tight around 0; a state bound on x_N far outside the reachable
+  // set: x_N = A…x0 + Σ… with |u| ≤ 1e-3 cannot reach it.
+  OcpQpDims d = OcpQpDims::uniform(6, 3, 2, 1, 2, 0, 0);
+  OcpQp in(d);
+  in.x0 = qp.x0;
+  for (int i = 0; i <= 6; ++i) {
+    OcpQpStage& s = in.stage[i];
+    s.Q = Eigen::MatrixXd::Identity(3, 3);
+    if (i < 6) {
+      s.R = Eigen::MatrixXd::Identity(2, 2);
+      s.A = 0.9 * Eigen::MatrixXd::Identity(3, 3);
+      s.B = Eigen::MatrixXd::Ones(3, 2);
+      s.lbu.setConstant(-1e-3);
+      s.ubu.setConstant(1e-3);
+    }
+    if (i > 0) {
+      s.lbx[0] = i == 6 ? 100.0 : -1e3;
+      s.ubx[0] = 1e3;
+    }
+  }
+  QpRiccatiIpm solver(d);
+  OcpQpSolution sol(d);
+  const QpStatus st = solver.solve(in, sol);
+  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
+  EXPECT_EQ(sol.status, st);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpRiccatiIpmFailure, InconsistentBoundsAreInfeasible) {
+  OcpQp qp = small_qp();
+  qp.stage[2].lbu.setConstant(1.0);
+  qp.stage[2].ubu.setConstant(-1.0);
+  QpRiccatiIpm solver(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  const QpStatus st = solver.solve(qp, sol);
+  EXPECT_NE(st, QpStatus::success);
+  EXPECT_NE(st, QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpRiccatiIpmFailure, SingularHessianOnUnboundedInput) {
+  // R = 0 and S = 0 with the input unbounded: the QP has no unique minimizer (unbounded if
+  // r ≠ 0); the uu Riccati block is singular.
+  OcpQpDims d = OcpQpDims::uniform(5, 3, 2);
+  OcpQp qp(d);
+  qp.x0.setOnes();
+  for (int i = 0; i <= 5; ++i) {
+    qp.stage[i].Q = Eigen::MatrixXd::Identity(3, 3);
+    if (i < 5) {
+      qp.stage[i].A = Eigen::MatrixXd::Identity(3, 3);
+      qp.stage[i].B = Eigen::MatrixXd::Zero(3, 2);
+      qp.stage[i].r.setOnes();
+    }
+  }
+  QpRiccatiIpm solver(d);
+  OcpQpSolution sol(d);
+  EXPECT_EQ(solver.solve(qp, sol), QpStatus::factorization_failed);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpRiccatiIpmFailure, IndefiniteHessian) {
+  // A negative curvature direction of an unconstrained state: the QP is unbounded below.
+  OcpQpDims d = OcpQpDims::uniform(5, 3, 2, 1, 2);
+  OcpQp qp(d);
+  qp.x0.setOnes();
+  for (int i = 0; i <= 5; ++i) {
+    qp.stage[i].Q = Eigen::MatrixXd::Identity(3, 3);
+    if (i == 3) qp.stage[i].Q(2, 2) = -2.0;
+    if (i < 5) {
+      qp.stage[i].R = Eigen::MatrixXd::Identity(2, 2);
+      qp.stage[i].A = Eigen::MatrixXd::Identity(3, 3);
+      qp.stage[i].B = Eigen::MatrixXd::Ones(3, 2);
+      qp.stage[i].lbu.setConstant(-1.0);
+      qp.stage[i].ubu.setConstant(1.0);
+    }
+    if (i > 0) {
+      qp.stage[i].lbx.setConstant(-1.0);  // bounds state 0 only
+      qp.stage[i].ubx.setConstant(1.0);
+    }
+  }
+  QpRiccatiIpm solver(d);
+  OcpQpSolution sol(d);
+  EXPECT_EQ(solver.solve(qp, sol), QpStatus::factorization_failed);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpRiccatiIpmFailure, SemidefiniteStateCostIsFine) {
+  // Q = 0 everywhere (cost on inputs only) is singular but the QP is well posed: the square-root
+  // Riccati must handle a singular cost-to-go P.
+  OcpQp qp = small_qp();
+  for (auto& s : qp.stage) {
+    s.Q.setZero();
+    s.S.setZero();
+  }
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(qp);
+  ASSERT_TRUE(ref.certified);
+  QpRiccatiIpm solver(qp.dims, tight());
+  OcpQpSolution sol(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
+  EXPECT_LE(std::abs(sol.objective - ref.objective) / std::max(1.0, std::abs(ref.objective)), 1e-7);
+}
+
+TEST(QpRiccatiIpmFailure, NanOrInfInData) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int which = 0; which < 6; ++which) {
+    OcpQp qp = small_qp();
+    switch (which) {
+      case 0: qp.stage[2].A(1, 1) = nan; break;
+      case 1: qp.stage[0].R(0, 0) = inf; break;
+      case 2: qp.x0[0] = nan; break;
+      case 3: qp.stage[4].q[2] = -inf; break;
+      case 4: qp.stage[1].lbu[0] = nan; break;
+      case 5: qp.stage[3].C(0, 0) = nan; break;
+    }
+    QpRiccatiIpm solver(qp.dims);
+    OcpQpSolution sol(qp.dims);
+    // A NaN-polluted warm start must not leak either.
+    sol.x[1].setConstant(nan);
+    EXPECT_EQ(solver.solve(qp, sol, QpWarmStart::primal), QpStatus::invalid_data) << which;
+    EXPECT_TRUE(all_finite(sol)) << which;
+  }
+}
+
+TEST(QpRiccatiIpmFailure, MaxIterationsReportedWithFiniteIterate) {
+  const OcpQp qp = small_qp();
+  QpRiccatiIpmSettings s;
+  s.max_iterations = 2;
+  QpRiccatiIpm solver(qp.dims, s);
+  OcpQpSolution sol(qp.dims);
+  EXPECT_EQ(solver.solve(qp, sol), QpStatus::max_iterations);
+  EXPECT_EQ(sol.iterations, 2);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpRiccatiIpmFailure, InvalidDimsOrMismatchedProblem) {
+  OcpQpDims bad = OcpQpDims::uniform(3, 2, 1, 0, 1);
+  bad.nbx[1] = 5;  // more bounds than states
+  QpRiccatiIpm solver;
+  EXPECT_FALSE(solver.setup(bad));
+  const OcpQp qp = small_qp();
+  OcpQpSolution sol(qp.dims);
+  EXPECT_EQ(solver.solve(qp, sol), QpStatus::invalid_data);
+  QpRiccatiIpm other(OcpQpDims::uniform(4, 3, 2));
+  EXPECT_EQ(other.solve(qp, sol), QpStatus::invalid_data);
+  OcpQp badidx = qp;
+  badidx.stage[1].idxbu[0] = 7;
+  QpRiccatiIpm ok(qp.dims);
+  EXPECT_EQ(ok.solve(badidx, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+}  // namespace
+}  // namespace mixpilot

@@ -1,0 +1,122 @@
+// QpRiccatiIpm::solve() allocates nothing (issue 3): this test links mixpilot_core_nomalloc,
+// the engine compiled with EIGEN_RUNTIME_NO_MALLOC, so any Eigen heap allocation inside solve()
+// aborts; in addition every malloc/calloc/realloc of the process (std::vector
+// growth, operator new, ...) is counted while solve() runs and must stay at zero.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+
+#include "core/qp_riccati_ipm.hpp"
+#include "qp_random.hpp"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define MIXPILOT_COUNT_MALLOC 0
+#else
+#define MIXPILOT_COUNT_MALLOC 1
+#endif
+
+#if MIXPILOT_COUNT_MALLOC
+extern "C" void* __libc_malloc(std::size_t);
+extern "C" void* __libc_calloc(std::size_t, std::size_t);
+extern "C" void* __libc_realloc(void*, std::size_t);
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+extern "C" void* malloc(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_malloc(n);
+}
+extern "C" void* calloc(std::size_t n, std::size_t m) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_calloc(n, m);
+}
+extern "C" void* realloc(void* p, std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_realloc(p, n);
+}
+#endif
+
+namespace mixpilot {
+namespace {
+
+// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
+struct NoMalloc {
+  NoMalloc() {
+#if MIXPILOT_COUNT_MALLOC
+    g_allocations = 0;
+    g_counting = true;
+#endif
+    Eigen::internal::set_is_malloc_allowed(false);
+  }
+  ~NoMalloc() {
+    Eigen::internal::set_is_malloc_allowed(true);
+#if MIXPILOT_COUNT_MALLOC
+    g_counting = false;
+#endif
+  }
+  static long count() {
+#if MIXPILOT_COUNT_MALLOC
+    return g_allocations.load();
+#else
+    return 0;
+#endif
+  }
+};
+
+TEST(QpNoMalloc, GuardsAreLive) {
+  EXPECT_DEATH(
+      {
+        NoMalloc guard;
+        Eigen::VectorXd v(64);
+        v.setOnes();
+      },
+      "");
+#if MIXPILOT_COUNT_MALLOC
+  long n = 0;
+  {
+    NoMalloc guard;
+    void* volatile p = std::malloc(32);
+    std::free(p);
+    n = NoMalloc::count();
+  }
+  EXPECT_EQ(n, 1);
+#endif
+}
+
+TEST(QpNoMalloc, SolveAllocatesNothing) {
+  testing_qp::RandomQpSpec spec;
+  spec.N = 20;
+  spec.nx_min = 6;
+  spec.nx_max = 9;  // stage-varying dims
+  spec.nu = 3;
+  spec.ng_max = 2;
+  spec.soft_fraction = 0.4;
+  const OcpQp qp = testing_qp::random_qp(spec, 77);
+  OcpQp bad = qp;
+  bad.stage[3].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  OcpQp indefinite = qp;
+  for (auto& s : indefinite.stage) s.R *= -1.0;
+
+  QpRiccatiIpm solver(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  QpStatus cold, primal, dual, invalid, failed;
+  {
+    NoMalloc guard;
+    cold = solver.solve(qp, sol);
+    primal = solver.solve(qp, sol, QpWarmStart::primal);
+    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
+    invalid = solver.solve(bad, sol);
+    failed = solver.solve(indefinite, sol);
+    EXPECT_EQ(NoMalloc::count(), 0);
+  }
+  EXPECT_EQ(cold, QpStatus::success);
+  EXPECT_EQ(primal, QpStatus::success);
+  EXPECT_EQ(dual, QpStatus::success);
+  EXPECT_EQ(invalid, QpStatus::invalid_data);
+  EXPECT_EQ(failed, QpStatus::factorization_failed);
+}
+
+}  // namespace
+}  // namespace mixpilot
