@@ -35,4 +35,18 @@ inline constexpr double kRefineTol = 1e-12;
 inline constexpr double kInfBound = 1e20;
 }  // namespace qp_defaults
 
+// Defaults of the offline Ipopt adapter (core/nlp_ipopt.hpp), SPEC §4: full NLPs to convergence.
+namespace ipopt_defaults {
+// Ipopt's `tol`: the scaled KKT error (stationarity, feasibility, complementarity) at exit.
+inline constexpr double kTolerance = 1e-10;
+inline constexpr int kMaxIterations = 1000;
+// Ipopt's `print_level`: 0 prints nothing (the banner is suppressed too); 5 is Ipopt's usual log.
+inline constexpr int kPrintLevel = 0;
+// A bound whose magnitude is ≥ kInfBound is absent (the same convention as qp_defaults).
+inline constexpr double kInfBound = 1e20;
+// Central-difference step of the constraint-curvature Hessian, relative to max(1, |w_k|):
+// ≈ ε^(1/3) balances the O(h²) truncation against the O(ε/h) rounding error.
+inline constexpr double kCurvatureStep = 1e-5;
+}  // namespace ipopt_defaults
+
 }  // namespace mixpilot

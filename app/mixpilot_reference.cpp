@@ -1,0 +1,119 @@
+// mixpilot-reference: offline reference trajectories computed with Ipopt (core/nlp_ipopt.hpp).
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "core/crazyflie_tracking.hpp"
+#include "core/nlp_ipopt.hpp"
+#include "core/trajectory_io.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: mixpilot-reference <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  smooth-step   SPEC 5.2's smooth step of the Crazyflie: hover at (0,0,0.4) to (1,-1,1),\n"
+    "                T = 6 s, N = 400, dt = 15 ms, the 5.2 weights, solved to convergence by\n"
+    "                Ipopt from the hover guess\n"
+    "\n"
+    "options:\n"
+    "  --out FILE          write the trajectory as CSV (docs: core/trajectory_io.hpp)\n"
+    "  --hessian NAME      fd-curvature (default), gauss-newton or limited-memory\n"
+    "  --tol X             Ipopt tolerance (default 1e-10)\n"
+    "  --max-iter N        iteration limit (default 1000)\n"
+    "  --print-level N     Ipopt's log level, 0..12 (default 0: silent; 5: the usual log)\n"
+    "  -h, --help          show this help\n";
+
+using namespace mixpilot;
+
+int usage_error(const char* what) {
+  std::fprintf(stderr, "mixpilot-reference: %s\n\n%s", what, kUsage);
+  return 2;
+}
+
+int run_smooth_step(const std::string& out, const IpoptOcpSettings& settings) {
+  constexpr int N = 400;
+  constexpr double dt = 0.015;
+  const Eigen::Vector3d start(0.0, 0.0, 0.4), target(1.0, -1.0, 1.0);
+  const CrazyflieTracking problem(N, dt);
+  OcpStageData data(problem.ocp());
+  problem.set_hover_target(data, target);
+  OcpTrajectory traj(problem.ocp());
+  problem.hover_guess(traj, start);
+  const Eigen::VectorXd x0 = problem.model().hover_state(start);
+
+  std::printf("smooth step: hover (0,0,0.4) -> (1,-1,1), N = %d, dt = %.3f s, T = %.1f s\n", N,
+              dt, N * dt);
+  IpoptOcpSolver solver(settings);
+  const IpoptOcpResult r = solver.solve(problem.ocp(), data, x0, traj);
+  std::printf("ipopt: %s (%s), %d iterations, %.2f s\n", to_string(r.status), r.message,
+              r.iterations, r.solve_seconds);
+  std::printf("objective %.12g, constraint violation %.2e, dual infeasibility %.2e, "
+              "dynamics residual %.2e\n",
+              r.objective, r.constraint_violation, r.dual_infeasibility, r.dynamics_residual);
+  if (r.status != IpoptOcpStatus::solved) {
+    std::fprintf(stderr, "mixpilot-reference: Ipopt did not converge; nothing written\n");
+    return 1;
+  }
+  const Eigen::Vector3d pN = traj.x[N].head<3>();
+  double omega_min = 1e300, omega_max = -1e300;
+  for (const auto& u : traj.u) {
+    omega_min = std::min(omega_min, u.minCoeff());
+    omega_max = std::max(omega_max, u.maxCoeff());
+  }
+  std::printf("final position (%.6f, %.6f, %.6f), error %.2e m; Omega in [%.4f, %.4f] krpm\n",
+              pN(0), pN(1), pN(2), (pN - target).norm(), omega_min, omega_max);
+  if (!out.empty()) {
+    std::string error;
+    if (!write_trajectory_csv(out, traj, dt, error)) {
+      std::fprintf(stderr, "mixpilot-reference: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", out.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string command, out;
+  IpoptOcpSettings settings;
+  for (int a = 1; a < argc; ++a) {
+    const std::string_view arg = argv[a];
+    const bool has_value = a + 1 < argc;
+    if (arg == "-h" || arg == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (arg == "--out" && has_value) {
+      out = argv[++a];
+    } else if (arg == "--hessian" && has_value) {
+      const std::string_view name = argv[++a];
+      if (name == "fd-curvature")
+        settings.hessian = IpoptHessian::gauss_newton_fd_curvature;
+      else if (name == "gauss-newton")
+        settings.hessian = IpoptHessian::gauss_newton;
+      else if (name == "limited-memory")
+        settings.hessian = IpoptHessian::limited_memory;
+      else
+        return usage_error("unknown --hessian (fd-curvature, gauss-newton, limited-memory)");
+    } else if (arg == "--tol" && has_value) {
+      settings.tolerance = std::atof(argv[++a]);
+      if (!(settings.tolerance > 0.0)) return usage_error("--tol must be a positive number");
+    } else if (arg == "--max-iter" && has_value) {
+      settings.max_iterations = std::atoi(argv[++a]);
+    } else if (arg == "--print-level" && has_value) {
+      settings.print_level = std::atoi(argv[++a]);
+    } else if (!arg.empty() && arg[0] != '-' && command.empty()) {
+      command = arg;
+    } else {
+      return usage_error(("unexpected argument '" + std::string(arg) + "'").c_str());
+    }
+  }
+  if (command == "smooth-step") return run_smooth_step(out, settings);
+  if (command.empty()) return usage_error("missing command");
+  return usage_error(("unknown command '" + command + "'").c_str());
+}
