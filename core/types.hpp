@@ -49,4 +49,11 @@ inline constexpr double kInfBound = 1e20;
 inline constexpr double kCurvatureStep = 1e-5;
 }  // namespace ipopt_defaults
 
+// Defaults of the RTI solver (core/rti.hpp).
+namespace rti_defaults {
+// Warm-start each QP (primal-dual) from the previous, shifted QP solution. Off: the QP is posed
+// in the step (Δx, Δu), so the previous step is no primal guess (see bench_rti.cpp).
+inline constexpr bool kQpWarmStart = false;
+}  // namespace rti_defaults
+
 }  // namespace mixpilot

@@ -2,7 +2,9 @@
 // allocation check armed (EIGEN_RUNTIME_NO_MALLOC), which aborts on any Eigen heap allocation.
 #include <gtest/gtest.h>
 
+#include "core/crazyflie_tracking.hpp"
 #include "core/integrator_erk4.hpp"
+#include "core/rti.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"
@@ -50,6 +52,25 @@ TEST(NoMalloc, Erk4Crazyflie) {
 TEST(NoMalloc, Erk4MikroKopter) {
   const models::MikroKopter mk;
   expect_erk4_allocation_free(mk, mk.hover_state({0, 0, 1}), mk.hover_input());
+}
+
+TEST(NoMalloc, RtiPrepareFeedbackShift) {
+  CrazyflieTracking problem(50, 0.015);
+  RtiSolver rti;
+  ASSERT_TRUE(rti.setup(problem.ocp()));
+  problem.set_hover_target(rti.data(), {0.1, -0.1, 0.5});
+  problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
+  Eigen::VectorXd x = problem.model().hover_state({0, 0, 0.4});
+  Eigen::VectorXd u(4);
+  for (int k = 0; k < 5; ++k) {
+    NoMalloc guard;
+    ASSERT_EQ(rti.prepare(), RtiStatus::success);
+    ASSERT_EQ(rti.feedback(x), RtiStatus::success);
+    u = rti.control();
+    rti.shift();
+    x(2) += 0.01;  // a new measurement
+  }
+  EXPECT_TRUE(u.allFinite());
 }
 
 }  // namespace
