@@ -26,9 +26,18 @@ void trsv_ln(int n, const double* L, int ldl, const double* inv_diag, double* x)
 // x ← L⁻ᵀ x.
 void trsv_lt(int n, const double* L, int ldl, const double* inv_diag, double* x);
 
-// y += Lᵀ x  (L n x n lower).
-void trmv_lt_add(int n, const double* L, int ldl, const double* x, double* y);
-// y = L x.
-void trmv_ln(int n, const double* L, int ldl, const double* x, double* y);
+// Register-blocked (AVX2/FMA) variants on row-padded storage: all row counts are rounded up to
+// a multiple of 4, so every ld must be ≥ pad4(rows) and padding rows must be readable (inputs'
+// padding rows zero). L's strict upper triangle must be zero.
+// Y (pad4(n) x m) = A · L (m x m lower).
+void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int ldl, double* Y,
+                    int ldy);
+// C += Y Yᵀ (Y n x m) and C = L Lᵀ in place, fused (left-looking, 4 columns at a time), with
+// potrf_l's pivot rules; keeps C's strict upper triangle zero.
+bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int ldc, int n_strict,
+                          double* inv_diag, double psd_tol);
+// y (m) += A x (A m x n);  y (n) += Aᵀ x (A m x n). Exact row counts, no padding needed.
+void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
+void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y);
 
 }  // namespace mixpilot::kernels

@@ -65,6 +65,8 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   w.DCt.assign(n1, {});
   w.L.assign(n1, {});
   w.Y.assign(n1, {});
+  w.Hbase.assign(n1, {});
+  w.Hfull.assign(n1, {});
   w.inv_diag.assign(n1, {});
   w.tmp.assign(n1, {});
   int ov = 0, op = 0, os = 0, om = 0, oc = 0;
@@ -85,10 +87,14 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     oc += nc;
     w.var_of_box[i] = Eigen::VectorXi::Zero(dims.nbu[i] + dims.nbx[i]);
     w.soft_of[i] = Eigen::VectorXi::Constant(nc, -1);
-    w.BAt[i] = Eigen::MatrixXd::Zero(nv, nx1);
+    // Row counts padded to a multiple of 4 for the register-blocked kernels (padding rows zero).
+    const int np = (nv + 3) & ~3;
+    w.BAt[i] = Eigen::MatrixXd::Zero(np, nx1);
     w.DCt[i] = Eigen::MatrixXd::Zero(nv, dims.ng[i]);
-    w.L[i] = Eigen::MatrixXd::Zero(nv, nv);
-    w.Y[i] = Eigen::MatrixXd::Zero(nv, nx1);
+    w.L[i] = Eigen::MatrixXd::Zero(np, nv);
+    w.Y[i] = Eigen::MatrixXd::Zero(np, nx1);
+    w.Hbase[i] = Eigen::MatrixXd::Zero(np, nv);
+    w.Hfull[i] = Eigen::MatrixXd::Zero(nv, nv);
     w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
     w.tmp[i] = Eigen::VectorXd::Zero(std::max({nv, nx1, nc, 1}));
   }
@@ -134,7 +140,7 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     const int nc = w.nc[i], ns = d.ns[i];
     if (i < d.N) {
       w.BAt[i].topRows(nu) = s.B.transpose();
-      w.BAt[i].bottomRows(nx) = s.A.transpose();
+      w.BAt[i].middleRows(nu, nx) = s.A.transpose();
       w.bflat.segment(w.off_pi[i], d.nx[i + 1]) = s.b;
     }
     w.gflat.segment(w.off_v[i], nu) = s.r;
@@ -145,6 +151,15 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
       w.DCt[i].topRows(nu) = s.D.transpose();
       w.DCt[i].bottomRows(nx) = s.C.transpose();
     }
+    // Stage Hessian [R S; Sᵀ Q] in (u, x) order: lower triangle (strict upper stays zero) for
+    // the factorization, full for residuals.
+    w.Hbase[i].topLeftCorner(nu, nu).triangularView<Eigen::Lower>() = s.R;
+    w.Hbase[i].block(nu, 0, nx, nu) = s.S.transpose();
+    w.Hbase[i].block(nu, nu, nx, nx).triangularView<Eigen::Lower>() = s.Q;
+    w.Hfull[i].topLeftCorner(nu, nu) = s.R;
+    w.Hfull[i].topRightCorner(nu, nx) = s.S;
+    w.Hfull[i].bottomLeftCorner(nx, nu) = s.S.transpose();
+    w.Hfull[i].bottomRightCorner(nx, nx) = s.Q;
     for (int k = 0; k < nbu; ++k) w.var_of_box[i][k] = s.idxbu[k];
     for (int k = 0; k < nbx; ++k) w.var_of_box[i][nbu + k] = nu + s.idxbx[k];
     w.soft_of[i].setConstant(-1);
@@ -262,17 +277,13 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
     const int nb = d.nbu[i] + d.nbx[i];
     const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i];
-    auto u = v.segment(ov, nu);
-    auto x = v.segment(ov + nu, nx);
-    auto ru = out_v.segment(ov, nu);
+    const int nv = nu + nx;
     auto rx = out_v.segment(ov + nu, nx);
-    out_v.segment(ov, nu + nx) = g.segment(ov, nu + nx);
-    ru.noalias() += st.R * u;
-    ru.noalias() += st.S * x;
-    rx.noalias() += st.Q * x;
-    rx.noalias() += st.S.transpose() * u;
+    out_v.segment(ov, nv) = g.segment(ov, nv);
+    kernels::gemv_n(nv, nv, w.Hfull[i].data(), nv, v.data() + ov, out_v.data() + ov);
     if (i < d.N)
-      out_v.segment(ov, nu + nx).noalias() += w.BAt[i] * pi.segment(w.off_pi[i], d.nx[i + 1]);
+      kernels::gemv_n(nv, d.nx[i + 1], w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
+                      pi.data() + w.off_pi[i], out_v.data() + ov);
     if (i > 0) rx -= pi.segment(w.off_pi[i - 1], nx);
     for (int k = 0; k < nb; ++k) out_v[ov + w.var_of_box[i][k]] += lam[om + nc + k] - lam[om + k];
     if (ng > 0) {
@@ -290,7 +301,8 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
       const int nx1 = d.nx[i + 1], op = w.off_pi[i];
       auto rp = out_pi.segment(op, nx1);
       rp = b.segment(op, nx1) - v.segment(w.off_v[i + 1] + d.nu[i + 1], nx1);
-      rp.noalias() += w.BAt[i].transpose() * v.segment(ov, nu + nx);
+      kernels::gemv_t(nv, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()), v.data() + ov,
+                      rp.data());
     }
   }
 }
@@ -356,35 +368,30 @@ bool QpRiccatiIpm::factorize(const OcpQp& qp) {
     }
     // H̃ = [R S; Sᵀ Q] + ∇dᵀ W̃ ∇d (lower triangle).
     Eigen::MatrixXd& L = w.L[i];
-    const int n = nu + nx;
-    const int nf = i == 0 ? nu : n;  // stage 0: x_0 fixed, only the uu block
-    L.topLeftCorner(nu, nu).triangularView<Eigen::Lower>() = st.R;
-    if (i > 0) {
-      L.bottomLeftCorner(nx, nu) = st.S.transpose();
-      L.bottomRightCorner(nx, nx).triangularView<Eigen::Lower>() = st.Q;
-    }
+    const int ld = static_cast<int>(L.rows());
+    const int nf = i == 0 ? nu : nu + nx;  // stage 0: x_0 fixed, only the uu block
+    L = w.Hbase[i];
     for (int k = 0; k < nb; ++k) {
       const int p = w.var_of_box[i][k];
       if (p < nf) L(p, p) += w.wc[oc + k];
     }
     for (int k = 0; k < ng; ++k) {
       const double wk = w.wc[oc + nb + k];
-      if (wk != 0.0)
-        kernels::syr_lower(nf, wk, w.DCt[i].col(k).data(), L.data(), static_cast<int>(L.rows()));
+      if (wk != 0.0) kernels::syr_lower(nf, wk, w.DCt[i].col(k).data(), L.data(), ld);
     }
+    // Y = BAt · Lx_{i+1};  L L ᵀ = H̃ + Y Yᵀ.
+    int nx1 = 0;
     if (i < d.N) {
-      const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
+      nx1 = d.nx[i + 1];
+      const int nu1 = d.nu[i + 1];
       const Eigen::MatrixXd& L1 = w.L[i + 1];
       const int ld1 = static_cast<int>(L1.rows());
-      // Y = BAt · Lx_{i+1};  L += Y Yᵀ.
-      kernels::trmm_rl(nf, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
-                       L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
-                       w.Y[i].data(), static_cast<int>(w.Y[i].rows()));
-      kernels::syrk_ln(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()), L.data(),
-                       static_cast<int>(L.rows()));
+      kernels::trmm_rl_padded(nf, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
+                              L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
+                              w.Y[i].data(), static_cast<int>(w.Y[i].rows()));
     }
-    if (!kernels::potrf_l(nf, nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(),
-                          settings_.psd_tol))
+    if (!kernels::syrk_potrf_ln_padded(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()),
+                                       L.data(), ld, nu, w.inv_diag[i].data(), settings_.psd_tol))
       return false;
   }
   return true;
@@ -394,7 +401,7 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
                                    const Eigen::VectorXd& rs, const Eigen::VectorXd& rpi,
                                    const Eigen::VectorXd& rt, const Eigen::VectorXd& rc,
                                    Eigen::VectorXd& dv, Eigen::VectorXd& dpi, Eigen::VectorXd& ds,
-                                   Eigen::VectorXd& dt, Eigen::VectorXd& dlam) {
+                                   Eigen::VectorXd& dt, Eigen::VectorXd& dlam, bool with_pi) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   w.rho = w.mask.cwiseProduct(rc + w.lam.cwiseProduct(rt)).cwiseQuotient(w.t);
@@ -425,9 +432,10 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
       auto y = w.tmp[i].head(nx1);
       y = w.l.segment(w.off_v[i + 1] + nu1, nx1);
       const int ld1 = static_cast<int>(L1.rows());
-      kernels::trmv_lt_add(nx1, L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
-                           rpi.data() + w.off_pi[i], y.data());
-      g.head(nf).noalias() += w.Y[i].topRows(nf) * y;
+      // Lx's strict upper triangle is zero, so the triangular products are plain gemv.
+      kernels::gemv_t(nx1, nx1, L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
+                      rpi.data() + w.off_pi[i], y.data());
+      kernels::gemv_n(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()), y.data(), g.data());
     }
     kernels::trsv_ln(nf, w.L[i].data(), static_cast<int>(w.L[i].rows()), w.inv_diag[i].data(),
                      g.data());
@@ -442,7 +450,8 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
     if (i == 0) dx.setZero();
     if (nu > 0) {
       du = w.l.segment(ov, nu);
-      if (i > 0) du.noalias() += L.bottomLeftCorner(nx, nu).transpose() * dx;
+      if (i > 0)
+        kernels::gemv_t(nx, nu, L.data() + nu, static_cast<int>(L.rows()), dx.data(), du.data());
       kernels::trsv_lt(nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(), du.data());
       du = -du;
     }
@@ -450,14 +459,17 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
       const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
       auto dx1 = dv.segment(w.off_v[i + 1] + nu1, nx1);
       dx1 = rpi.segment(w.off_pi[i], nx1);
-      dx1.noalias() += w.BAt[i].transpose() * dv.segment(ov, nu + nx);
+      kernels::gemv_t(nu + nx, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
+                      dv.data() + ov, dx1.data());
+      if (!with_pi) continue;  // the predictor needs no Δπ
       const Eigen::MatrixXd& L1 = w.L[i + 1];
       const int ld1 = static_cast<int>(L1.rows());
       const double* Lx = L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1;
       auto y = w.tmp[i].head(nx1);
       y = w.l.segment(w.off_v[i + 1] + nu1, nx1);
-      kernels::trmv_lt_add(nx1, Lx, ld1, dx1.data(), y.data());
-      kernels::trmv_ln(nx1, Lx, ld1, y.data(), dpi.data() + w.off_pi[i]);
+      kernels::gemv_t(nx1, nx1, Lx, ld1, dx1.data(), y.data());
+      dpi.segment(w.off_pi[i], nx1).setZero();
+      kernels::gemv_n(nx1, nx1, Lx, ld1, y.data(), dpi.data() + w.off_pi[i]);
     }
   }
   // Slack, inequality-slack and multiplier directions.
@@ -490,9 +502,11 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
   dlam = -w.mask.cwiseProduct(rc + w.lam.cwiseProduct(dt)).cwiseQuotient(w.t);
 }
 
-void QpRiccatiIpm::newton_direction(const OcpQp& qp, int refinement_steps) {
+void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine) {
   Workspace& w = ws_;
-  solve_direction(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, w.dv, w.dpi, w.ds, w.dt, w.dlam);
+  solve_direction(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, w.dv, w.dpi, w.ds, w.dt, w.dlam,
+                  final);
+  const int refinement_steps = final && refine ? settings_.refinement_steps : 0;
   // Iterative refinement: Δλ = −W ∇dΔv − ρ cancels to O(λ) from terms of O(W), so rounding in Δv
   // is amplified by W = λ/t → ∞; the error of the unreduced Newton equations is computed and
   // solved for with the same factorization. The t and λ equations hold exactly by construction.
@@ -501,9 +515,10 @@ void QpRiccatiIpm::newton_direction(const OcpQp& qp, int refinement_steps) {
                     w.err_pi);
     const double e = std::max(stationarity_norm(w.err_v, w.err_s),
                               w.err_pi.size() > 0 ? w.err_pi.lpNorm<Eigen::Infinity>() : 0.0);
-    if (!(e > settings_.refine_tol)) break;
+    const double target = settings_.refine_ratio * std::min(settings_.tol_stat, settings_.tol_eq);
+    if (!(e > target)) break;
     solve_direction(qp, w.err_v, w.err_s, w.err_pi, w.zero_m, w.zero_m, w.cv, w.cpi, w.cs, w.ct,
-                    w.clam);
+                    w.clam, true);
     w.dv += w.cv;
     w.dpi += w.cpi;
     w.ds += w.cs;
@@ -576,7 +591,10 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
     }
     // Predictor (affine scaling) direction.
     w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t));
-    newton_direction(qp, cfg.refinement_steps);
+    // Refinement only pays once the barrier weights W = λ/t ≳ λ²/μ are large, i.e. near the
+    // end; the predictor only sets σ and the second-order term and is never refined.
+    const bool refine = mu_ < qp_defaults::kRefineMuRatio * cfg.tol_comp;
+    newton_direction(qp, w.m_total == 0, refine);
     if (w.m_total > 0) {
       double a_aff = max_step(w.t, w.dt, 1.0);
       a_aff = max_step(w.lam, w.dlam, a_aff);
@@ -587,7 +605,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       // Corrector: Mehrotra's second-order term and centring, same factorization.
       w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
                                  Eigen::VectorXd::Constant(w.t.size(), sigma * mu_));
-      newton_direction(qp, cfg.refinement_steps);
+      newton_direction(qp, true, refine);
     }
     const double check = w.dv.sum() + w.dpi.sum() + w.ds.sum() + w.dt.sum() + w.dlam.sum();
     if (!std::isfinite(check)) {

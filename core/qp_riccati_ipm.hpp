@@ -33,10 +33,10 @@ struct QpRiccatiIpmSettings {
   double warm_start_floor = qp_defaults::kWarmStartFloor;
   double psd_tol = qp_defaults::kPsdTol;
   double inf_bound = qp_defaults::kInfBound;
-  // Iterative-refinement steps per Newton direction, done while the linear-solve error exceeds
-  // refine_tol (∞-norm).
+  // Iterative refinement of each iteration's final Newton direction: at most refinement_steps,
+  // while the linear-solve error (∞-norm) exceeds refine_ratio · min(tol_stat, tol_eq).
   int refinement_steps = qp_defaults::kRefinementSteps;
-  double refine_tol = qp_defaults::kRefineTol;
+  double refine_ratio = qp_defaults::kRefineRatio;
   bool check_data = true;  // scan the QP data for NaN/Inf before solving
 };
 
@@ -60,11 +60,16 @@ struct QpRiccatiIpmWorkspace {
   std::vector<int> off_c;    // into flat per-constraint vectors (nc)
   std::vector<Eigen::VectorXi> var_of_box;  // nbu+nbx: index into v_i of each box constraint
   std::vector<Eigen::VectorXi> soft_of;     // nc: slack index j of constraint k, or -1
-  std::vector<Eigen::MatrixXd> BAt;         // (nu+nx) x nx_{i+1}: [Bᵀ; Aᵀ]
+  // Matrices used by the register-blocked kernels have their row count padded to a multiple of 4
+  // (np = pad4(nu+nx)); padding rows are zero.
+  std::vector<Eigen::MatrixXd> BAt;         // np x nx_{i+1}: [Bᵀ; Aᵀ]
+  std::vector<Eigen::MatrixXd> Hbase;       // np x (nu+nx): [R S; Sᵀ Q], lower triangle only
+  std::vector<Eigen::MatrixXd> Hfull;       // (nu+nx) x (nu+nx): [R S; Sᵀ Q]
   std::vector<Eigen::MatrixXd> DCt;         // (nu+nx) x ng: [Dᵀ; Cᵀ]
-  std::vector<Eigen::MatrixXd> L;           // (nu+nx) x (nu+nx): H̃ + BAt P BAtᵀ, then its
-                                            // lower Cholesky factor (stage 0: uu block only)
-  std::vector<Eigen::MatrixXd> Y;           // (nu+nx) x nx_{i+1}: BAt · Lx_{i+1}
+  std::vector<Eigen::MatrixXd> L;           // np x (nu+nx): H̃ + Y Yᵀ, then its lower Cholesky
+                                            // factor, strict upper triangle zero (stage 0: uu
+                                            // block only)
+  std::vector<Eigen::MatrixXd> Y;           // np x nx_{i+1}: BAt · Lx_{i+1}
   std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L), 0 for zero pivots
   std::vector<Eigen::VectorXd> tmp;         // max(nx_{i+1}, nc): scratch per stage
 
@@ -129,9 +134,11 @@ class QpRiccatiIpm {
   void solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv, const Eigen::VectorXd& rs,
                        const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
                        const Eigen::VectorXd& rc, Eigen::VectorXd& dv, Eigen::VectorXd& dpi,
-                       Eigen::VectorXd& ds, Eigen::VectorXd& dt, Eigen::VectorXd& dlam);
-  // Direction for the current residuals and w.rc, with iterative refinement.
-  void newton_direction(const OcpQp& qp, int refinement_steps);
+                       Eigen::VectorXd& ds, Eigen::VectorXd& dt, Eigen::VectorXd& dlam,
+                       bool with_pi);
+  // Direction for the current residuals and w.rc (Δπ only if final), refined if final and
+  // refine.
+  void newton_direction(const OcpQp& qp, bool final, bool refine);
   void write_solution(const OcpQp& qp, OcpQpSolution& sol);
 
   Settings settings_{};

@@ -27,10 +27,14 @@ inline constexpr double kWarmStartFloor = 1e-4;
 // Riccati Cholesky: input pivots must be > 0; a state pivot in [−kPsdTol·|diagonal|, 0] is a
 // zero eigenvalue of a positive semidefinite cost-to-go (allowed), anything below is indefinite.
 inline constexpr double kPsdTol = 1e-10;
-// Iterative refinement of each Newton direction (needed once λ/t spans many orders of
-// magnitude near convergence): at most kRefinementSteps, while the solve error exceeds kRefineTol.
+// Iterative refinement of the Newton direction (needed once λ/t spans many orders of magnitude
+// near convergence): at most kRefinementSteps, while the linear-solve error exceeds
+// kRefineRatio · min(tol_stat, tol_eq), i.e. while it could keep the iterate from converging.
 inline constexpr int kRefinementSteps = 2;
-inline constexpr double kRefineTol = 1e-12;
+inline constexpr double kRefineRatio = 0.1;
+// ... and only while μ < kRefineMuRatio · tol_comp: W = λ/t ≈ λ²/μ is only then large enough for
+// the rounding it amplifies to matter.
+inline constexpr double kRefineMuRatio = 1e3;
 // A bound whose magnitude is ≥ kInfBound is absent (one-sided constraints).
 inline constexpr double kInfBound = 1e20;
 }  // namespace qp_defaults

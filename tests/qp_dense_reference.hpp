@@ -209,13 +209,21 @@ inline void dense_ipm(const DenseQp& D, Eigen::VectorXd& z, Eigen::VectorXd& lam
   }
 }
 
-inline DenseSolution dense_reference(const OcpQp& qp) {
+// With z_guess, the active set is guessed from it (constraints within 1e-7 of their bound)
+// instead of by the dense IPM; either way the result is certified by the KKT check below.
+inline DenseSolution dense_reference(const OcpQp& qp, const Eigen::VectorXd* z_guess = nullptr) {
   const DenseQp D = densify(qp);
   const Eigen::Index nz = D.H.rows(), ne = D.E.rows(), m = D.G.rows();
   Eigen::VectorXd z, lam, sl;
-  dense_ipm(D, z, lam, sl);
   std::vector<bool> active(static_cast<std::size_t>(m));
-  for (Eigen::Index k = 0; k < m; ++k) active[k] = lam[k] > sl[k];
+  if (z_guess) {
+    z = *z_guess;
+    const Eigen::VectorXd g = D.G * z - D.h;
+    for (Eigen::Index k = 0; k < m; ++k) active[k] = g[k] > -1e-7 * (1.0 + std::abs(D.h[k]));
+  } else {
+    dense_ipm(D, z, lam, sl);
+    for (Eigen::Index k = 0; k < m; ++k) active[k] = lam[k] > sl[k];
+  }
   DenseSolution out;
   for (int loop = 0; loop < 100; ++loop) {
     std::vector<Eigen::Index> act;
@@ -234,7 +242,7 @@ inline DenseSolution dense_reference(const OcpQp& qp) {
       K.block(nz + ne + a, 0, 1, nz) = D.G.row(act[a]);
       rhs[nz + ne + a] = D.h[act[a]];
     }
-    const Eigen::VectorXd sol = K.fullPivLu().solve(rhs);
+    const Eigen::VectorXd sol = K.partialPivLu().solve(rhs);
     const Eigen::VectorXd zc = sol.head(nz);
     const double kkt_res = (K * sol - rhs).lpNorm<Eigen::Infinity>();
     // Most violated inactive constraint and most negative active multiplier.

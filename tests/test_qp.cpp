@@ -6,8 +6,12 @@
 #include <cmath>
 #include <limits>
 
+#include <sstream>
+
+#include "core/ocp_qp_io.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "qp_dense_reference.hpp"
+#include "qp_problems.hpp"
 #include "qp_random.hpp"
 
 namespace mixpilot {
@@ -30,7 +34,7 @@ Kkt kkt_residuals(const OcpQp& qp, const OcpQpSolution& s) {
   k.x0 = (s.x[0] - qp.x0).lpNorm<Eigen::Infinity>();
   for (int i = 0; i <= d.N; ++i) {
     const OcpQpStage& st = qp.stage[i];
-    const int nu = d.nu[i], nbu = d.nbu[i], nbx = d.nbx[i], nc = d.nc(i), ns = d.ns[i];
+    const int nbu = d.nbu[i], nbx = d.nbx[i], nc = d.nc(i), ns = d.ns[i];
     Eigen::VectorXd gu = st.R * s.u[i] + st.S * s.x[i] + st.r;
     Eigen::VectorXd gx = st.Q * s.x[i] + st.S.transpose() * s.u[i] + st.q;
     if (i < d.N) {
@@ -185,8 +189,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{spec(25, 5, 5, 4, 3, 1.0), 13}, Case{spec(60, 4, 4, 2, 1, 0.0), 14}),
     [](const ::testing::TestParamInfo<Case>& info) {
       const RandomQpSpec& s = info.param.spec;
-      return "N" + std::to_string(s.N) + "_nx" + std::to_string(s.nx_max) + "_nu" +
-             std::to_string(s.nu) + "_seed" + std::to_string(info.param.seed);
+      std::ostringstream name;
+      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
+      return name.str();
     });
 
 TEST(QpRiccatiIpm, UnconstrainedIsOneNewtonStep) {
@@ -230,7 +235,9 @@ TEST(QpRiccatiIpm, WarmStartReproducesColdSolutionInFewerIterations) {
     double dx = 0;
     for (int i = 0; i <= qp.dims.N; ++i) dx = std::max(dx, (w.x[i] - c2.x[i]).lpNorm<Eigen::Infinity>());
     EXPECT_LE(dx, 1e-7);
-    if (mode == QpWarmStart::primal_dual) EXPECT_LT(w.iterations, c2.iterations);
+    if (mode == QpWarmStart::primal_dual) {
+      EXPECT_LT(w.iterations, c2.iterations);
+    }
   }
 }
 
@@ -247,6 +254,87 @@ TEST(QpRiccatiIpm, DimsMayDifferPerStage) {
   ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
   const Eigen::VectorXd z = testing_qp::to_dense(testing_qp::densify(qp), qp.dims, sol);
   EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>() / std::max(1.0, ref.z.lpNorm<Eigen::Infinity>()), 1e-7);
+}
+
+// The controllers' QPs used by mixpilot-bench (tests/qp_problems.hpp): solved at tight
+// tolerances, certified against the dense KKT system, with active constraints.
+class ControllerQp : public ::testing::TestWithParam<int> {};
+
+TEST_P(ControllerQp, MatchesCertifiedDenseReference) {
+  const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
+                   : GetParam() == 1 ? testing_qp::crazyflie_qp()
+                                     : testing_qp::pendubot_qp();
+  QpRiccatiIpm solver(qp.dims, tight());
+  OcpQpSolution sol(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
+  const Kkt k = kkt_residuals(qp, sol);
+  EXPECT_LE(k.max(), 1e-8);
+  const testing_qp::DenseQp D = testing_qp::densify(qp);
+  const Eigen::VectorXd z = testing_qp::to_dense(D, qp.dims, sol);
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(qp, &z);
+  ASSERT_TRUE(ref.certified);
+  EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>() / std::max(1.0, ref.z.lpNorm<Eigen::Infinity>()), 1e-7);
+  EXPECT_LE(std::abs(sol.objective - ref.objective) / std::max(1.0, std::abs(ref.objective)), 1e-7);
+  int active = 0;
+  for (int i = 0; i <= qp.dims.N; ++i)
+    active += (sol.lam_l[i].array() > 1e-6).count() + (sol.lam_u[i].array() > 1e-6).count();
+  EXPECT_GT(active, 0);
+  // At the benchmark tolerances too (what mixpilot-bench measures).
+  QpRiccatiIpmSettings bench;
+  bench.tol_comp = 1e-8;
+  bench.tol_stat = 1e-6;
+  QpRiccatiIpm fast(qp.dims, bench);
+  OcpQpSolution s2(qp.dims);
+  ASSERT_EQ(fast.solve(qp, s2), QpStatus::success);
+  EXPECT_LE(std::abs(s2.objective - ref.objective) / std::max(1.0, std::abs(ref.objective)), 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Bench, ControllerQp, ::testing::Values(0, 1, 2),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return std::string(info.param == 0   ? "mi"
+                                              : info.param == 1 ? "crazyflie"
+                                                                : "pendubot");
+                         });
+
+TEST(QpDump, RoundTripIsExact) {
+  const OcpQp qp = testing_qp::random_qp(spec(7, 3, 6, 2, 2, 0.5), 61);
+  QpRiccatiIpmSettings st = tight();
+  st.max_iterations = 33;
+  std::stringstream ss;
+  write_ocp_qp_json(ss, qp, st, "roundtrip");
+  std::string line;
+  std::getline(ss, line);
+  OcpQp back;
+  QpRiccatiIpmSettings st2;
+  std::string name, err;
+  ASSERT_TRUE(read_ocp_qp_json(line, back, st2, name, err)) << err;
+  EXPECT_EQ(name, "roundtrip");
+  EXPECT_EQ(st2.max_iterations, 33);
+  EXPECT_EQ(st2.tol_comp, st.tol_comp);
+  ASSERT_EQ(back.dims.nx, qp.dims.nx);
+  ASSERT_EQ(back.dims.ns, qp.dims.ns);
+  EXPECT_EQ(back.x0, qp.x0);
+  for (int i = 0; i <= qp.dims.N; ++i) {
+    const OcpQpStage &a = qp.stage[i], &b = back.stage[i];
+    EXPECT_TRUE(a.A == b.A && a.B == b.B && a.b == b.b && a.Q == b.Q && a.S == b.S && a.R == b.R &&
+                a.q == b.q && a.r == b.r && a.C == b.C && a.D == b.D)
+        << i;
+    EXPECT_TRUE(a.idxbu == b.idxbu && a.idxbx == b.idxbx && a.idxs == b.idxs) << i;
+    EXPECT_TRUE(a.lbu == b.lbu && a.ubu == b.ubu && a.lbx == b.lbx && a.ubx == b.ubx &&
+                a.lg == b.lg && a.ug == b.ug)
+        << i;  // ±inf survive as ±1e30 → ±inf
+    EXPECT_TRUE(a.Zl == b.Zl && a.Zu == b.Zu && a.zl == b.zl && a.zu == b.zu) << i;
+  }
+  QpRiccatiIpm s1(qp.dims, st), s2(back.dims, st2);
+  OcpQpSolution r1(qp.dims), r2(back.dims);
+  ASSERT_EQ(s1.solve(qp, r1), QpStatus::success);
+  ASSERT_EQ(s2.solve(back, r2), QpStatus::success);
+  EXPECT_EQ(r1.iterations, r2.iterations);
+  EXPECT_EQ(r1.objective, r2.objective);
+
+  EXPECT_FALSE(read_ocp_qp_json("{\"format\":\"other\"}", back, st2, name, err));
+  EXPECT_FALSE(read_ocp_qp_json(line.substr(0, line.size() / 2), back, st2, name, err));
+  EXPECT_FALSE(err.empty());
 }
 
 // --- Failure modes: a clear status, never a crash, never NaN in the outputs. ---

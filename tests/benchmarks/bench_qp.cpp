@@ -1,0 +1,103 @@
+// BM_QpSolve/<problem>: one OCP-QP solve by QpRiccatiIpm (issue 3, SPEC §4) on the QPs of
+// tests/qp_problems.hpp, at the issue's tolerances (complementarity 1e-8, stationarity 1e-6).
+//   mi         MikroKopter mixed-initiative (SPEC §5.4): nx 16, nu 4, N 50, 4 τ bounds per stage,
+//              4 Ω bounds on stages 1..N
+//   crazyflie  nx 13, nu 4, N 50, 4 input bounds (SPEC §5.2)
+//   pendubot   nx 4, nu 1, N 10, input bound and two ℓ2²-soft velocity bounds (SPEC §5.1)
+// <problem> is cold-started; <problem>_warm solves the next sampling instant's QP (x0 = predicted
+// x_1 plus a 2 % disturbance) warm-started (primal-dual) from the shifted solution, as in RTI.
+// Counter "iterations": IPM iterations per solve.
+//
+// MIXPILOT_DUMP_QP=<file> appends each QP solved here (once per benchmark) to <file> as one JSON
+// line, with the solver settings; format in docs/qp-dump-format.md.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "core/ocp_qp_io.hpp"
+#include "core/qp_riccati_ipm.hpp"
+#include "tests/qp_problems.hpp"
+
+namespace mixpilot {
+namespace {
+
+QpRiccatiIpmSettings bench_settings() {
+  QpRiccatiIpmSettings s;
+  s.tol_comp = 1e-8;
+  s.tol_stat = 1e-6;
+  return s;
+}
+
+void dump_once(const std::string& name, const OcpQp& qp, const QpRiccatiIpmSettings& settings) {
+  static std::set<std::string> done;
+  const char* path = std::getenv("MIXPILOT_DUMP_QP");
+  if (path == nullptr || *path == '\0' || !done.insert(name).second) return;
+  std::ofstream out(path, std::ios::app);
+  write_ocp_qp_json(out, qp, settings, name);
+}
+
+// RTI shift: stage i takes stage i+1's values where the sizes agree (the last stage keeps its own).
+void shift(OcpQpSolution& s) {
+  auto sh = [](std::vector<Eigen::VectorXd>& v) {
+    for (std::size_t i = 0; i + 1 < v.size(); ++i)
+      if (v[i].size() == v[i + 1].size()) v[i] = v[i + 1];
+  };
+  sh(s.x), sh(s.u), sh(s.pi), sh(s.lam_l), sh(s.lam_u), sh(s.sl), sh(s.su), sh(s.lam_sl),
+      sh(s.lam_su);
+}
+
+void run(benchmark::State& state, const std::string& name, const OcpQp& base, bool warm) {
+  const QpRiccatiIpmSettings settings = bench_settings();
+  QpRiccatiIpm solver(base.dims, settings);
+  OcpQpSolution sol(base.dims), start(base.dims);
+  OcpQp qp = base;
+  if (warm) {
+    // The next sampling instant: x0 is the predicted x_1 plus a disturbance; warm start from
+    // the shifted previous solution.
+    if (solver.solve(base, start) != QpStatus::success) state.SkipWithError("first solve failed");
+    qp.x0 = start.x[1] + 0.02 * start.x[1].cwiseAbs().cwiseMax(1e-3);
+    shift(start);
+  }
+  dump_once(name, qp, settings);
+  QpStatus status = QpStatus::success;
+  for (auto _ : state) {
+    if (warm) sol = start;  // same sizes: a copy without allocation
+    status = solver.solve(qp, sol, warm ? QpWarmStart::primal_dual : QpWarmStart::cold);
+    benchmark::DoNotOptimize(sol.x.data());
+    benchmark::ClobberMemory();
+  }
+  if (status != QpStatus::success) state.SkipWithError(to_string(status));
+  state.counters["iterations"] = sol.iterations;
+}
+
+const OcpQp& mi() {
+  static const OcpQp qp = testing_qp::mixed_initiative_qp();
+  return qp;
+}
+const OcpQp& crazyflie() {
+  static const OcpQp qp = testing_qp::crazyflie_qp();
+  return qp;
+}
+const OcpQp& pendubot() {
+  static const OcpQp qp = testing_qp::pendubot_qp();
+  return qp;
+}
+
+void mi_cold(benchmark::State& s) { run(s, "BM_QpSolve/mi", mi(), false); }
+void mi_warm(benchmark::State& s) { run(s, "BM_QpSolve/mi_warm", mi(), true); }
+void cf_cold(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie", crazyflie(), false); }
+void cf_warm(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie_warm", crazyflie(), true); }
+void pb_cold(benchmark::State& s) { run(s, "BM_QpSolve/pendubot", pendubot(), false); }
+void pb_warm(benchmark::State& s) { run(s, "BM_QpSolve/pendubot_warm", pendubot(), true); }
+BENCHMARK(mi_cold)->Name("BM_QpSolve/mi")->Unit(benchmark::kMicrosecond);
+BENCHMARK(mi_warm)->Name("BM_QpSolve/mi_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(cf_cold)->Name("BM_QpSolve/crazyflie")->Unit(benchmark::kMicrosecond);
+BENCHMARK(cf_warm)->Name("BM_QpSolve/crazyflie_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(pb_cold)->Name("BM_QpSolve/pendubot")->Unit(benchmark::kMicrosecond);
+BENCHMARK(pb_warm)->Name("BM_QpSolve/pendubot_warm")->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace mixpilot
