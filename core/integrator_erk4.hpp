@@ -2,8 +2,8 @@
 // Classical explicit Runge-Kutta 4 (ERK4), SPEC §2/§4:
 //   k1 = f(x, u), k2 = f(x + Δt/2 k1, u), k3 = f(x + Δt/2 k2, u), k4 = f(x + Δt k3, u),
 //   x⁺ = x + Δt/6 (k1 + 2 k2 + 2 k3 + k4), then the model's projection (models/model.hpp).
-// Sensitivities: the step is evaluated once in forward-mode AD with nx + nu seeded directions
-// (z = (x, u)), so A and B are the exact derivatives of the discrete map, identical to forward
+// Sensitivities: the step is evaluated once in forward-mode AD (models/dual.hpp) with nx + nu
+// seeded directions (z = (x, u)), so A and B are the exact derivatives of the discrete map, identical to forward
 // propagation of the variational equations through the same Butcher tableau ("internal
 // numerical differentiation"), without forming dense nx x nx products per stage.
 // All temporaries are fixed-size and live on the stack: no heap allocation.
@@ -47,17 +47,27 @@ class IntegratorErk4 final : public Integrator {
   }
 
   void step(const State& x, const Input& u, double dt, State& x_next, MatA& A, MatB& B) const {
-    constexpr int nz = kNx + kNu;
-    using Ad = models::AutoDiff<nz>;
-    Eigen::Matrix<Ad, kNx, 1> xa, xn;
-    Eigen::Matrix<Ad, kNu, 1> ua;
-    for (int i = 0; i < kNx; ++i) xa(i) = Ad(x(i), nz, i);
-    for (int i = 0; i < kNu; ++i) ua(i) = Ad(u(i), nz, kNx + i);
-    step(xa, ua, dt, xn);
+    // The same arithmetic as step<double>, on dual numbers seeded with z = (x, u). Stage
+    // updates are written out per derivative block instead of through Eigen expressions: a
+    // Dual is a struct of up to ~200 bytes, and the temporaries Eigen copies around cost more
+    // than the derivative arithmetic itself.
+    AdState xz, xs, k, acc;
+    AdInput ua;
+    for (int i = 0; i < kNx; ++i) xz(i) = Ad::variable(x(i), i);
+    for (int i = 0; i < kNu; ++i) ua(i) = Ad::variable(u(i), kNx + i);
+    model_.dynamics(xz, ua, k);  // k1
+    stage<true>(xz, 0.5 * dt, 1.0, k, acc, xs);
+    model_.dynamics(xs, ua, k);  // k2
+    stage<false>(xz, 0.5 * dt, 2.0, k, acc, xs);
+    model_.dynamics(xs, ua, k);  // k3
+    stage<false>(xz, dt, 2.0, k, acc, xs);
+    model_.dynamics(xs, ua, k);  // k4
+    finish(xz, dt / 6.0, k, acc, xs);
+    models::project(model_, xs);
     for (int i = 0; i < kNx; ++i) {
-      x_next(i) = xn(i).value();
-      A.row(i) = xn(i).derivatives().template head<kNx>().transpose();
-      B.row(i) = xn(i).derivatives().template tail<kNu>().transpose();
+      x_next(i) = xs(i).v;
+      for (int j = 0; j < kNx; ++j) A(i, j) = xs(i).derivative(j);
+      for (int j = 0; j < kNu; ++j) B(i, j) = xs(i).derivative(kNx + j);
     }
   }
 
@@ -91,6 +101,38 @@ class IntegratorErk4 final : public Integrator {
   }
 
  private:
+  static constexpr int kNz = kNx + kNu;
+  using Ad = models::AutoDiff<kNz>;
+  using AdState = Eigen::Matrix<Ad, kNx, 1>;
+  using AdInput = Eigen::Matrix<Ad, kNu, 1>;
+
+  // One pass over k per stage: acc (+)= w k, then the next stage's point xs = x + c k (x is
+  // the seeded state, so ∂xs/∂z = [I 0] + c ∂k/∂z).
+  template <bool first>
+  static void stage(const AdState& x, double c, double w, const AdState& k, AdState& acc,
+                    AdState& xs) {
+    for (int i = 0; i < kNx; ++i) {
+      acc(i).v = first ? k(i).v : acc(i).v + w * k(i).v;
+      xs(i).v = x(i).v + c * k(i).v;
+#pragma GCC unroll 16
+      for (int j = 0; j < Ad::blocks; ++j) {
+        acc(i).d[j] = first ? k(i).d[j] : acc(i).d[j] + w * k(i).d[j];
+        xs(i).d[j] = x(i).d[j] + c * k(i).d[j];
+      }
+    }
+  }
+  // x⁺ = x + Δt/6 (acc + k4), into xs.
+  static void finish(const AdState& x, double c, const AdState& k, const AdState& acc,
+                     AdState& xs) {
+    for (int i = 0; i < kNx; ++i) {
+      xs(i).v = x(i).v + c * (acc(i).v + k(i).v);
+#pragma GCC unroll 16
+      for (int j = 0; j < Ad::blocks; ++j) {
+        xs(i).d[j] = x(i).d[j] + c * (acc(i).d[j] + k(i).d[j]);
+      }
+    }
+  }
+
   Model model_;
 };
 

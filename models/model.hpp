@@ -1,16 +1,17 @@
 #pragma once
 // What every dynamic model provides, and its continuous-time Jacobians by forward-mode AD.
 //
-// Jacobians come from forward-mode automatic differentiation (Eigen's AutoDiffScalar with a
-// fixed-size derivative vector) rather than hand-written formulas: they are exact to rounding,
-// cannot drift from the model when it changes, and the fixed size lets the compiler unroll and
-// vectorize the derivative arithmetic, which exploits the sparsity of f for free (each
-// elementary operation costs one short vector update). See core/integrator_erk4.hpp for the
-// same technique applied to a whole ERK4 step, which is what the NMPC uses.
+// Jacobians come from forward-mode automatic differentiation (models/dual.hpp, a dual number
+// with a fixed-size derivative array) rather than hand-written formulas: they are exact to
+// rounding, cannot drift from the model when it changes, and the fixed size lets the compiler
+// unroll and vectorize the derivative arithmetic, which exploits the sparsity of f for free
+// (each elementary operation costs one short vector update). See core/integrator_erk4.hpp for
+// the same technique applied to a whole ERK4 step, which is what the NMPC uses.
 #include <concepts>
 
 #include <Eigen/Core>
-#include <unsupported/Eigen/AutoDiff>
+
+#include "models/dual.hpp"
 
 namespace mixpilot::models {
 
@@ -31,9 +32,10 @@ void project(const M& model, Eigen::Matrix<T, M::nx, 1>& x) {
   if constexpr (requires { model.project(x); }) model.project(x);
 }
 
-// Forward-mode AD scalar carrying derivatives with respect to n directions.
+// Forward-mode AD scalar carrying derivatives with respect to n directions. Constructed and
+// read like Eigen's AutoDiffScalar: Ad(value, n, i), .value(), .derivatives().
 template <int n>
-using AutoDiff = Eigen::AutoDiffScalar<Eigen::Matrix<double, n, 1>>;
+using AutoDiff = Dual<n>;
 
 // f(x, u) with ∂f/∂x (nx x nx) and ∂f/∂u (nx x nu).
 template <DynamicModel M>
@@ -52,8 +54,8 @@ void dynamics_jacobians(const M& model, const Eigen::Matrix<double, M::nx, 1>& x
   model.dynamics(xa, ua, fa);
   for (int i = 0; i < nx; ++i) {
     f(i) = fa(i).value();
-    fx.row(i) = fa(i).derivatives().template head<nx>().transpose();
-    fu.row(i) = fa(i).derivatives().template tail<nu>().transpose();
+    for (int j = 0; j < nx; ++j) fx(i, j) = fa(i).derivative(j);
+    for (int j = 0; j < nu; ++j) fu(i, j) = fa(i).derivative(nx + j);
   }
 }
 

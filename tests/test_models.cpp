@@ -3,8 +3,12 @@
 
 #include <random>
 
+#include <Eigen/Core>
+#include <unsupported/Eigen/AutoDiff>
+
 #include "core/integrator_erk4.hpp"
 #include "models/crazyflie.hpp"
+#include "models/dual.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/model.hpp"
 #include "models/pendubot.hpp"
@@ -138,6 +142,105 @@ TEST(Jacobians, PendubotMatchesFiniteDifferences) { expect_jacobians_match_fd(Pe
 TEST(Jacobians, CrazyflieMatchesFiniteDifferences) { expect_jacobians_match_fd(Crazyflie{}, 2); }
 TEST(Jacobians, MikroKopterMatchesFiniteDifferences) {
   expect_jacobians_match_fd(MikroKopter{}, 3);
+}
+
+// Dual numbers (models/dual.hpp): every operation against Eigen's AutoDiffScalar (to rounding)
+// and against central differences of the same expression in double. The operands a(z), b(z)
+// are affine in z ∈ R⁵ with dense gradients, so each direction and the padding lanes of the
+// second block (5 of 8 used) are exercised.
+constexpr int kDirs = 5;
+using D = models::Dual<kDirs>;
+using Eig = Eigen::AutoDiffScalar<Eigen::Matrix<double, kDirs, 1>>;
+using Vec = Eigen::Matrix<double, kDirs, 1>;
+
+struct Operand {
+  double value;
+  Vec grad;
+  D dual() const {
+    D r(value);
+    for (int j = 0; j < kDirs; ++j) r.d[j / 4][j % 4] = grad(j);
+    return r;
+  }
+  Eig eigen() const { return Eig(value, grad); }
+  double at(int j, double h) const { return value + h * grad(j); }  // a(z₀ + h e_j)
+};
+
+template <class F>
+void expect_op_matches(const char* what, F f, const Operand& a, const Operand& b) {
+  const D r = f(a.dual(), b.dual());
+  const Eig e = f(a.eigen(), b.eigen());
+  const double scale = std::max(1.0, e.derivatives().norm());
+  EXPECT_NEAR(r.value(), e.value(), 1e-15 * std::max(1.0, std::abs(e.value()))) << what;
+  EXPECT_LE((r.derivatives() - e.derivatives()).norm(), 1e-14 * scale) << what;
+  for (int j = kDirs; j < 4 * D::blocks; ++j) EXPECT_EQ(r.d[j / 4][j % 4], 0.0) << what;
+  for (int j = 0; j < kDirs; ++j) {
+    const double h = 1e-6;
+    const double fd = (f(a.at(j, h), b.at(j, h)) - f(a.at(j, -h), b.at(j, -h))) / (2.0 * h);
+    EXPECT_NEAR(r.derivative(j), fd, 1e-7 * scale) << what << " direction " << j;
+  }
+}
+
+TEST(Dual, OperationsMatchAutoDiffAndFiniteDifferences) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-2.0, 2.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Operand a{uni(rng), Vec::NullaryExpr([&] { return uni(rng); })};
+    Operand b{uni(rng), Vec::NullaryExpr([&] { return uni(rng); })};
+    if (std::abs(b.value) < 0.2) b.value += 0.5;  // keep a/b, c/b well conditioned
+    const Operand pos{0.5 + std::abs(a.value), a.grad};  // for sqrt
+    const double c = uni(rng);
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    expect_op_matches("-a", [](auto x, auto) { return -x; }, a, b);
+    expect_op_matches("a + b", [](auto x, auto y) { return x + y; }, a, b);
+    expect_op_matches("a - b", [](auto x, auto y) { return x - y; }, a, b);
+    expect_op_matches("a * b", [](auto x, auto y) { return x * y; }, a, b);
+    expect_op_matches("a / b", [](auto x, auto y) { return x / y; }, a, b);
+    expect_op_matches("a + c", [c](auto x, auto) { return x + c; }, a, b);
+    expect_op_matches("c + a", [c](auto x, auto) { return c + x; }, a, b);
+    expect_op_matches("a - c", [c](auto x, auto) { return x - c; }, a, b);
+    expect_op_matches("c - a", [c](auto x, auto) { return c - x; }, a, b);
+    expect_op_matches("a * c", [c](auto x, auto) { return x * c; }, a, b);
+    expect_op_matches("c * a", [c](auto x, auto) { return c * x; }, a, b);
+    expect_op_matches("a / c", [c](auto x, auto) { return x / (c + 3.0); }, a, b);
+    expect_op_matches("c / b", [c](auto, auto y) { return c / y; }, a, b);
+    expect_op_matches("sqrt a", [](auto x, auto) { return sqrt(x); }, pos, b);
+    expect_op_matches("sin a", [](auto x, auto) { return sin(x); }, a, b);
+    expect_op_matches("cos a", [](auto x, auto) { return cos(x); }, a, b);
+    // Compound assignments, including with an aliased operand.
+    expect_op_matches("a += b", [](auto x, auto y) { x += y; return x; }, a, b);
+    expect_op_matches("a -= b", [](auto x, auto y) { x -= y; return x; }, a, b);
+    expect_op_matches("a *= b", [](auto x, auto y) { x *= y; return x; }, a, b);
+    expect_op_matches("a /= b", [](auto x, auto y) { x /= y; return x; }, a, b);
+    expect_op_matches("a *= a", [](auto x, auto) { x *= x; return x; }, a, b);
+    expect_op_matches("a += c", [c](auto x, auto) { x += c; return x; }, a, b);
+    expect_op_matches("a -= c", [c](auto x, auto) { x -= c; return x; }, a, b);
+    expect_op_matches("a *= c", [c](auto x, auto) { x *= c; return x; }, a, b);
+    expect_op_matches("a /= c", [c](auto x, auto) { x /= (c + 3.0); return x; }, a, b);
+    // A composite, as models use them.
+    expect_op_matches(
+        "composite",
+        [c](auto x, auto y) { return (1.0 - 2.0 * (x * x + y * y)) * sin(x) / (3.0 + cos(y)) + c; },
+        a, b);
+  }
+}
+
+TEST(Dual, SeedsAndEigenScalar) {
+  // variable() and AutoDiffScalar's (value, n, i) constructor seed unit vectors; constants
+  // have zero derivatives; Eigen expressions mix Dual with double.
+  for (int i = 0; i < kDirs; ++i) {
+    const D z = D::variable(0.5 + i, i), w(0.5 + i, kDirs, i);
+    EXPECT_EQ(z.value(), 0.5 + i);
+    EXPECT_EQ(z.derivatives(), Vec::Unit(i));
+    EXPECT_EQ(w.derivatives(), Vec::Unit(i));
+    for (int j = kDirs; j < 4 * D::blocks; ++j) EXPECT_EQ(z.d[j / 4][j % 4], 0.0);
+  }
+  EXPECT_EQ(D(2.5).derivatives(), Vec::Zero());
+  Eigen::Matrix<D, 2, 1> x(D::variable(1.0, 0), D::variable(2.0, 3));
+  const Eigen::Matrix<D, 2, 1> y = x + 0.5 * x;
+  EXPECT_EQ(y(0).value(), 1.5);
+  EXPECT_EQ(y(1).derivatives(), 1.5 * Vec::Unit(3));
 }
 
 }  // namespace
