@@ -1,0 +1,296 @@
+// Scenario files (core/scenario_toml.hpp): the shipped mi_helix.toml and its geometry, the
+// defaults, and that each kind of error names file, line, column and key.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "core/scenario_toml.hpp"
+
+namespace mixpilot {
+namespace {
+
+const std::string kMiHelix = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml";
+
+// Header every inline case starts from (4 lines, so the case's own lines are 5, 6, ...).
+constexpr const char* kHead =
+    "name = \"t\"\n"
+    "mode = \"mixed_initiative\"\n"
+    "model = \"mikrokopter\"\n"
+    "pilot = \"reckless\"\n";
+
+// The error text for kHead + body (empty when it parses).
+std::string error_of(const std::string& body) {
+  std::string error;
+  const auto sc = parse_scenario(std::string(kHead) + body, "t.toml", error);
+  EXPECT_EQ(sc.has_value(), error.empty());
+  return error;
+}
+
+Scenario parse_ok(const std::string& body) {
+  std::string error;
+  const auto sc = parse_scenario(std::string(kHead) + body, "t.toml", error);
+  EXPECT_TRUE(sc) << error;
+  return sc ? *sc : Scenario{};
+}
+
+TEST(Scenario, ShippedMiHelixLoads) {
+  std::string error;
+  const auto sc = load_scenario(kMiHelix, error);
+  ASSERT_TRUE(sc) << error;
+  EXPECT_EQ(error, "");
+  EXPECT_EQ(sc->name, "mi_helix");
+  EXPECT_EQ(sc->mode, "mixed_initiative");
+  EXPECT_EQ(sc->model, "mikrokopter");
+  EXPECT_EQ(sc->duration, 30.0);
+  EXPECT_EQ(sc->default_pilot, "novice");
+  EXPECT_EQ(sc->source_path, kMiHelix);
+  EXPECT_NE(sc->source_text.find("[[arena.obstacles]]"), std::string::npos);
+  EXPECT_GE(sc->arena.obstacles.size(), 6u);
+  for (const char* p : {"novice", "experienced", "reckless"}) {
+    ASSERT_TRUE(sc->pilots.count(p)) << p;
+    EXPECT_EQ(sc->pilots.at(p).name, p);
+  }
+  EXPECT_EQ(sc->pilots.at("experienced").q1, Eigen::Vector3d(400, 400, 600));
+  // Table 7.1.
+  const MiControllerSettings table71;
+  EXPECT_EQ(sc->controller.N, table71.N);
+  EXPECT_EQ(sc->controller.dt, table71.dt);
+  EXPECT_EQ(sc->controller.weights.q_eta, table71.weights.q_eta);
+  EXPECT_EQ(sc->controller.weights.q_e, table71.weights.q_e);
+  EXPECT_EQ(sc->controller.weights.q_nu, table71.weights.q_nu);
+  EXPECT_EQ(sc->controller.weights.r, table71.weights.r);
+  EXPECT_EQ(sc->controller.ph.r, table71.ph.r);
+  EXPECT_EQ(sc->controller.ph.N_b, table71.ph.N_b);
+  EXPECT_EQ(sc->controller.ph.mu1, table71.ph.mu1);
+  EXPECT_EQ(sc->controller.ph.mu2, table71.ph.mu2);
+  EXPECT_EQ(sc->controller.ph.theta2, table71.ph.theta2);
+  EXPECT_EQ(sc->controller.ph.zeta, table71.ph.zeta);
+  EXPECT_EQ(sc->controller.vehicle_radius, 0.3);
+}
+
+// SPEC 5.4: every obstacle clear of the reference by more than r + the quadrotor's radius,
+// with ~0.1 m to spare (a pilot anywhere inside B keeps clearance), but near enough to matter.
+TEST(Scenario, MiHelixObstaclesClearTheReference) {
+  std::string error;
+  const auto sc = load_scenario(kMiHelix, error);
+  ASSERT_TRUE(sc) << error;
+  const double required = sc->controller.ph.r + sc->controller.vehicle_radius;
+  EXPECT_NEAR(required, 0.475, 1e-12);
+  constexpr int kSamples = 300000;  // 0.1 ms: ≤ 21 µm of arc between samples
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < sc->arena.obstacles.size(); ++j) {
+    const Obstacle& o = sc->arena.obstacles[j];
+    double clearance = std::numeric_limits<double>::infinity();
+    double at = 0;
+    for (int i = 0; i <= kSamples; ++i) {
+      const double t = sc->duration * i / kSamples;
+      const double c = (sc->reference.position(t) - o.center).norm() - o.radius;
+      if (c < clearance) clearance = c, at = t;
+    }
+    std::printf("obstacle %zu: clearance %.4f m at t = %.2f s\n", j, clearance, at);
+    EXPECT_GT(clearance, required + 0.1) << "obstacle " << j;
+    nearest = std::min(nearest, clearance);
+  }
+  EXPECT_LT(nearest, 0.7);
+}
+
+TEST(Scenario, MiHelixStaysInsideTheArenaWithMargin) {
+  std::string error;
+  const auto sc = load_scenario(kMiHelix, error);
+  ASSERT_TRUE(sc) << error;
+  double margin = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 30000; ++i) {
+    const Eigen::Vector3d p = sc->reference.position(sc->duration * i / 30000);
+    margin = std::min({margin, (p - sc->arena.min).minCoeff(), (sc->arena.max - p).minCoeff()});
+  }
+  EXPECT_GE(margin, 0.5);
+  for (const Obstacle& o : sc->arena.obstacles) {
+    EXPECT_TRUE((o.center.array() >= sc->arena.min.array()).all());
+    EXPECT_TRUE((o.center.array() <= sc->arena.max.array()).all());
+  }
+}
+
+TEST(Scenario, DefaultsApplyToOmittedKeys) {
+  const Scenario sc = parse_ok("duration = 20\n");  // an integer is a fine number
+  EXPECT_EQ(sc.duration, 20.0);
+  const Scenario def;
+  EXPECT_EQ(sc.controller.N, def.controller.N);
+  EXPECT_EQ(sc.controller.dt, def.controller.dt);
+  EXPECT_EQ(sc.controller.obstacle_form, ObstacleForm::lcl);
+  EXPECT_EQ(sc.controller.safety_constraints, true);
+  EXPECT_EQ(sc.controller.slack_l1, def.controller.slack_l1);
+  EXPECT_EQ(sc.controller.weights.q_e, def.controller.weights.q_e);
+  EXPECT_EQ(sc.controller.ph.zeta, def.controller.ph.zeta);
+  EXPECT_EQ(sc.controller.ph.initial_lambda, def.controller.ph.initial_lambda);
+  EXPECT_EQ(sc.reference.radius, def.reference.radius);
+  EXPECT_EQ(sc.reference.angular_rate, def.reference.angular_rate);
+  EXPECT_EQ(sc.arena.min, def.arena.min);
+  EXPECT_EQ(sc.arena.max, def.arena.max);
+  EXPECT_TRUE(sc.arena.obstacles.empty());
+  EXPECT_EQ(sc.plant.rate_hz, 1000.0);
+  EXPECT_EQ(sc.plant.seed, 1u);
+  // "reckless" is always there; nothing else is invented.
+  ASSERT_EQ(sc.pilots.size(), 1u);
+  EXPECT_EQ(sc.pilots.at("reckless").max_tilt, PilotProfile{}.max_tilt);
+  EXPECT_EQ(sc.source_path, "t.toml");
+
+  // Partly given tables keep the defaults of the rest.
+  const Scenario p = parse_ok(
+      "[controller.ph]\n"
+      "r = 0.2\n"
+      "[pilots.a]\n"
+      "q5 = 3\n");
+  EXPECT_EQ(p.controller.ph.r, 0.2);
+  EXPECT_EQ(p.controller.ph.N_b, def.controller.ph.N_b);
+  EXPECT_EQ(p.pilots.at("a").q5, 3.0);
+  EXPECT_EQ(p.pilots.at("a").q1, PilotProfile{}.q1);
+  EXPECT_EQ(p.pilots.at("a").name, "a");
+}
+
+TEST(Scenario, SyntaxError) {
+  EXPECT_EQ(error_of("[controller]\nN = \n"),
+            "t.toml:6:5: TOML syntax: error while parsing key-value pair: expected value, saw "
+            "'\\n'");
+}
+
+TEST(Scenario, WrongType) {
+  EXPECT_EQ(error_of("[controller]\ndt = \"fast\"\n"),
+            "t.toml:6:6: controller.dt: expected a number, got the string \"fast\"");
+  EXPECT_EQ(error_of("[controller]\nN = 50.0\n"),
+            "t.toml:6:5: controller.N: expected an integer, got 50.0");
+  EXPECT_EQ(error_of("controller = 3\n"), "t.toml:5:14: controller: expected a table, got 3");
+  EXPECT_EQ(error_of("[controller.weights]\nq_eta = [1.0, 2.0]\n"),
+            "t.toml:6:9: controller.weights.q_eta: expected an array of 3 numbers, got an array "
+            "of 2");
+  EXPECT_EQ(error_of("[controller.weights]\nq_eta = [1.0, true, 2.0]\n"),
+            "t.toml:6:15: controller.weights.q_eta[1]: expected a number, got true");
+  EXPECT_EQ(error_of("[arena]\nobstacles = 1\n"),
+            "t.toml:6:13: arena.obstacles: expected an array of tables ([[arena.obstacles]]), "
+            "got 1");
+}
+
+TEST(Scenario, UnknownKey) {
+  EXPECT_EQ(error_of("[controller.ph]\nthetta2 = 50.0\n"),
+            "t.toml:6:1: controller.ph.thetta2: unknown key (did you mean \"theta2\"?)");
+  EXPECT_EQ(error_of("duraton = 3.0\n"), "t.toml:5:1: duraton: unknown key (did you mean "
+                                          "\"duration\"?)");
+  // Far from every known key: list them.
+  EXPECT_EQ(error_of("[plant]\nwind = 3.0\n"),
+            "t.toml:6:1: plant.wind: unknown key; expected one of: rate_hz input_delay "
+            "position_noise seed");
+  EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.1\nr = 1.0\n"),
+            "t.toml:8:1: arena.obstacles[0].r: unknown key (did you mean \"radius\"?)");
+  EXPECT_EQ(error_of("[pilots.a]\nq6 = 1.0\n"),
+            "t.toml:6:1: pilots.a.q6: unknown key (did you mean \"q1\"?)");
+  EXPECT_EQ(error_of("[weather]\n"),
+            "t.toml:5:2: weather: unknown key; expected one of: name mode model duration pilot "
+            "controller reference arena pilots plant");
+}
+
+TEST(Scenario, OutOfRange) {
+  EXPECT_EQ(error_of("[controller.ph]\nr = -0.1\n"),
+            "t.toml:6:5: controller.ph.r: expected a positive number, got -0.1");
+  EXPECT_EQ(error_of("[controller.ph]\nmu1 = 1.0\n"),
+            "t.toml:6:7: controller.ph.mu1: expected a number in (0, 1), got 1.0");
+  EXPECT_EQ(error_of("[controller]\nN = 0\n"),
+            "t.toml:6:5: controller.N: expected an integer >= 1, got 0");
+  EXPECT_EQ(error_of("duration = nan\n"),
+            "t.toml:5:12: duration: expected a finite number, got nan");
+  EXPECT_EQ(error_of("[controller]\nN = 8\n[controller.ph]\nN_b = 10\n"),
+            "t.toml:8:7: controller.ph.N_b: expected at most controller.N = 8, got 10");
+  // The defaulted N_b (10) against a short horizon points at the [controller.ph] table... or,
+  // with no such table, at [controller].
+  EXPECT_EQ(error_of("[controller]\nN = 8\n"),
+            "t.toml:5:1: controller.ph.N_b: expected at most controller.N = 8, got 10");
+  EXPECT_EQ(error_of("[plant]\nrate_hz = 500\n"),
+            "t.toml:6:11: plant.rate_hz: expected a number >= 1000, got 500");
+  EXPECT_EQ(error_of("[controller]\ndt = 0.0155\n[plant]\nrate_hz = 1000.0\n"),
+            "t.toml:8:11: plant.rate_hz: expected a rate giving a whole number of substeps per "
+            "control step, got controller.dt * rate_hz = 15.5");
+  EXPECT_EQ(error_of("[arena]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, -1.0, 1.0]\n"),
+            "t.toml:7:7: arena.max: expected every component above arena.min = [0.0, 0.0, "
+            "0.0], got [1.0, -1.0, 1.0]");
+  EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 9.0]\nradius = 0.1\n"),
+            "t.toml:6:10: arena.obstacles[0].center: expected a point inside the arena [-3.0, "
+            "-3.0, 0.0] .. [3.0, 3.0, 3.0], got [0.0, 0.0, 9.0]");
+  EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.0\n"),
+            "t.toml:7:10: arena.obstacles[0].radius: expected a positive number, got 0.0");
+  EXPECT_EQ(error_of("[reference]\nclimb_rate = 0.2\n"),
+            "t.toml:5:1: reference: expected a helix inside the arena over [0, duration], but "
+            "it leaves it at t = 12.503 s, at (-0.330, -0.944, 3.001)");
+}
+
+TEST(Scenario, MissingRequiredKey) {
+  std::string error;
+  EXPECT_FALSE(parse_scenario("name = \"t\"\nmode = \"mixed_initiative\"\n", "t.toml", error));
+  EXPECT_EQ(error,
+            "t.toml:1:1: model: missing required key (expected one of \"mikrokopter\", "
+            "\"crazyflie\", \"pendubot\")\n"
+            "t.toml:1:1: pilot: expected the name of a profile in [pilots] (\"reckless\"), got "
+            "\"novice\" (the default)");
+  EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\n"),
+            "t.toml:5:1: arena.obstacles[0].radius: missing required key (expected a number)");
+}
+
+TEST(Scenario, BadEnumString) {
+  EXPECT_EQ(error_of("[controller]\nobstacle_form = \"lcp\"\n"),
+            "t.toml:6:17: controller.obstacle_form: expected one of \"lcl\", \"squared\", got "
+            "the string \"lcp\"");
+  std::string error;
+  EXPECT_FALSE(parse_scenario("name = \"t\"\nmode = \"tracking\"\nmodel = \"mikrokopter\"\n"
+                              "pilot = \"reckless\"\n",
+                              "t.toml", error));
+  EXPECT_EQ(error,
+            "t.toml:2:8: mode: expected one of \"mixed_initiative\", got the string "
+            "\"tracking\"");
+  EXPECT_FALSE(parse_scenario("name = \"t\"\nmode = \"mixed_initiative\"\nmodel = \"crazyflie\"\n"
+                              "pilot = \"reckless\"\n",
+                              "t.toml", error));
+  EXPECT_EQ(error,
+            "t.toml:3:9: model: expected \"mikrokopter\" for mode \"mixed_initiative\" (SPEC "
+            "5.4), got \"crazyflie\"");
+}
+
+TEST(Scenario, DefaultPilotMustNameAProfile) {
+  std::string error;
+  EXPECT_FALSE(parse_scenario("name = \"t\"\nmode = \"mixed_initiative\"\nmodel = \"mikrokopter\"\n"
+                              "pilot = \"novce\"\n[pilots.novice]\n",
+                              "t.toml", error));
+  EXPECT_EQ(error,
+            "t.toml:4:9: pilot: expected the name of a profile in [pilots] (\"novice\", "
+            "\"reckless\"), got \"novce\"");
+}
+
+TEST(Scenario, DuplicateProfile) {
+  EXPECT_EQ(error_of("[pilots.a]\nq5 = 1.0\n[pilots.a]\nq5 = 2.0\n"),
+            "t.toml:7:1: pilots.a: defined twice (cannot redefine existing table 'pilots.a'); "
+            "each key, table and pilot profile may appear once");
+}
+
+TEST(Scenario, DuplicateKey) {
+  EXPECT_EQ(error_of("[controller.ph]\nr = 0.1\nr = 0.2\n"),
+            "t.toml:7:5: controller.ph.r: defined twice (cannot redefine existing floating-point "
+            "'r'); each key, table and pilot profile may appear once");
+  EXPECT_EQ(error_of("duration = 1.0\nduration = 2.0\n"),
+            "t.toml:6:12: duration: defined twice (cannot redefine existing floating-point "
+            "'duration'); each key, table and pilot profile may appear once");
+}
+
+TEST(Scenario, AllErrorsReportedInFileOrder) {
+  const std::string e = error_of("[plant]\nseed = -1\n[controller]\ndt = 0\n");
+  EXPECT_EQ(e,
+            "t.toml:6:8: plant.seed: expected an integer >= 0, got -1\n"
+            "t.toml:8:6: controller.dt: expected a positive number, got 0");
+}
+
+TEST(Scenario, MissingFile) {
+  std::string error;
+  EXPECT_FALSE(load_scenario("no/such/scenario.toml", error));
+  EXPECT_EQ(error, "no/such/scenario.toml: cannot open file (No such file or directory)");
+}
+
+}  // namespace
+}  // namespace mixpilot
