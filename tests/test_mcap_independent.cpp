@@ -1,0 +1,215 @@
+// Independent reader: a recording written by SessionRecorder is read by the reference MCAP
+// implementation (npm @mcap/core) and its messages decoded by Foxglove's ros2msg parser and
+// CDR deserializer (tests/mcap_check/check.mjs). The JSON that script prints must equal the
+// JSON built here from what was written: topics, schema names/encodings, message counts,
+// Statistics, metadata names and keys, the data-section CRC, and the last message of every
+// topic field by field (which proves the CDR layout and the embedded schemas).
+//
+// Needs node and tests/mcap_check/node_modules (the CTest fixture mcap_check_npm_ci runs
+// `npm ci` there). Without node the test is skipped.
+#include <gtest/gtest.h>
+
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/recording.hpp"
+#include "core/version.hpp"
+
+#ifndef MIXPILOT_NODE
+#define MIXPILOT_NODE ""
+#endif
+
+namespace mixpilot {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Compact JSON as JSON.stringify prints it. Numbers use fixed notation with the shortest
+// round-trip digits, which is what JavaScript prints for magnitudes in [1e-7, 1e21).
+class Json {
+ public:
+  Json& raw(std::string_view s) {
+    comma();
+    out_ += s;
+    return *this;
+  }
+  Json& key(std::string_view k) {
+    str(k);
+    out_ += ':';
+    fresh_ = true;
+    return *this;
+  }
+  Json& str(std::string_view s) {
+    comma();
+    out_ += '"';
+    for (char c : s) {
+      if (c == '"' || c == '\\') out_ += '\\';
+      if (c == '\n') {
+        out_ += "\\n";
+        continue;
+      }
+      out_ += c;
+    }
+    out_ += '"';
+    return *this;
+  }
+  Json& num(double v) {
+    comma();
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
+    out_.append(buf, r.ptr);
+    return *this;
+  }
+  Json& begin(char c) {
+    comma();
+    out_ += c;
+    fresh_ = true;
+    return *this;
+  }
+  Json& end(char c) {
+    out_ += c;
+    fresh_ = false;
+    return *this;
+  }
+  template <class T>
+  Json& nums(const T& values) {
+    begin('[');
+    for (double v : values) num(v);
+    return end(']');
+  }
+  Json& stamp(const RosTime& t) {
+    key("stamp").begin('{').key("sec").num(t.sec).key("nanosec").num(t.nanosec);
+    return end('}');
+  }
+  const std::string& text() const { return out_; }
+
+ private:
+  void comma() {
+    if (!fresh_ && !out_.empty()) out_ += ',';
+    fresh_ = false;
+  }
+  std::string out_;
+  bool fresh_ = true;
+};
+
+std::string run(const std::string& command) {
+  std::string out;
+  std::FILE* p = ::popen(command.c_str(), "r");
+  if (p == nullptr) return "popen failed";
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  ::pclose(p);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+constexpr uint64_t kPeriodNs = 15'000'000;
+constexpr uint64_t kSteps = 70;  // last step at 1.035 s: the stamp's sec and nanosec both used
+
+TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
+  const std::string node = MIXPILOT_NODE;
+  if (node.empty()) GTEST_SKIP() << "node not found at configure time";
+  const fs::path check_dir = fs::path(MIXPILOT_SOURCE_DIR) / "tests" / "mcap_check";
+  ASSERT_TRUE(fs::exists(check_dir / "node_modules" / "@mcap" / "core"))
+      << "run `npm ci --prefix tests/mcap_check` (CTest fixture mcap_check_npm_ci)";
+
+  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
+  fs::create_directories(dir);
+  const fs::path file = dir / "session.mcap";
+
+  SessionRecorder rec;
+  std::string err;
+  ASSERT_TRUE(rec.open(file.string(), kPeriodNs,
+                       {"[arena]\nradius = 0.175\n", "scenarios/x.toml", 7, "experienced"}, err))
+      << err;
+  JoyMsg joy;
+  PilotCommandMsg pilot;
+  VehicleStateMsg state;
+  AppliedCommandMsg applied;
+  SolverStatsMsg solver;
+  PredictionMsg pred;
+  double lambda = 0;
+  for (uint64_t k = 0; k < kSteps; ++k) {
+    const double s = static_cast<double>(k);
+    joy = {{}, "gamepad0", {0.5f, -0.25f, static_cast<float>(k) * 0.125f, 1.0f}, {1, 0, 0, 1, 3}};
+    ASSERT_TRUE(rec.record_joy(k, joy));
+    pilot = {{}, k, 0.01 * s, -0.02 * s, {0.0655, 0.0656, 0.0657, 0.0658}, "experienced"};
+    ASSERT_TRUE(rec.record_pilot(pilot));
+    state.step = k;
+    state.x.assign(16, 0.0);
+    for (std::size_t i = 0; i < 16; ++i) state.x[i] = 0.001 * s + static_cast<double>(i);
+    ASSERT_TRUE(rec.record_state(state));
+    lambda = 1.0 / (1.0 + s);
+    ASSERT_TRUE(rec.record_lambda(k, lambda));
+    applied = {{}, k, {0.0756, -0.1285, 0.1285, 0.03}, 0.1 * s, -0.1, {0.06, 0.07, 0.08, 0.09}};
+    ASSERT_TRUE(rec.record_applied(applied));
+    solver = {{}, k, static_cast<uint8_t>(k % 3), static_cast<uint32_t>(k + 5), 12.5, 30.25,
+              101.0, 150.75, k % 2 == 1};
+    ASSERT_TRUE(rec.record_solver(solver));
+    pred = {{}, k, std::vector<double>(33, 0.5 * s), std::vector<double>(30, -0.25)};
+    ASSERT_TRUE(rec.record_prediction(pred));
+  }
+  ASSERT_TRUE(rec.close(err)) << err;
+
+  const std::string actual =
+      run("'" + node + "' '" + (check_dir / "check.mjs").string() + "' '" + file.string() + "' 2>&1");
+
+  // The expected JSON, in check.mjs's order.
+  const RosTime t = ros_time_from_ns((kSteps - 1) * kPeriodNs);
+  ASSERT_GT(t.sec, 0);
+  ASSERT_GT(t.nanosec, 0u);
+  Json j;
+  j.begin('{');
+  j.key("profile").str("ros2").key("library").str(version()).key("dataSectionCrc").str("ok");
+  j.key("statistics").begin('{');
+  j.key("messageCount").num(7.0 * kSteps).key("schemaCount").num(7).key("channelCount").num(7);
+  j.key("metadataCount").num(1).key("messageStartTime").num(0);
+  j.key("messageEndTime").num(static_cast<double>((kSteps - 1) * kPeriodNs));
+  j.end('}');
+  std::vector<RecordedType> types(recorded_types().begin(), recorded_types().end());
+  std::sort(types.begin(), types.end(),
+            [](const auto& a, const auto& b) { return std::string(a.topic) < b.topic; });
+  j.key("channels").begin('[');
+  for (const auto& ty : types) {
+    j.begin('{').key("topic").str(ty.topic).key("schemaName").str(ty.schema_name);
+    j.key("schemaEncoding").str("ros2msg").key("messageEncoding").str("cdr");
+    j.key("messages").num(kSteps).key("statistics").num(kSteps).end('}');
+  }
+  j.end(']');
+  j.key("metadata").begin('[').begin('{').key("name").str("mixpilot").key("keys").begin('[');
+  for (const char* k : {"control_period_ns", "pilot", "scenario", "scenario_path", "seed", "version"})
+    j.str(k);
+  j.end(']').end('}').end(']');
+  j.key("last").begin('{');
+  // Sorted by topic, fields in .msg order.
+  j.key("/controller/applied").begin('{').stamp(t).key("step").num(applied.step);
+  j.key("u").nums(applied.u).key("roll").num(applied.roll).key("pitch").num(applied.pitch);
+  j.key("rotor_speed").nums(applied.rotor_speed).end('}');
+  j.key("/controller/lambda").begin('{').key("data").num(lambda).end('}');
+  j.key("/controller/prediction").begin('{').stamp(t).key("step").num(pred.step);
+  j.key("position").nums(pred.position).key("reference").nums(pred.reference).end('}');
+  j.key("/controller/solver").begin('{').stamp(t).key("step").num(solver.step);
+  j.key("status").num(solver.status).key("qp_iterations").num(solver.qp_iterations);
+  j.key("integration_us").num(solver.integration_us);
+  j.key("linearization_us").num(solver.linearization_us).key("qp_us").num(solver.qp_us);
+  j.key("total_us").num(solver.total_us).key("fallback").raw(solver.fallback ? "true" : "false");
+  j.end('}');
+  j.key("/joy").begin('{').key("header").begin('{').stamp(t).key("frame_id").str(joy.frame_id);
+  j.end('}').key("axes").nums(joy.axes).key("buttons").nums(joy.buttons).end('}');
+  j.key("/pilot/command").begin('{').stamp(t).key("step").num(pilot.step);
+  j.key("roll").num(pilot.roll).key("pitch").num(pilot.pitch);
+  j.key("rotor_speed").nums(pilot.rotor_speed).key("source").str(pilot.source).end('}');
+  j.key("/vehicle/state").begin('{').stamp(t).key("step").num(state.step);
+  j.key("x").nums(state.x).end('}');
+  j.end('}');
+  j.end('}');
+
+  EXPECT_EQ(actual, j.text());
+}
+
+}  // namespace
+}  // namespace mixpilot
