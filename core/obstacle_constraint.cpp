@@ -10,13 +10,15 @@ void ObstacleConstraint::eval(const Eigen::Ref<const Eigen::VectorXd>& x,
   Gx.setZero();
   Gu.setZero();
   for (int j = 0; j < num_; ++j) {
-    const Eigen::Vector3d d = x.segment<3>(pos_) - p.segment<3>(off_ + 3 * j);
+    const int o = off_ + kParamsPerObstacle * j;
+    const Eigen::Vector3d d = x.segment<3>(pos_) - p.segment<3>(o);
+    const double clearance = p(o + 3);
     if (form_ == ObstacleForm::squared) {
-      g(j) = d.squaredNorm();
+      g(j) = d.squaredNorm() - clearance * clearance;
       Gx.row(j).segment<3>(pos_) = 2.0 * d.transpose();
     } else {
       const double n = d.norm();
-      g(j) = n;
+      g(j) = n - clearance;
       // ∇‖d‖ = d/‖d‖; at the centre any unit vector is a subgradient: take +z.
       if (n > 1e-12) {
         Gx.row(j).segment<3>(pos_) = d.transpose() / n;

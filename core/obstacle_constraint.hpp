@@ -1,10 +1,11 @@
 #pragma once
-// Spherical obstacle clearance (SPEC §5.3): per obstacle j with centre o_j taken from the stage
-// parameters p[param_offset + 3j .. +3],
-//   lcl:      g_j = ‖p − o_j‖₂           ≥ d_C      (least-conservative linearized form)
-//   squared:  g_j = ‖p − o_j‖₂²          ≥ d_C²     (the usual smooth baseline)
+// Spherical obstacle clearance (SPEC §5.3). Obstacle j reads its centre o_j and clearance d_j
+// (obstacle radius plus vehicle radius) from the stage parameters p[off + 4j .. off + 4j + 4]:
+//   lcl:      g_j = ‖p − o_j‖₂  − d_j   ≥ 0   (least-conservative linearized form)
+//   squared:  g_j = ‖p − o_j‖₂² − d_j²  ≥ 0   (the usual smooth baseline)
 // Under one linearization per step, the lcl half-space contains the squared one (Proposition 1),
 // so RTI is less conservative with lcl; converged, both describe the same feasible set.
+// Use with lg = 0, ug = +∞ (≥ 1e20).
 #include "core/ocp.hpp"
 
 namespace mixpilot {
@@ -13,6 +14,8 @@ enum class ObstacleForm { lcl, squared };
 
 class ObstacleConstraint final : public PathConstraint {
  public:
+  static constexpr int kParamsPerObstacle = 4;  // centre (3), clearance
+
   // position_index: first of the three position components in x.
   ObstacleConstraint(int num_obstacles, ObstacleForm form, int position_index = 0,
                      int param_offset = 0)
@@ -20,11 +23,6 @@ class ObstacleConstraint final : public PathConstraint {
 
   int ng() const override { return num_; }
   ObstacleForm form() const { return form_; }
-
-  // The bound g ≥ lower_bound(d_C) that expresses clearance d_C in this form.
-  double lower_bound(double clearance) const {
-    return form_ == ObstacleForm::lcl ? clearance : clearance * clearance;
-  }
 
   void eval(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& u,
             const Eigen::Ref<const Eigen::VectorXd>& p, Eigen::Ref<Eigen::VectorXd> g,

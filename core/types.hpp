@@ -60,4 +60,30 @@ namespace rti_defaults {
 inline constexpr bool kQpWarmStart = false;
 }  // namespace rti_defaults
 
+// PH index of SPEC §5.4 (Table 7.1).
+namespace ph_defaults {
+inline constexpr double kRadius = 0.175;  // r [m]
+inline constexpr int kHorizon = 10;       // N_b
+inline constexpr double kMu1 = 0.99;
+inline constexpr double kMu2 = 0.3;
+inline constexpr double kTheta2 = 55.0;
+inline constexpr double kZeta = 1e-13;
+inline constexpr double kInitialLambda = 0.5;  // authority shared until a prediction exists
+}  // namespace ph_defaults
+
+// Mixed-initiative controller of SPEC §5.4.
+namespace mi_defaults {
+inline constexpr int kHorizon = 50;                 // N
+inline constexpr double kDt = 0.015;                // [s], t_N = 0.75 s
+inline constexpr int kMaxConstrainedObstacles = 4;  // nearest obstacles carried per step
+inline constexpr double kVehicleRadius = 0.3;       // [m]
+// Exact ℓ1 penalty above any multiplier the tracking cost can produce (SPEC §5.3 uses 14.5e3),
+// plus a small ℓ2² term that keeps the slack Hessian positive.
+inline constexpr double kSlackL1 = 1.45e4;
+inline constexpr double kSlackL2 = 1e2;
+// Back-off of the rotor-speed bounds: RTI meets them for the linearized prediction, and the
+// C_D Ω² term adds up to C_D ΔΩ² Δt / J_m ≈ 1e-3 in one step, so the plant keeps its bounds.
+inline constexpr double kRotorSpeedBackoff = 1e-3;
+}  // namespace mi_defaults
+
 }  // namespace mixpilot

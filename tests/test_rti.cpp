@@ -160,16 +160,16 @@ TEST(RtiSqp, SoftObstacleConstraintMatchesIpopt) {
   for (const ObstacleForm form : {ObstacleForm::lcl, ObstacleForm::squared}) {
     ObstacleConstraint constraint(1, form);
     Ocp ocp = problem.ocp();
-    ocp.np = 3;
+    ocp.np = ObstacleConstraint::kParamsPerObstacle;
     ocp.constraint = &constraint;
-    ocp.lg = Eigen::VectorXd::Constant(1, constraint.lower_bound(clearance));
+    ocp.lg = Eigen::VectorXd::Zero(1);
     ocp.ug = Eigen::VectorXd::Constant(1, 1e20);
     ocp.soft_constraints = {SoftConstraint{0, 1.0, 1.0, 14.5e3, 14.2e3}};
 
     RtiSolver rti;
     ASSERT_TRUE(rti.setup(ocp, converged_settings()));
     problem.set_hover_target(rti.data(), target);
-    for (auto& p : rti.data().p) p = obstacle;
+    for (auto& p : rti.data().p) p << obstacle, clearance;
     const Eigen::VectorXd x0 = problem.model().hover_state({0, 0, 0.4});
     problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
     const SqpResult sqp = rti.sqp(x0, 200, 1e-10);
