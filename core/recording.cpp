@@ -133,6 +133,15 @@ std::span<const RecordedType> recorded_types() { return kTypes; }
 
 // ---- CDR encode/decode --------------------------------------------------------------------
 
+// The encoders with the stamp given separately: the recorder stamps messages without copying
+// them (no allocation per recorded message once the buffers have grown).
+void encode_body(const JoyMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const PilotCommandMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const VehicleStateMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w);
+
 namespace {
 void put_time(const RosTime& t, CdrWriter& w) {
   w.write(t.sec);
@@ -173,8 +182,9 @@ bool finish(CdrReader& r, std::string& error) {
 }
 }  // namespace
 
-void encode(const JoyMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const JoyMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const JoyMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write_string(m.frame_id);
   w.write_sequence(std::span<const float>(m.axes));
   w.write_sequence(std::span<const int32_t>(m.buttons));
@@ -186,8 +196,9 @@ bool decode(std::span<const uint8_t> d, JoyMsg& m, std::string& error) {
   return finish(r, error);
 }
 
-void encode(const PilotCommandMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const PilotCommandMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const PilotCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write(m.step);
   w.write(m.roll);
   w.write(m.pitch);
@@ -201,8 +212,9 @@ bool decode(std::span<const uint8_t> d, PilotCommandMsg& m, std::string& error) 
   return finish(r, error);
 }
 
-void encode(const VehicleStateMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const VehicleStateMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const VehicleStateMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write(m.step);
   w.write_sequence(std::span<const double>(m.x));
 }
@@ -212,8 +224,9 @@ bool decode(std::span<const uint8_t> d, VehicleStateMsg& m, std::string& error) 
   return finish(r, error);
 }
 
-void encode(const AppliedCommandMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const AppliedCommandMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write(m.step);
   w.write_sequence(std::span<const double>(m.u));
   w.write(m.roll);
@@ -227,8 +240,9 @@ bool decode(std::span<const uint8_t> d, AppliedCommandMsg& m, std::string& error
   return finish(r, error);
 }
 
-void encode(const SolverStatsMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const SolverStatsMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write(m.step);
   w.write(m.status);
   w.write(m.qp_iterations);
@@ -246,8 +260,9 @@ bool decode(std::span<const uint8_t> d, SolverStatsMsg& m, std::string& error) {
   return finish(r, error);
 }
 
-void encode(const PredictionMsg& m, CdrWriter& w) {
-  put_time(m.stamp, w);
+void encode(const PredictionMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
   w.write(m.step);
   w.write_sequence(std::span<const double>(m.position));
   w.write_sequence(std::span<const double>(m.reference));
@@ -305,10 +320,8 @@ bool SessionRecorder::put_encoded(Topic t, uint64_t step) {
 
 template <class Msg>
 bool SessionRecorder::put(Topic t, uint64_t step, const Msg& m) {
-  Msg stamped = m;
-  stamped.stamp = ros_time_from_ns(log_time_ns(step));
   cdr_.reset();
-  encode(stamped, cdr_);
+  encode_body(m, ros_time_from_ns(log_time_ns(step)), cdr_);
   return put_encoded(t, step);
 }
 
