@@ -69,22 +69,52 @@ bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double p
 }
 
 void trsv_ln(int n, const double* L, int ldl, const double* inv_diag, double* x) {
-  // Blocks of 4 columns: the triangular 4 x 4 diagonal block by substitution, then the rows below
-  // updated by a 4-column gemv (vectorized over rows).
+  // Blocks of 4 columns: the 4 x 4 diagonal block by substitution, then the rows below updated
+  // with the block's 4 solved components (4-row AVX2 chunks, the last one masked).
   for (int jb = 0; jb < n; jb += 4) {
     const int bw = n - jb < 4 ? n - jb : 4;
-    for (int c = 0; c < bw; ++c) {
-      const int j = jb + c;
-      const double* lj = L + static_cast<ptrdiff_t>(j) * ldl;
-      const double z = x[j] * inv_diag[j];
-      x[j] = z;
-      for (int r = j + 1; r < jb + bw; ++r) x[r] -= lj[r] * z;
+    if (bw == 4) {  // unrolled: the generic loop below costs more in loop control than flops
+      const double* l0 = L + jb + static_cast<ptrdiff_t>(jb) * ldl;
+      const double* l1 = l0 + ldl;
+      const double* l2 = l1 + ldl;
+      double* xb = x + jb;
+      const double z0 = xb[0] * inv_diag[jb];
+      const double z1 = (xb[1] - l0[1] * z0) * inv_diag[jb + 1];
+      const double z2 = (xb[2] - l0[2] * z0 - l1[2] * z1) * inv_diag[jb + 2];
+      const double z3 = (xb[3] - l0[3] * z0 - l1[3] * z1 - l2[3] * z2) * inv_diag[jb + 3];
+      xb[0] = z0, xb[1] = z1, xb[2] = z2, xb[3] = z3;
+    } else {
+      for (int c = 0; c < bw; ++c) {
+        const int j = jb + c;
+        const double* lj = L + static_cast<ptrdiff_t>(j) * ldl;
+        const double z = x[j] * inv_diag[j];
+        x[j] = z;
+        for (int r = j + 1; r < jb + bw; ++r) x[r] -= lj[r] * z;
+      }
     }
-    if (jb + bw < n) {
-      double z[4];
-      for (int c = 0; c < bw; ++c) z[c] = -x[jb + c];
-      gemv_n(n - jb - bw, bw, L + jb + bw + static_cast<ptrdiff_t>(jb) * ldl, ldl, z, x + jb + bw);
+    if (jb + 4 >= n) break;
+#if defined(__AVX2__) && defined(__FMA__)
+    const double* l0 = L + static_cast<ptrdiff_t>(jb) * ldl;
+    const __m256d z0 = _mm256_broadcast_sd(x + jb), z1 = _mm256_broadcast_sd(x + jb + 1),
+                  z2 = _mm256_broadcast_sd(x + jb + 2), z3 = _mm256_broadcast_sd(x + jb + 3);
+    int r = jb + 4;
+    for (; r + 4 <= n; r += 4) {
+      __m256d v = _mm256_loadu_pd(x + r);
+      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + r), z0, v);
+      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + ldl + r), z1, v);
+      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + 2 * ldl + r), z2, v);
+      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + 3 * ldl + r), z3, v);
+      _mm256_storeu_pd(x + r, v);
     }
+    for (; r < n; ++r)
+      x[r] -= l0[r] * x[jb] + l0[ldl + r] * x[jb + 1] + l0[2 * ldl + r] * x[jb + 2] +
+              l0[3 * ldl + r] * x[jb + 3];
+#else
+    for (int c = 0; c < 4; ++c) {
+      const double* lc = L + static_cast<ptrdiff_t>(jb + c) * ldl;
+      for (int r = jb + 4; r < n; ++r) x[r] -= lc[r] * x[jb + c];
+    }
+#endif
   }
 }
 

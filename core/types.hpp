@@ -20,7 +20,7 @@ inline constexpr double kStepFraction = 0.995;
 inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
 inline constexpr double kInitSlack = 1e-1;
-inline constexpr double kInitMu = 1e-1;
+inline constexpr double kInitMu = 1.0;
 // Warm start from primal and dual: slacks and multipliers are clipped from below at this value
 // so the iterate is strictly interior.
 inline constexpr double kWarmStartFloor = 1e-4;
