@@ -126,6 +126,10 @@ struct Case {
   RandomQpSpec spec;
   unsigned seed;
 };
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << "N=" << c.spec.N << " nx=" << c.spec.nx_min << ".." << c.spec.nx_max << " nu=" << c.spec.nu
+      << " ng<=" << c.spec.ng_max << " soft=" << c.spec.soft_fraction << " seed=" << c.seed;
+}
 
 class RandomQp : public ::testing::TestWithParam<Case> {};
 
