@@ -21,7 +21,6 @@ void ScoreAccumulator::on_sample(const TelemetrySample& s) {
   reference_.push_back(s.reference);
   lambda_.push_back(s.lambda);
   rti_us_.push_back(s.stats.total_us);
-  if (s.stats.total_us > dt_ * 1e6) ++deadline_misses_;
   if (s.stats.status == RtiStatus::fallback) ++fallbacks_;
 
   const double dr = s.pilot.roll - s.applied.roll, dp = s.pilot.pitch - s.applied.pitch;
@@ -98,15 +97,7 @@ Score ScoreAccumulator::finish() const {
   sc.override_rms = std::sqrt(sum_override_sq_ / double(K));
   sc.stick_smoothness = K > 1 ? std::sqrt(sum_stick_sq_ / double(K - 1)) : 0.0;
 
-  std::vector<double> t = rti_us_;
-  const auto nth = [&](double q) {
-    const std::size_t i = std::min(K - 1, std::size_t(std::floor(q * double(K - 1) + 0.5)));
-    std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(i), t.end());
-    return t[i];
-  };
-  sc.rti_median_us = nth(0.5);
-  sc.rti_p99_us = nth(0.99);
-  sc.deadline_misses = deadline_misses_;
+  set_timing(sc, rti_us_, dt_);
   sc.fallbacks = fallbacks_;
 
   const double quality = 0.4 * sc.time_in_ball + 0.4 * sc.mean_lambda +
@@ -115,9 +106,50 @@ Score ScoreAccumulator::finish() const {
   return sc;
 }
 
-std::string to_json(const Score& s, int indent) {
+void set_timing(Score& sc, std::vector<double> t, double dt) {
+  sc.rti_median_us = sc.rti_p99_us = 0.0;
+  sc.deadline_misses = 0;
+  if (t.empty()) return;
+  const std::size_t K = t.size();
+  for (double v : t) sc.deadline_misses += v > dt * 1e6 ? 1 : 0;
+  const auto nth = [&](double q) {
+    const std::size_t i = std::min(K - 1, std::size_t(std::floor(q * double(K - 1) + 0.5)));
+    std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(i), t.end());
+    return t[i];
+  };
+  sc.rti_median_us = nth(0.5);
+  sc.rti_p99_us = nth(0.99);
+}
+
+namespace {
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string to_json(const Score& s, const std::vector<std::pair<std::string, std::string>>& labels,
+                    int indent) {
   const std::string pad(std::size_t(std::max(indent, 0)), ' ');
   std::string out = "{\n";
+  for (const auto& [key, value] : labels) {
+    out += pad + "\"" + json_escape(key) + "\": \"" + json_escape(value) + "\",\n";
+  }
   char buf[128];
   const auto num = [&](const char* key, double v, bool last = false) {
     std::snprintf(buf, sizeof buf, "%s\"%s\": %.17g%s\n", pad.c_str(), key, v, last ? "" : ",");

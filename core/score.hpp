@@ -50,8 +50,14 @@ struct Score {
   double skill = 0;
 };
 
-// JSON object with the fields above (17 significant digits: exact round trip).
-std::string to_json(const Score& score, int indent = 2);
+// JSON object with the fields above (17 significant digits: exact round trip), preceded by
+// the given string-valued labels (e.g. scenario, pilot).
+std::string to_json(const Score& score,
+                    const std::vector<std::pair<std::string, std::string>>& labels = {},
+                    int indent = 2);
+
+// Timing fields from per-step controller times [µs] (median, p99, misses of dt).
+void set_timing(Score& score, std::vector<double> total_us, double dt);
 
 class ScoreAccumulator final : public TelemetrySink {
  public:
@@ -72,7 +78,6 @@ class ScoreAccumulator final : public TelemetrySink {
   double min_clearance_ = 1e9;
   int collisions_ = 0;
   bool in_contact_ = false;
-  int deadline_misses_ = 0;
   std::int64_t fallbacks_ = 0;
 };
 

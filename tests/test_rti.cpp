@@ -169,7 +169,10 @@ TEST(RtiSqp, SoftObstacleConstraintMatchesIpopt) {
     RtiSolver rti;
     ASSERT_TRUE(rti.setup(ocp, converged_settings()));
     problem.set_hover_target(rti.data(), target);
-    for (auto& p : rti.data().p) p << obstacle, clearance;
+    for (auto& p : rti.data().p) {
+      p.head<3>() = obstacle;
+      p(3) = clearance;
+    }
     const Eigen::VectorXd x0 = problem.model().hover_state({0, 0, 0.4});
     problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
     const SqpResult sqp = rti.sqp(x0, 200, 1e-10);
