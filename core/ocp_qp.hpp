@@ -50,7 +50,8 @@ struct OcpQpStage {
   Eigen::MatrixXd A;  // nx_{i+1} x nx_i
   Eigen::MatrixXd B;  // nx_{i+1} x nu_i
   Eigen::VectorXd b;  // nx_{i+1}
-  // Cost; Q and R symmetric (only their lower triangles are read).
+  // Cost; Q and R must be symmetric (the factorization reads their lower triangles, the
+  // residuals the full matrices).
   Eigen::MatrixXd Q;  // nx x nx
   Eigen::MatrixXd S;  // nu x nx
   Eigen::MatrixXd R;  // nu x nu
