@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/integrator_erk4.hpp"
+#include "core/mode.hpp"
 #include "core/pilot_emulated.hpp"
 #include "core/recording.hpp"
 #include "core/scenario_toml.hpp"
@@ -53,13 +54,17 @@ constexpr const char* kFlyUsage =
     "Runs one session of the scenario as fast as possible and prints a short summary.\n"
     "\n"
     "  --scenario FILE    scenario file (TOML, docs/scenario-format.md); optional when PILOT is\n"
-    "                     a recording, whose embedded scenario is then used\n"
+    "                     a recording, whose embedded scenario is then used. Its `mode` picks\n"
+    "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
     "                     RECORDING.mcap (replays its pilot commands); default: the scenario's\n"
+    "                     (mixed_initiative only)\n"
     "  --headless         run without a window (required: this build has no GUI yet)\n"
     "  --duration S       fly S seconds instead of the scenario's duration\n"
-    "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md)\n"
-    "  --report OUT.json  write the score as JSON (fields: README, Scoring)\n";
+    "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md;\n"
+    "                     mixed_initiative only)\n"
+    "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
+    "                     mode's metrics as JSON\n";
 
 constexpr const char* kScoreUsage =
     "usage: mixpilot score FILE.mcap... [--jobs N] [--json OUT]\n"
@@ -152,8 +157,60 @@ void print_summary(const Scenario& sc, const std::string& pilot, const Score& s,
   if (lost) std::printf("  the vehicle was lost: the plant state stopped being finite\n");
 }
 
+// Modes other than mixed_initiative fly on their own (core/mode.hpp).
+int run_mode(const std::string& mode, const FlyOptions& o) {
+  const ModeRunner runner = find_mode_runner(mode);
+  if (!runner) {
+    std::string known = "mixed_initiative";
+    for (const auto& m : mode_runner_names()) known += ", " + m;
+    std::fprintf(stderr, "mixpilot fly: %s: mode \"%s\" has no runner (known: %s)\n",
+                 o.scenario_path.c_str(), mode.c_str(), known.c_str());
+    return 1;
+  }
+  if (!o.pilot.empty()) usage_error("fly", "--pilot is for mixed_initiative scenarios");
+  if (!o.record.empty()) usage_error("fly", "--record is for mixed_initiative scenarios");
+  ModeOptions options;
+  options.duration = o.duration;
+  const ModeResult r = runner(o.scenario_path, options);
+  if (!r.ok) {
+    std::fprintf(stderr, "mixpilot fly: %s\n", r.error.c_str());
+    return 1;
+  }
+  std::fputs(r.summary.c_str(), stdout);
+  if (!r.summary.empty() && r.summary.back() != '\n') std::fputc('\n', stdout);
+  if (!o.report.empty()) {
+    std::string json = "{\n  \"mode\": \"" + mode + "\"";
+    char buf[160];
+    for (const auto& [name, value] : r.metrics) {
+      std::snprintf(buf, sizeof buf, ",\n  \"%s\": %.17g", name.c_str(), value);
+      json += buf;
+    }
+    json += "\n}\n";
+    std::string error;
+    if (!write_file(o.report, json, error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("  report %s\n", o.report.c_str());
+  }
+  return 0;
+}
+
 int run_fly(const FlyOptions& o) {
   std::string error;
+  if (!o.scenario_path.empty()) {
+    std::string text;
+    if (!read_text_file(o.scenario_path, text, error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      return 1;
+    }
+    const auto mode = scenario_mode(text, o.scenario_path, error);
+    if (!mode) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      return 1;
+    }
+    if (*mode != "mixed_initiative") return run_mode(*mode, o);
+  }
   std::optional<RecordingContents> recording;
   if (ends_with(o.pilot, ".mcap")) {
     recording = read_recording(o.pilot, error);

@@ -15,298 +15,13 @@
 #include <utility>
 #include <vector>
 
-// Debian's toml++ is the compiled shared library, built with exceptions: this TU keeps them on
-// (switching them off would select the noex ABI the library does not export) and catches
-// toml::parse_error itself.
-#include <toml++/toml.h>
+#include "core/toml_read.hpp"
 
 namespace mixpilot {
 namespace {
 
-struct Pos {
-  std::uint32_t line = 1;
-  std::uint32_t col = 1;
-};
+using namespace toml_read;  // NOLINT: the reading vocabulary of this file
 
-Pos pos_of(const toml::source_region& r) { return {r.begin.line, r.begin.column}; }
-
-// Collects `<file>:<line>:<col>: <key path>: <what>` lines; reported sorted by position.
-class Diagnostics {
- public:
-  explicit Diagnostics(std::string file) : file_(std::move(file)) {}
-
-  void add(Pos p, std::string_view path, std::string_view what) {
-    std::string text = file_ + ':' + std::to_string(p.line) + ':' + std::to_string(p.col) + ": ";
-    text.append(path).append(": ").append(what);
-    items_.push_back({p, std::move(text)});
-  }
-  bool empty() const { return items_.empty(); }
-  std::string str() {
-    std::stable_sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) {
-      return std::pair(a.pos.line, a.pos.col) < std::pair(b.pos.line, b.pos.col);
-    });
-    std::string out;
-    for (const Item& i : items_) out += (out.empty() ? "" : "\n") + i.text;
-    return out;
-  }
-
- private:
-  struct Item {
-    Pos pos;
-    std::string text;
-  };
-  std::string file_;
-  std::vector<Item> items_;
-};
-
-// Shortest round-trip text; floats keep a '.' so "got 50.0" is not mistaken for an integer.
-std::string fmt(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  std::string s(buf, r.ptr);
-  if (s.find_first_of(".eni") == std::string::npos) s += ".0";
-  return s;
-}
-
-std::string describe(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::string:
-      return "the string \"" + n.as_string()->get() + '"';
-    case toml::node_type::integer:
-      return std::to_string(n.as_integer()->get());
-    case toml::node_type::floating_point:
-      return fmt(n.as_floating_point()->get());
-    case toml::node_type::boolean:
-      return n.as_boolean()->get() ? "true" : "false";
-    case toml::node_type::array:
-      return "an array of " + std::to_string(n.as_array()->size());
-    case toml::node_type::table:
-      return "a table";
-    default:
-      return "a date/time";
-  }
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const auto lower = [](char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; };
-      const std::size_t sub = diag + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
-      diag = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, sub});
-    }
-  }
-  return row[b.size()];
-}
-
-// Range checks: nullptr when fine, else what was expected.
-using Check = const char* (*)(double);
-using IntCheck = const char* (*)(std::int64_t);
-
-const char* finite(double) { return nullptr; }  // non-finite values are rejected before checks
-const char* positive(double v) { return v > 0 ? nullptr : "expected a positive number"; }
-const char* non_negative(double v) { return v >= 0 ? nullptr : "expected a number >= 0"; }
-const char* unit_open(double v) {
-  return v > 0 && v < 1 ? nullptr : "expected a number in (0, 1)";
-}
-const char* unit_closed(double v) {
-  return v >= 0 && v <= 1 ? nullptr : "expected a number in [0, 1]";
-}
-const char* tilt(double v) {
-  return v > 0 && v < std::numbers::pi / 2 ? nullptr : "expected an angle in (0, pi/2) rad";
-}
-const char* at_least_1000(double v) { return v >= 1000 ? nullptr : "expected a number >= 1000"; }
-const char* int_positive(std::int64_t v) { return v >= 1 ? nullptr : "expected an integer >= 1"; }
-const char* int_non_negative(std::int64_t v) {
-  return v >= 0 ? nullptr : "expected an integer >= 0";
-}
-
-// One TOML table being read: every key asked for is "known"; finish() reports the rest.
-// A missing table (t == nullptr) reads as all-defaults.
-class Section {
- public:
-  Section(Diagnostics& d, const toml::table* t, std::string path, Pos pos)
-      : d_(d), t_(t), path_(std::move(path)), pos_(pos) {}
-
-  const toml::table* table() const { return t_; }
-  Pos pos() const { return pos_; }
-  std::string path(std::string_view key) const {
-    return path_.empty() ? std::string(key) : path_ + '.' + std::string(key);
-  }
-  // Position of key's value if given, else of this table (cross-checks on defaulted keys).
-  Pos pos(std::string_view key) const {
-    const toml::node* n = t_ ? t_->get(key) : nullptr;
-    return n ? pos_of(n->source()) : pos_;
-  }
-
-  const toml::node* take(std::string_view key, bool required, std::string_view expected) {
-    known_.emplace_back(key);
-    const toml::node* n = t_ ? t_->get(key) : nullptr;
-    if (!n && required) {
-      d_.add(pos_, path(key), "missing required key (expected " + std::string(expected) + ')');
-    }
-    return n;
-  }
-
-  Section sub(std::string_view key) {
-    const toml::node* n = take(key, false, "");
-    if (n && !n->is_table()) {
-      d_.add(pos_of(n->source()), path(key), "expected a table, got " + describe(*n));
-      n = nullptr;
-    }
-    return Section(d_, n ? n->as_table() : nullptr, path(key), n ? pos_of(n->source()) : pos_);
-  }
-
-  bool num(std::string_view key, double& out, Check check = finite, bool required = false) {
-    const toml::node* n = take(key, required, "a number");
-    return n && read_num(*n, path(key), out, check);
-  }
-
-  bool integer(std::string_view key, std::int64_t& out, IntCheck check, bool required = false) {
-    const toml::node* n = take(key, required, "an integer");
-    if (!n) return false;
-    if (!n->is_integer()) {
-      d_.add(pos_of(n->source()), path(key), "expected an integer, got " + describe(*n));
-      return false;
-    }
-    const std::int64_t v = n->as_integer()->get();
-    if (const char* e = check(v)) {
-      d_.add(pos_of(n->source()), path(key), std::string(e) + ", got " + std::to_string(v));
-      return false;
-    }
-    out = v;
-    return true;
-  }
-
-  bool integer(std::string_view key, int& out, IntCheck check, bool required = false) {
-    std::int64_t v = out;
-    if (!integer(key, v, check, required)) return false;
-    if (v > std::numeric_limits<int>::max()) {
-      d_.add(pos(key), path(key), "expected an integer below 2^31, got " + std::to_string(v));
-      return false;
-    }
-    out = int(v);
-    return true;
-  }
-
-  bool boolean(std::string_view key, bool& out) {
-    const toml::node* n = take(key, false, "");
-    if (!n) return false;
-    if (!n->is_boolean()) {
-      d_.add(pos_of(n->source()), path(key), "expected true or false, got " + describe(*n));
-      return false;
-    }
-    out = n->as_boolean()->get();
-    return true;
-  }
-
-  bool string(std::string_view key, std::string& out, bool required = false) {
-    const toml::node* n = take(key, required, "a string");
-    if (!n) return false;
-    if (!n->is_string() || n->as_string()->get().empty()) {
-      d_.add(pos_of(n->source()), path(key), "expected a non-empty string, got " + describe(*n));
-      return false;
-    }
-    out = n->as_string()->get();
-    return true;
-  }
-
-  bool choice(std::string_view key, std::string& out, std::initializer_list<const char*> allowed,
-              bool required = false) {
-    std::string list;
-    for (const char* a : allowed) list += (list.empty() ? "" : ", ") + ('"' + std::string(a) + '"');
-    const toml::node* n = take(key, required, "one of " + list);
-    if (!n) return false;
-    if (n->is_string()) {
-      for (const char* a : allowed) {
-        if (n->as_string()->get() == a) {
-          out = a;
-          return true;
-        }
-      }
-    }
-    d_.add(pos_of(n->source()), path(key), "expected one of " + list + ", got " + describe(*n));
-    return false;
-  }
-
-  template <int n>
-  bool vec(std::string_view key, Eigen::Matrix<double, n, 1>& out, Check check = finite,
-           bool required = false) {
-    const std::string expected = "an array of " + std::to_string(n) + " numbers";
-    const toml::node* node = take(key, required, expected);
-    if (!node) return false;
-    const toml::array* a = node->as_array();
-    if (!a || a->size() != std::size_t(n)) {
-      d_.add(pos_of(node->source()), path(key), "expected " + expected + ", got " + describe(*node));
-      return false;
-    }
-    Eigen::Matrix<double, n, 1> v;
-    bool ok = true;
-    for (int i = 0; i < n; ++i) {
-      ok = read_num(*a->get(std::size_t(i)), path(key) + '[' + std::to_string(i) + ']', v[i],
-                    check) && ok;
-    }
-    if (ok) out = v;
-    return ok;
-  }
-
-  // Keys nobody asked for: typos, or keys placed in the wrong table.
-  void finish() {
-    if (!t_) return;
-    for (auto&& [k, v] : *t_) {
-      if (std::find(known_.begin(), known_.end(), k.str()) != known_.end()) continue;
-      std::string what = "unknown key";
-      const std::string* best = nullptr;
-      std::size_t best_d = 3;  // suggest only close matches
-      for (const std::string& c : known_) {
-        // A prefix counts as close too ("r" for "radius").
-        const bool prefix = c.starts_with(k.str()) || k.str().starts_with(c);
-        const std::size_t dist = prefix ? 0 : edit_distance(k.str(), c);
-        if (dist < best_d && dist < c.size()) best = &c, best_d = dist;
-      }
-      if (best) {
-        what += " (did you mean \"" + *best + "\"?)";
-      } else {
-        what += "; expected one of:";
-        for (const std::string& c : known_) what += ' ' + c;
-      }
-      d_.add(pos_of(k.source()), path(k.str()), what);
-    }
-  }
-
- private:
-  bool read_num(const toml::node& n, const std::string& path, double& out, Check check) {
-    double v = 0;
-    if (n.is_floating_point()) {
-      v = n.as_floating_point()->get();
-    } else if (n.is_integer()) {
-      v = double(n.as_integer()->get());  // `duration = 30` is as good as 30.0
-    } else {
-      d_.add(pos_of(n.source()), path, "expected a number, got " + describe(n));
-      return false;
-    }
-    if (!std::isfinite(v)) {
-      d_.add(pos_of(n.source()), path, "expected a finite number, got " + describe(n));
-      return false;
-    }
-    if (const char* e = check(v)) {
-      d_.add(pos_of(n.source()), path, std::string(e) + ", got " + describe(n));
-      return false;
-    }
-    out = v;
-    return true;
-  }
-
-  Diagnostics& d_;
-  const toml::table* t_;
-  std::string path_;
-  Pos pos_;
-  std::vector<std::string> known_;
-};
 
 void read_controller(Section s, MiControllerSettings& c, Diagnostics& d) {
   const bool n_ok = s.integer("N", c.N, int_positive) || !s.table() || !s.table()->get("N");
@@ -501,51 +216,6 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   return sc;
 }
 
-// Name of the last `[table]` or `[[table]]` header before `line` (1-based), "" if none.
-std::string header_before(std::string_view text, std::uint32_t line) {
-  std::string header;
-  std::uint32_t n = 1;
-  for (std::size_t at = 0; at < text.size() && n < line; ++n) {
-    std::size_t end = text.find('\n', at);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view l = text.substr(at, end - at);
-    at = end + 1;
-    const std::size_t b = l.find_first_not_of(" \t");
-    if (b == std::string_view::npos || l[b] != '[') continue;
-    const std::size_t close = l.find(']', b);
-    if (close == std::string_view::npos) continue;
-    header.clear();
-    for (char c : l.substr(b, close - b)) {
-      if (c != '[' && c != ' ' && c != '\t') header += c;
-    }
-  }
-  return header;
-}
-
-// toml++ says "Error while parsing <what>: <detail>"; a redefinition names the key, which then
-// goes in the key-path slot (this is how a duplicate [pilots.<name>] is reported). toml++ names
-// a table by its full path but a plain key relative to its table: prefix that table's header.
-void add_syntax_error(Diagnostics& d, const toml::parse_error& e, std::string_view text) {
-  std::string desc(e.description());
-  constexpr std::string_view redefine = "cannot redefine existing ";
-  if (const auto at = desc.find(redefine); at != std::string::npos) {
-    const auto q1 = desc.find('\'', at);
-    const auto q2 = q1 == std::string::npos ? q1 : desc.find('\'', q1 + 1);
-    if (q2 != std::string::npos) {
-      std::string key = desc.substr(q1 + 1, q2 - q1 - 1);
-      if (desc.compare(at + redefine.size(), 5, "table") != 0) {
-        const std::string table = header_before(text, e.source().begin.line);
-        if (!table.empty()) key = table + '.' + key;
-      }
-      d.add(pos_of(e.source()), key,
-            "defined twice (" + desc.substr(at) + "); each key, table and pilot profile may "
-            "appear once");
-      return;
-    }
-  }
-  if (desc.rfind("Error", 0) == 0) desc[0] = 'e';
-  d.add(pos_of(e.source()), "TOML syntax", desc);
-}
 
 }  // namespace
 
@@ -553,10 +223,7 @@ std::optional<Scenario> parse_scenario(std::string_view text, const std::string&
                                        std::string& error) {
   Diagnostics d(source_name);
   toml::table root;
-  try {
-    root = toml::parse(text, std::string_view(source_name));
-  } catch (const toml::parse_error& e) {
-    add_syntax_error(d, e, text);
+  if (!parse_toml(text, source_name, d, root)) {
     error = d.str();
     return std::nullopt;
   }
@@ -572,19 +239,43 @@ std::optional<Scenario> parse_scenario(std::string_view text, const std::string&
 }
 
 std::optional<Scenario> load_scenario(const std::string& path, std::string& error) {
+  std::string text;
+  if (!read_text_file(path, text, error)) return std::nullopt;
+  return parse_scenario(text, path, error);
+}
+
+bool read_text_file(const std::string& path, std::string& text, std::string& error) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     error = path + ": cannot open file (" + std::error_code(errno, std::generic_category()).message() +
             ')';
-    return std::nullopt;
+    return false;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
+  std::ostringstream s;
+  s << in.rdbuf();
   if (in.bad()) {
     error = path + ": read error";
+    return false;
+  }
+  text = s.str();
+  return true;
+}
+
+std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
+                                         std::string& error) {
+  Diagnostics d(source_name);
+  toml::table root;
+  if (!parse_toml(text, source_name, d, root)) {
+    error = d.str();
     return std::nullopt;
   }
-  return parse_scenario(text.str(), path, error);
+  Section s(d, &root, "", Pos{1, 1});
+  std::string mode;
+  if (!s.string("mode", mode, true)) {
+    error = d.str();
+    return std::nullopt;
+  }
+  return mode;
 }
 
 }  // namespace mixpilot

@@ -23,4 +23,11 @@ std::optional<Scenario> load_scenario(const std::string& path, std::string& erro
 std::optional<Scenario> parse_scenario(std::string_view text, const std::string& source_name,
                                        std::string& error);
 
+// The whole text of a file; false with "<path>: cannot open file (...)" otherwise.
+bool read_text_file(const std::string& path, std::string& text, std::string& error);
+
+// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader.
+std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
+                                         std::string& error);
+
 }  // namespace mixpilot
