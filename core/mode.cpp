@@ -1,5 +1,7 @@
 #include "core/mode.hpp"
 
+#include "core/obstacles.hpp"
+
 
 namespace mixpilot {
 
@@ -13,6 +15,7 @@ struct Entry {
 // One line per mode (issue 6), e.g. {"pendubot_swingup", &fly_pendubot_swingup}.
 const std::vector<Entry>& modes() {
   static const std::vector<Entry> kModes = {
+      {"obstacle_avoidance", &fly_obstacle_avoidance},
   };
   return kModes;
 }

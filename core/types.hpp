@@ -87,4 +87,21 @@ inline constexpr double kSlackL2 = 1e2;
 inline constexpr double kRotorSpeedBackoff = 1e-3;
 }  // namespace mi_defaults
 
+// Obstacle avoidance with the LCL constraint, SPEC §5.3 (thesis ch. 6).
+namespace obstacle_defaults {
+inline constexpr int kHorizon = 50;             // N
+inline constexpr double kDt = 0.015;            // [s]
+inline constexpr double kClearance = 0.2;       // d_C [m]
+inline constexpr double kSlackL1Lower = 14.5e3;  // exact ℓ1 penalty, lower side (eq. 6.5)
+inline constexpr double kSlackL1Upper = 14.2e3;  // upper side (inert: the upper side is absent)
+// ℓ2² slack weight. SPEC §5.3 is pure ℓ1 (Z = 0): kept positive until the QP solver handles
+// Z = 0 with an absent upper side (issue 6). 100 as mi_defaults::kSlackL2: with Z = 1 the cold
+// first QP of obstacles_thrown_balls (lcl) stops at min_step; the closed-loop minimum distances
+// are the same to 0.01 mm for Z = 1, 10, 100 (the ℓ1 term keeps the slacks at zero).
+inline constexpr double kSlackL2 = 100.0;
+inline constexpr double kPlantRateHz = 1000.0;  // RK4 substeps per second of the plant
+inline constexpr double kGravity = 9.81;        // [m/s²], thrown balls
+inline constexpr double kViolationTolerance = 1e-3;  // a violation is ‖p − o‖ < d_C − 1 mm
+}  // namespace obstacle_defaults
+
 }  // namespace mixpilot
