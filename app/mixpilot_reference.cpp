@@ -7,6 +7,7 @@
 
 #include "core/crazyflie_tracking.hpp"
 #include "core/nlp_ipopt.hpp"
+#include "core/obstacles.hpp"
 #include "core/trajectory_io.hpp"
 
 namespace {
@@ -18,6 +19,10 @@ constexpr const char* kUsage =
     "  smooth-step   SPEC 5.2's smooth step of the Crazyflie: hover at (0,0,0.4) to (1,-1,1),\n"
     "                T = 6 s, N = 400, dt = 15 ms, the 5.2 weights, solved to convergence by\n"
     "                Ipopt from the hover guess\n"
+    "  obstacles-p1  SPEC 5.3's obstacle-free reference: hover at (0,0,0.4) to p1 = (1,-1,1),\n"
+    "                T = 3 s, N = 200, dt = 15 ms, the 5.3 weights, Ipopt from the hover guess\n"
+    "                (scenarios/references/obstacles_to_1_-1_1.csv)\n"
+    "  obstacles-p2  the same to p2 = (0.5,-0.5,1) (scenarios/references/obstacles_to_0.5_-0.5_1.csv)\n"
     "\n"
     "options:\n"
     "  --out FILE          write the trajectory as CSV (docs: core/trajectory_io.hpp)\n"
@@ -77,6 +82,53 @@ int run_smooth_step(const std::string& out, const IpoptOcpSettings& settings) {
   return 0;
 }
 
+// SPEC 5.3 references (thesis eq. 6.7): the obstacle-avoidance OCP without obstacles,
+// tracking the hover at `target` over T = 3 s, N = 200.
+int run_obstacle_reference(const Eigen::Vector3d& target, const std::string& out,
+                           const IpoptOcpSettings& settings) {
+  ObstacleControllerSettings cs;
+  cs.N = 200;
+  cs.dt = 0.015;
+  const Eigen::Vector3d start(0.0, 0.0, 0.4);
+  const ObstacleAvoidanceOcp problem(0, cs);
+  OcpStageData data(problem.ocp());
+  problem.set_hover_target(data, target);
+  OcpTrajectory traj(problem.ocp());
+  problem.hover_guess(traj, start);
+  const Eigen::VectorXd x0 = problem.model().hover_state(start);
+
+  std::printf("obstacle reference: hover (0,0,0.4) -> (%g,%g,%g), N = %d, dt = %.3f s, "
+              "T = %.1f s\n", target(0), target(1), target(2), cs.N, cs.dt, cs.N * cs.dt);
+  IpoptOcpSolver solver(settings);
+  const IpoptOcpResult r = solver.solve(problem.ocp(), data, x0, traj);
+  std::printf("ipopt: %s (%s), %d iterations, %.2f s\n", to_string(r.status), r.message,
+              r.iterations, r.solve_seconds);
+  std::printf("objective %.12g, constraint violation %.2e, dual infeasibility %.2e, "
+              "dynamics residual %.2e\n",
+              r.objective, r.constraint_violation, r.dual_infeasibility, r.dynamics_residual);
+  if (r.status != IpoptOcpStatus::solved) {
+    std::fprintf(stderr, "mixpilot-reference: Ipopt did not converge; nothing written\n");
+    return 1;
+  }
+  const Eigen::Vector3d pN = traj.x[cs.N].head<3>();
+  double omega_min = 1e300, omega_max = -1e300;
+  for (const auto& u : traj.u) {
+    omega_min = std::min(omega_min, u.minCoeff());
+    omega_max = std::max(omega_max, u.maxCoeff());
+  }
+  std::printf("final position (%.6f, %.6f, %.6f), error %.2e m; Omega in [%.4f, %.4f] krpm\n",
+              pN(0), pN(1), pN(2), (pN - target).norm(), omega_min, omega_max);
+  if (!out.empty()) {
+    std::string error;
+    if (!write_trajectory_csv(out, traj, cs.dt, error)) {
+      std::fprintf(stderr, "mixpilot-reference: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", out.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -114,6 +166,8 @@ int main(int argc, char** argv) {
     }
   }
   if (command == "smooth-step") return run_smooth_step(out, settings);
+  if (command == "obstacles-p1") return run_obstacle_reference({1.0, -1.0, 1.0}, out, settings);
+  if (command == "obstacles-p2") return run_obstacle_reference({0.5, -0.5, 1.0}, out, settings);
   if (command.empty()) return usage_error("missing command");
   return usage_error(("unknown command '" + command + "'").c_str());
 }
