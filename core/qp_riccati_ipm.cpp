@@ -104,7 +104,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     *p = Eigen::VectorXd::Zero(ov);
   for (Eigen::VectorXd* p : {&w.pi, &w.dpi, &w.res_pi, &w.bflat, &w.err_pi, &w.cpi})
     *p = Eigen::VectorXd::Zero(op);
-  for (Eigen::VectorXd* p : {&w.s, &w.ds, &w.res_s, &w.zflat, &w.err_s, &w.cs})
+  for (Eigen::VectorXd* p : {&w.s, &w.ds, &w.res_s, &w.zflat, &w.err_s, &w.cs, &w.slive, &w.sfix})
     *p = Eigen::VectorXd::Zero(os);
   for (Eigen::VectorXd* p : {&w.t, &w.dt, &w.lam, &w.dlam, &w.res_t, &w.mask, &w.w, &w.rc,
                              &w.rho, &w.dt_aff, &w.dlam_aff, &w.ct, &w.clam, &w.zero_m})
@@ -188,9 +188,21 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     }
     // s ≥ 0 is implied at the optimum when z = 0 < Z (stationarity gives s = λ/Z ≥ 0); imposing
     // it would make s·λ_s = 0 degenerate (both → 0 like √μ) for every inactive ℓ2²-soft side.
+    // A slack whose bound side is absent is decoupled from everything else: min ½Z s² + z s over
+    // s ≥ 0, solved in closed form (s = max(0, −z/Z), s = 0 for Z = 0) and kept out of the
+    // iteration. Left in, a pure ℓ1 side (Z = 0) has only the barrier as curvature and its
+    // cold-started λ_s = μ/t ≪ z: the Newton step asks for Δs ≈ −z/W and Mehrotra's corrector
+    // (Δλ_aff Δt_aff ≈ −z·t·z/λ) then throws s far off, stalling the whole QP.
+    const int os = w.off_s[i];
     for (int j = 0; j < ns; ++j) {
-      w.mask[om + 2 * nc + j] = (s.zl[j] != 0.0 || s.Zl[j] <= 0.0) ? 1.0 : 0.0;
-      w.mask[om + 2 * nc + ns + j] = (s.zu[j] != 0.0 || s.Zu[j] <= 0.0) ? 1.0 : 0.0;
+      const int k = s.idxs[j];
+      const bool live_l = w.mask[om + k] != 0.0, live_u = w.mask[om + nc + k] != 0.0;
+      w.slive[os + j] = live_l ? 1.0 : 0.0;
+      w.slive[os + ns + j] = live_u ? 1.0 : 0.0;
+      w.sfix[os + j] = live_l || s.Zl[j] <= 0.0 ? 0.0 : std::max(0.0, -s.zl[j] / s.Zl[j]);
+      w.sfix[os + ns + j] = live_u || s.Zu[j] <= 0.0 ? 0.0 : std::max(0.0, -s.zu[j] / s.Zu[j]);
+      w.mask[om + 2 * nc + j] = live_l && (s.zl[j] != 0.0 || s.Zl[j] <= 0.0) ? 1.0 : 0.0;
+      w.mask[om + 2 * nc + ns + j] = live_u && (s.zu[j] != 0.0 || s.Zu[j] <= 0.0) ? 1.0 : 0.0;
     }
   }
   w.m_total = static_cast<int>(w.mask.sum() + 0.5);
@@ -224,6 +236,8 @@ void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmS
       w.v.segment(ov, nu + nx).setZero();
       w.s.segment(os, 2 * ns).setZero();
     }
+    for (int j = 0; j < 2 * ns; ++j)
+      if (w.slive[os + j] == 0.0) w.s[os + j] = w.sfix[os + j];
     if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
     if (i < d.N) {
       if (dual)
@@ -257,6 +271,26 @@ void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmS
     }
     w.t[k] = std::max(w.t[k], thr);
     w.lam[k] = dual ? std::max(w.lam[k], thr) : settings_.init_mu / w.t[k];
+  }
+  if (dual) return;
+  // Cold multipliers of s ≥ 0 on the slack's stationarity Z s + z − λ_b − λ_s = 0 (linear, and
+  // the only equation λ_s enters): λ_s = max(μ0/t_s, Z s + z − λ_b). With the generic μ0/t_s ≪ z
+  // instead (z = 1.45e4 in SPEC §5.3), the first step must create λ_s ≈ z from nothing: it asks
+  // for Δs ≈ −z/W, only a tiny step fits, and Mehrotra's second-order term Δλ_aff∘Δt_aff ≈ −z²/W
+  // then drives s and t_s up by orders of magnitude. With Z = 0 nothing pulls them back and the
+  // solve ends in min_step (an ℓ2² weight Z > 0 had masked this).
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& st = qp.stage[i];
+    const int ns = d.ns[i], nc = w.nc[i], os = w.off_s[i], om = w.off_m[i];
+    for (int j = 0; j < ns; ++j) {
+      const int k = st.idxs[j];
+      const int ml = om + 2 * nc + j, mu = om + 2 * nc + ns + j;
+      if (w.mask[ml] != 0.0)
+        w.lam[ml] = std::max(w.lam[ml], st.Zl[j] * w.s[os + j] + st.zl[j] - w.lam[om + k]);
+      if (w.mask[mu] != 0.0)
+        w.lam[mu] =
+            std::max(w.lam[mu], st.Zu[j] * w.s[os + ns + j] + st.zu[j] - w.lam[om + nc + k]);
+    }
   }
 }
 
@@ -295,9 +329,11 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
     }
     for (int j = 0; j < ns; ++j) {
       const int k = st.idxs[j];
-      out_s[os + j] = st.Zl[j] * s[os + j] + z[os + j] - lam[om + k] - lam[om + 2 * nc + j];
-      out_s[os + ns + j] =
-          st.Zu[j] * s[os + ns + j] + z[os + ns + j] - lam[om + nc + k] - lam[om + 2 * nc + ns + j];
+      // A dead (decoupled) side sits at its closed-form optimum: no residual.
+      out_s[os + j] = w.slive[os + j] *
+                      (st.Zl[j] * s[os + j] + z[os + j] - lam[om + k] - lam[om + 2 * nc + j]);
+      out_s[os + ns + j] = w.slive[os + ns + j] * (st.Zu[j] * s[os + ns + j] + z[os + ns + j] -
+                                                   lam[om + nc + k] - lam[om + 2 * nc + ns + j]);
     }
     if (i < d.N) {
       const int nx1 = d.nx[i + 1], op = w.off_pi[i];
@@ -359,14 +395,20 @@ bool QpRiccatiIpm::factorize(const OcpQp& qp) {
     const int om = w.off_m[i], oc = w.off_c[i], os2 = w.off_s[i] / 2;
     // Effective constraint weights after eliminating the slacks.
     for (int k = 0; k < nc; ++k) w.wc[oc + k] = w.w[om + k] + w.w[om + nc + k];
+    const int os = w.off_s[i];
     for (int j = 0; j < ns; ++j) {
       const int k = st.idxs[j];
       const double wl = w.w[om + k], wu = w.w[om + nc + k];
-      const double pl = 1.0 / (st.Zl[j] + wl + w.w[om + 2 * nc + j]);
-      const double pu = 1.0 / (st.Zu[j] + wu + w.w[om + 2 * nc + ns + j]);
+      const double cl = st.Zl[j] + w.w[om + 2 * nc + j], cu = st.Zu[j] + w.w[om + 2 * nc + ns + j];
+      // Ψ⁻¹, 0 on a dead side (absent bound: W = 0 there and Δs = 0).
+      const double pl = w.slive[os + j] != 0.0 ? 1.0 / (cl + wl) : 0.0;
+      const double pu = w.slive[os + ns + j] != 0.0 ? 1.0 / (cu + wu) : 0.0;
       w.psi_l[os2 + j] = pl;
       w.psi_u[os2 + j] = pu;
-      w.wc[oc + k] -= wl * wl * pl + wu * wu * pu;
+      // W − W²/Ψ = W (Z + W_s)/Ψ without the cancellation: for an active pure-ℓ1 side (Z = 0,
+      // W → ∞, W_s → 0) the difference form loses every digit of the O(W_s) result.
+      // (A dead side's bound is absent, so its W is 0 and it contributes nothing.)
+      w.wc[oc + k] = wl * cl * pl + wu * cu * pu;
     }
     // H̃ = [R S; Sᵀ Q] + ∇dᵀ W̃ ∇d (lower triangle).
     Eigen::MatrixXd& L = w.L[i];
@@ -417,12 +459,20 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
     for (int k = 0; k < nc; ++k) w.gc[oc + k] = w.rho[om + k] - w.rho[om + nc + k];
     for (int j = 0; j < ns; ++j) {
       const int k = st.idxs[j];
-      const double al =
-          (-rs[os + j] - w.rho[om + k] - w.rho[om + 2 * nc + j]) * w.psi_l[os2 + j];
-      const double au =
-          (-rs[os + ns + j] - w.rho[om + nc + k] - w.rho[om + 2 * nc + ns + j]) *
-          w.psi_u[os2 + j];
-      w.gc[oc + k] += w.w[om + k] * al - w.w[om + nc + k] * au;
+      const double pl = w.psi_l[os2 + j], pu = w.psi_u[os2 + j];
+      if (pl == 0.0 && pu == 0.0) continue;  // both sides dead
+      // ρ_lb + W_lb Ψ_l⁻¹(−r_sl − ρ_lb − ρ_ls) = ρ_lb (Zl + W_ls) Ψ_l⁻¹ + W_lb Ψ_l⁻¹(−r_sl − ρ_ls)
+      // (no cancellation of the O(W) terms), likewise for the upper side.
+      const double wl = w.w[om + k], wu = w.w[om + nc + k];
+      const double gl = pl == 0.0 ? w.rho[om + k]
+                                  : (w.rho[om + k] * (st.Zl[j] + w.w[om + 2 * nc + j]) +
+                                     wl * (-rs[os + j] - w.rho[om + 2 * nc + j])) *
+                                        pl;
+      const double gu = pu == 0.0 ? w.rho[om + nc + k]
+                                  : (w.rho[om + nc + k] * (st.Zu[j] + w.w[om + 2 * nc + ns + j]) +
+                                     wu * (-rs[os + ns + j] - w.rho[om + 2 * nc + ns + j])) *
+                                        pu;
+      w.gc[oc + k] = gl - gu;
     }
     auto g = w.l.segment(ov, n);
     g = rv.segment(ov, n);
@@ -649,6 +699,10 @@ void QpRiccatiIpm::write_solution(const OcpQp& qp, OcpQpSolution& sol) {
     sol.su[i] = w.s.segment(os + ns, ns);
     sol.lam_sl[i] = w.lam.segment(om + 2 * nc, ns);
     sol.lam_su[i] = w.lam.segment(om + 2 * nc + ns, ns);
+    for (int j = 0; j < ns; ++j) {  // dead sides: λ_s from their stationarity Z s + z − λ_s = 0
+      if (w.slive[os + j] == 0.0) sol.lam_sl[i][j] = st.Zl[j] * sol.sl[i][j] + st.zl[j];
+      if (w.slive[os + ns + j] == 0.0) sol.lam_su[i][j] = st.Zu[j] * sol.su[i][j] + st.zu[j];
+    }
     auto tmp = w.tmp[i].head(std::max(nu, nx));
     if (nu > 0) {
       tmp.head(nu).noalias() = st.R * sol.u[i];

@@ -89,7 +89,10 @@ struct QpRiccatiIpmWorkspace {
   Eigen::VectorXd wc;           // per constraint: effective weight W̃ after slack elimination
   Eigen::VectorXd gc;           // per constraint: effective gradient term
   Eigen::VectorXd dd;           // per constraint: ∇d Δv (and d at the iterate)
-  Eigen::VectorXd psi_l, psi_u;  // per slack: Zl + W_lb + W_ls etc. (inverted)
+  Eigen::VectorXd psi_l, psi_u;  // per slack: Zl + W_lb + W_ls etc. (inverted; 0 if dead)
+  Eigen::VectorXd slive;        // per slack side (flat [s_l; s_u]): 1, or 0 when the side's
+                                // bound is absent (the slack is decoupled: "dead")
+  Eigen::VectorXd sfix;         // per slack side: a dead side's closed-form value max(0, −z/Z)
   Eigen::VectorXd l;            // per stage variable: L⁻¹(gradient) of the backward pass
   Eigen::VectorXd dt_aff, dlam_aff;
   int m_total = 0;  // number of present inequalities (for the mean complementarity)

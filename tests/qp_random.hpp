@@ -22,6 +22,8 @@ struct RandomQpSpec {
   double absent_side = 0.15;   // probability that one side of a bound is absent
   double gradient_scale = 5.0;
   bool all_bounds = false;     // every input bounded and min(nx, 4) states bounded on 1..N
+  bool pure_l1 = false;        // every soft constraint pure ℓ1 (Zl = Zu = 0), as in SPEC §5.3
+  double l1_scale = 1.0;       // ℓ1 weights drawn in l1_scale · [0.1, 2.1]
 };
 
 inline OcpQp random_qp(const RandomQpSpec& spec, unsigned seed) {
@@ -104,11 +106,11 @@ inline OcpQp random_qp(const RandomQpSpec& spec, unsigned seed) {
     for (int j = 0; j < d.ns[i]; ++j) {
       s.idxs[j] = soft[j];
       // Pure ℓ1, pure ℓ2² and mixed penalties.
-      const int kind = randint(0, 2);
+      const int kind = spec.pure_l1 ? (randint(0, 2), 0) : randint(0, 2);
       s.Zl[j] = kind == 0 ? 0.0 : 0.5 + 5.0 * U01(rng);
       s.Zu[j] = kind == 0 ? 0.0 : 0.5 + 5.0 * U01(rng);
-      s.zl[j] = kind == 1 ? 0.0 : 0.1 + 2.0 * U01(rng);
-      s.zu[j] = kind == 1 ? 0.0 : 0.1 + 2.0 * U01(rng);
+      s.zl[j] = kind == 1 ? 0.0 : spec.l1_scale * (0.1 + 2.0 * U01(rng));
+      s.zu[j] = kind == 1 ? 0.0 : spec.l1_scale * (0.1 + 2.0 * U01(rng));
     }
   }
   return qp;

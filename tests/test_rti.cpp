@@ -164,7 +164,8 @@ TEST(RtiSqp, SoftObstacleConstraintMatchesIpopt) {
     ocp.constraint = &constraint;
     ocp.lg = Eigen::VectorXd::Zero(1);
     ocp.ug = Eigen::VectorXd::Constant(1, 1e20);
-    ocp.soft_constraints = {SoftConstraint{0, 1.0, 1.0, 14.5e3, 14.2e3}};
+    // Pure exact ℓ1 penalty (Zl = Zu = 0) as SPEC §5.3 prescribes; the upper side is absent.
+    ocp.soft_constraints = {SoftConstraint{0, 0.0, 0.0, 14.5e3, 14.2e3}};
 
     RtiSolver rti;
     ASSERT_TRUE(rti.setup(ocp, converged_settings()));
