@@ -1,6 +1,7 @@
 #include "core/mode.hpp"
 
 #include "core/obstacles.hpp"
+#include "core/tracking.hpp"
 
 
 namespace mixpilot {
@@ -16,6 +17,7 @@ struct Entry {
 const std::vector<Entry>& modes() {
   static const std::vector<Entry> kModes = {
       {"obstacle_avoidance", &fly_obstacle_avoidance},
+      {"crazyflie_tracking", &fly_crazyflie_tracking},
   };
   return kModes;
 }

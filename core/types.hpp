@@ -104,4 +104,28 @@ inline constexpr double kGravity = 9.81;        // [m/s²], thrown balls
 inline constexpr double kViolationTolerance = 1e-3;  // a violation is ‖p − o‖ < d_C − 1 mm
 }  // namespace obstacle_defaults
 
+// Crazyflie tracking under delay, SPEC §5.2 (core/tracking.hpp).
+namespace tracking_defaults {
+inline constexpr int kHorizon = 50;                 // N
+inline constexpr double kDt = 0.015;                // [s]
+inline constexpr double kDuration = 8.0;            // [s]: the 6 s smooth step, then 2 s held
+inline constexpr bool kCompensation = true;         // ERK4 predictor over the RTT
+inline constexpr double kPlantRateHz = 1000.0;      // RK4 substeps per second of the plant
+inline constexpr double kRtt = 0.0;                 // round-trip time τ_r [s]
+inline constexpr double kMeasurementFraction = 0.5; // share of τ_r on the measurement side
+// Helix of SPEC §5.2 (b): R 0.3 m, z0 0.38 m, +0.002 m per 15 ms, 15 s. The angular rate is not
+// given (thesis §5.5.5): three turns in 15 s (0.38 m/s along the circle).
+inline constexpr double kHelixRadius = 0.3;                  // [m]
+inline constexpr double kHelixStartHeight = 0.38;            // [m]
+inline constexpr double kHelixClimbRate = 0.002 / 0.015;     // [m/s]
+inline constexpr double kHelixAngularRate = 1.2566370614359172;  // 2π/5 [rad/s]
+inline constexpr double kHelixLength = 15.0;                 // [s] (1000 intervals of 15 ms)
+// LQR baseline: R = 0.12·I4 (Q in TrackingLqr::q_diagonal()).
+inline constexpr double kLqrR = 0.12;
+// Settle time: ‖p − target‖ ≤ this for good [m].
+inline constexpr double kSettleRadius = 0.05;
+// A run is lost when the vehicle leaves this ball around its start [m].
+inline constexpr double kLostRadius = 100.0;
+}  // namespace tracking_defaults
+
 }  // namespace mixpilot
