@@ -7,6 +7,7 @@
 
 #include "core/crazyflie_tracking.hpp"
 #include "core/nlp_ipopt.hpp"
+#include "core/pendubot_swingup.hpp"
 #include "core/obstacles.hpp"
 #include "core/trajectory_io.hpp"
 
@@ -19,6 +20,9 @@ constexpr const char* kUsage =
     "  smooth-step   SPEC 5.2's smooth step of the Crazyflie: hover at (0,0,0.4) to (1,-1,1),\n"
     "                T = 6 s, N = 400, dt = 15 ms, the 5.2 weights, solved to convergence by\n"
     "                Ipopt from the hover guess\n"
+    "  pendubot-swingup  SPEC 5.1's swing-up reference: down-down to up-up, dt = 2 ms,\n"
+    "                N = 1250 (T = 2.5 s), |u| <= 0.36, |dq| <= (7, 4.5); Ipopt on a 20 ms grid\n"
+    "                first, then on 2 ms (scenarios/references/pendubot_swingup.csv; --N: T)\n"
     "  obstacles-p1  SPEC 5.3's obstacle-free reference: hover at (0,0,0.4) to p1 = (1,-1,1),\n"
     "                T = 3 s, N = 200, dt = 15 ms, the 5.3 weights, Ipopt from the hover guess\n"
     "                (scenarios/references/obstacles_to_1_-1_1.csv)\n"
@@ -29,6 +33,7 @@ constexpr const char* kUsage =
     "  --hessian NAME      fd-curvature (default), gauss-newton or limited-memory\n"
     "  --tol X             Ipopt tolerance (default 1e-10)\n"
     "  --max-iter N        iteration limit (default 1000)\n"
+    "  --N N               intervals of pendubot-swingup (default 1250, a multiple of 10)\n"
     "  --print-level N     Ipopt's log level, 0..12 (default 0: silent; 5: the usual log)\n"
     "  -h, --help          show this help\n";
 
@@ -129,11 +134,46 @@ int run_obstacle_reference(const Eigen::Vector3d& target, const std::string& out
   return 0;
 }
 
+// SPEC 5.1: the Pendubot swing-up reference the NMPC tracks (core/pendubot_swingup.hpp).
+int run_pendubot_swingup(const std::string& out, const IpoptOcpSettings& settings, int N) {
+  PendubotReferenceSettings s;
+  s.ipopt = settings;
+  if (N > 0) s.N = N;
+  std::printf("pendubot swing-up: down-down -> up-up, N = %d, dt = %.3f s, T = %.2f s, "
+              "|u| <= %.2f, |dq| <= (%.2f, %.2f)\n",
+              s.N, s.dt, s.N * s.dt, s.u_max, s.velocity_bound(0), s.velocity_bound(1));
+  const PendubotReferenceResult res = compute_pendubot_reference(s);
+  std::printf("ipopt, 20 ms grid: %s, %d iterations, %.2f s\n", to_string(res.coarse.status),
+              res.coarse.iterations, res.coarse.solve_seconds);
+  const IpoptOcpResult& r = res.ipopt;
+  std::printf("ipopt: %s (%s), %d iterations, %.2f s\n", to_string(r.status), r.message,
+              r.iterations, r.solve_seconds);
+  std::printf("objective %.12g, constraint violation %.2e, dual infeasibility %.2e, "
+              "dynamics residual %.2e\n",
+              r.objective, r.constraint_violation, r.dual_infeasibility, r.dynamics_residual);
+  std::printf("max |u| %.4f N·m, max |dq| (%.3f, %.3f) rad/s, final |x|inf %.2e\n",
+              res.max_abs_u, res.max_abs_velocity(0), res.max_abs_velocity(1), res.final_error);
+  if (r.status != IpoptOcpStatus::solved) {
+    std::fprintf(stderr, "mixpilot-reference: Ipopt did not converge; nothing written\n");
+    return 1;
+  }
+  if (!out.empty()) {
+    std::string error;
+    if (!write_trajectory_csv(out, res.trajectory, s.dt, error)) {
+      std::fprintf(stderr, "mixpilot-reference: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", out.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string command, out;
   IpoptOcpSettings settings;
+  int pendubot_n = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string_view arg = argv[a];
     const bool has_value = a + 1 < argc;
@@ -157,6 +197,9 @@ int main(int argc, char** argv) {
       if (!(settings.tolerance > 0.0)) return usage_error("--tol must be a positive number");
     } else if (arg == "--max-iter" && has_value) {
       settings.max_iterations = std::atoi(argv[++a]);
+    } else if (arg == "--N" && has_value) {
+      pendubot_n = std::atoi(argv[++a]);
+      if (pendubot_n < 1) return usage_error("--N must be a positive integer");
     } else if (arg == "--print-level" && has_value) {
       settings.print_level = std::atoi(argv[++a]);
     } else if (!arg.empty() && arg[0] != '-' && command.empty()) {
@@ -166,6 +209,7 @@ int main(int argc, char** argv) {
     }
   }
   if (command == "smooth-step") return run_smooth_step(out, settings);
+  if (command == "pendubot-swingup") return run_pendubot_swingup(out, settings, pendubot_n);
   if (command == "obstacles-p1") return run_obstacle_reference({1.0, -1.0, 1.0}, out, settings);
   if (command == "obstacles-p2") return run_obstacle_reference({0.5, -0.5, 1.0}, out, settings);
   if (command.empty()) return usage_error("missing command");

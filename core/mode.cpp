@@ -1,6 +1,7 @@
 #include "core/mode.hpp"
 
 #include "core/obstacles.hpp"
+#include "core/pendubot_swingup.hpp"
 #include "core/tracking.hpp"
 
 
@@ -16,6 +17,7 @@ struct Entry {
 // One line per mode (issue 6), e.g. {"pendubot_swingup", &fly_pendubot_swingup}.
 const std::vector<Entry>& modes() {
   static const std::vector<Entry> kModes = {
+      {"pendubot_swingup", &fly_pendubot_swingup},
       {"obstacle_avoidance", &fly_obstacle_avoidance},
       {"crazyflie_tracking", &fly_crazyflie_tracking},
   };

@@ -128,4 +128,31 @@ inline constexpr double kSettleRadius = 0.05;
 inline constexpr double kLostRadius = 100.0;
 }  // namespace tracking_defaults
 
+// Pendubot swing-up of SPEC §5.1 (core/pendubot_swingup.hpp).
+namespace pendubot_defaults {
+inline constexpr int kHorizon = 10;             // N
+inline constexpr double kDt = 0.002;            // [s]
+inline constexpr double kInputBound = 0.4;      // |u| ≤ 0.4 N·m
+inline constexpr double kVelocityBound1 = 7.8;  // |q̇1| ≤ 7.8 rad/s (soft)
+inline constexpr double kVelocityBound2 = 5.0;  // |q̇2| ≤ 5 rad/s (soft)
+inline constexpr double kSlackWeight = 40.0;    // ℓ2² slack weight ρ per bound side
+// Plant: RK4 substeps (0.25 ms) with the input held over the control interval.
+inline constexpr double kPlantRateHz = 4000.0;
+// Success: ‖wrap(q1, q2)‖ ≤ kAngleTolerance [rad] from some time on, to the end of the run.
+inline constexpr double kAngleTolerance = 0.05;
+// LQR hand-over (core/pendubot_swingup.hpp, "switch rule"): enter when ‖wrap(q)‖ ≤ kLqrEnter
+// and ‖q̇‖ ≤ kLqrEnterVelocity and |K x| ≤ u_max; leave when ‖wrap(q)‖ > kLqrExit.
+inline constexpr double kLqrEnter = 0.25;          // [rad]
+inline constexpr double kLqrEnterVelocity = 3.0;   // [rad/s]
+inline constexpr double kLqrExit = 0.6;            // [rad]
+// Encoders of the Quanser Pendubot (SPEC §5.1): counts per turn of q1 and q2.
+inline constexpr int kEncoderCounts1 = 8192;
+inline constexpr int kEncoderCounts2 = 4096;
+// First-order low-pass on the differenced velocities when quantization is on [Hz] (0: none).
+inline constexpr double kVelocityCutoffHz = 100.0;
+// Model-based α-β observer on the encoder angles (sensor.estimator = "observer").
+inline constexpr double kObserverAlpha = 0.2;
+inline constexpr double kObserverBeta = 0.02;
+}  // namespace pendubot_defaults
+
 }  // namespace mixpilot
