@@ -1,5 +1,6 @@
 #include "core/ocp_qp.hpp"
 
+#include <cmath>
 #include <limits>
 
 namespace mixpilot {
@@ -127,6 +128,50 @@ void OcpQpSolution::resize(const OcpQpDims& d) {
   status = QpStatus::invalid_data;
   iterations = 0;
   objective = res_stat = res_eq = res_ineq = res_comp = 0.0;
+}
+
+
+namespace {
+// Σ x·0 is 0 for finite data and NaN as soon as one entry is NaN or ±inf; a plain vectorized sum
+// (Eigen's allFinite costs several instructions per entry, and this scan runs every solve).
+bool finite(const Eigen::MatrixXd& m) { return (m.array() * 0.0).sum() == 0.0; }
+bool finite(const Eigen::VectorXd& m) { return (m.array() * 0.0).sum() == 0.0; }
+// Bounds: NaN is invalid; ±inf or |b| ≥ inf_bound means the side is absent.
+bool bound_ok(const Eigen::VectorXd& b) {
+  for (Eigen::Index k = 0; k < b.size(); ++k)
+    if (std::isnan(b[k])) return false;
+  return true;
+}
+}  // namespace
+
+bool ocp_qp_indices_valid(const OcpQp& qp) {
+  const OcpQpDims& d = qp.dims;
+  if (qp.stage.size() != static_cast<std::size_t>(d.N) + 1) return false;
+  for (int i = 0; i <= d.N; ++i) {
+    const OcpQpStage& s = qp.stage[i];
+    for (int k = 0; k < d.nbu[i]; ++k)
+      if (s.idxbu[k] < 0 || s.idxbu[k] >= d.nu[i]) return false;
+    for (int k = 0; k < d.nbx[i]; ++k)
+      if (s.idxbx[k] < 0 || s.idxbx[k] >= d.nx[i]) return false;
+    for (int j = 0; j < d.ns[i]; ++j)
+      if (s.idxs[j] < 0 || s.idxs[j] >= d.nc(i)) return false;
+  }
+  return true;
+}
+
+bool ocp_qp_data_finite(const OcpQp& qp) {
+  if (!finite(qp.x0)) return false;
+  for (int i = 0; i <= qp.dims.N; ++i) {
+    const OcpQpStage& s = qp.stage[i];
+    if (!(finite(s.A) && finite(s.B) && finite(s.b) && finite(s.Q) && finite(s.S) &&
+          finite(s.R) && finite(s.q) && finite(s.r) && finite(s.C) && finite(s.D) &&
+          finite(s.Zl) && finite(s.Zu) && finite(s.zl) && finite(s.zu)))
+      return false;
+    if (!(bound_ok(s.lbu) && bound_ok(s.ubu) && bound_ok(s.lbx) && bound_ok(s.ubx) &&
+          bound_ok(s.lg) && bound_ok(s.ug)))
+      return false;
+  }
+  return true;
 }
 
 }  // namespace mixpilot

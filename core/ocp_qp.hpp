@@ -93,6 +93,11 @@ struct OcpQp {
                    const std::vector<Eigen::VectorXd>& su) const;
 };
 
+// Validity checks shared by the solvers (qp's own dims): indices within the variables and
+// constraints they index; no NaN/Inf in the data (bounds may be ±inf: absent sides, not NaN).
+bool ocp_qp_indices_valid(const OcpQp& qp);
+bool ocp_qp_data_finite(const OcpQp& qp);
+
 enum class QpStatus {
   success,               // all residuals below their tolerances
   max_iterations,        // iteration limit reached; the last iterate is returned

@@ -30,22 +30,6 @@
 
 namespace mixpilot {
 
-namespace {
-
-// Σ x·0 is 0 for finite data and NaN as soon as one entry is NaN or ±inf; a plain vectorized sum
-// (Eigen's allFinite costs several instructions per entry, and this scan runs every solve).
-bool finite(const Eigen::MatrixXd& m) { return (m.array() * 0.0).sum() == 0.0; }
-bool finite(const Eigen::VectorXd& m) { return (m.array() * 0.0).sum() == 0.0; }
-
-// Bounds: NaN is invalid; ±inf or |b| ≥ inf_bound means the side is absent.
-bool bound_ok(const Eigen::VectorXd& b) {
-  for (Eigen::Index k = 0; k < b.size(); ++k)
-    if (std::isnan(b[k])) return false;
-  return true;
-}
-
-}  // namespace
-
 bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   settings_ = settings;
   ready_ = dims.valid();
@@ -112,21 +96,6 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   for (Eigen::VectorXd* p : {&w.lbnd, &w.ubnd, &w.wc, &w.gc, &w.dd}) *p = Eigen::VectorXd::Zero(oc);
   w.psi_l = Eigen::VectorXd::Zero(os / 2);
   w.psi_u = Eigen::VectorXd::Zero(os / 2);
-  return true;
-}
-
-bool QpRiccatiIpm::data_finite(const OcpQp& qp) const {
-  if (!finite(qp.x0)) return false;
-  for (int i = 0; i <= qp.dims.N; ++i) {
-    const OcpQpStage& s = qp.stage[i];
-    if (!(finite(s.A) && finite(s.B) && finite(s.b) && finite(s.Q) && finite(s.S) &&
-          finite(s.R) && finite(s.q) && finite(s.r) && finite(s.C) && finite(s.D) &&
-          finite(s.Zl) && finite(s.Zu) && finite(s.zl) && finite(s.zu)))
-      return false;
-    if (!(bound_ok(s.lbu) && bound_ok(s.ubu) && bound_ok(s.lbx) && bound_ok(s.ubx) &&
-          bound_ok(s.lg) && bound_ok(s.ug)))
-      return false;
-  }
   return true;
 }
 
@@ -605,16 +574,8 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       qp.dims.nbx != w.dims.nbx || qp.dims.nbu != w.dims.nbu || qp.dims.ng != w.dims.ng ||
       qp.dims.ns != w.dims.ns)
     return fail_invalid();
-  for (int i = 0; i <= w.dims.N; ++i) {
-    const OcpQpStage& s = qp.stage[i];
-    for (int k = 0; k < w.dims.nbu[i]; ++k)
-      if (s.idxbu[k] < 0 || s.idxbu[k] >= w.dims.nu[i]) return fail_invalid();
-    for (int k = 0; k < w.dims.nbx[i]; ++k)
-      if (s.idxbx[k] < 0 || s.idxbx[k] >= w.dims.nx[i]) return fail_invalid();
-    for (int j = 0; j < w.dims.ns[i]; ++j)
-      if (s.idxs[j] < 0 || s.idxs[j] >= w.nc[i]) return fail_invalid();
-  }
-  if (settings_.check_data && !data_finite(qp)) return fail_invalid();
+  if (!ocp_qp_indices_valid(qp)) return fail_invalid();
+  if (settings_.check_data && !ocp_qp_data_finite(qp)) return fail_invalid();
   load(qp);
   initialize(qp, sol, warm);
 

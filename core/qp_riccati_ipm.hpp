@@ -16,35 +16,10 @@
 #include <Eigen/Core>
 
 #include "core/ocp_qp.hpp"
+#include "core/qp_solver.hpp"
 #include "core/types.hpp"
 
 namespace mixpilot {
-
-struct QpRiccatiIpmSettings {
-  int max_iterations = qp_defaults::kMaxIterations;
-  double tol_stat = qp_defaults::kTolStationarity;
-  double tol_eq = qp_defaults::kTolEquality;
-  double tol_ineq = qp_defaults::kTolInequality;
-  double tol_comp = qp_defaults::kTolComplementarity;
-  double step_fraction = qp_defaults::kStepFraction;
-  double min_step = qp_defaults::kMinStep;
-  double init_slack = qp_defaults::kInitSlack;
-  double init_mu = qp_defaults::kInitMu;
-  double warm_start_floor = qp_defaults::kWarmStartFloor;
-  double psd_tol = qp_defaults::kPsdTol;
-  double inf_bound = qp_defaults::kInfBound;
-  // Iterative refinement of each iteration's final Newton direction: at most refinement_steps,
-  // while the linear-solve error (∞-norm) exceeds refine_ratio · min(tol_stat, tol_eq).
-  int refinement_steps = qp_defaults::kRefinementSteps;
-  double refine_ratio = qp_defaults::kRefineRatio;
-  bool check_data = true;  // scan the QP data for NaN/Inf before solving
-};
-
-enum class QpWarmStart {
-  cold,         // x = 0 (x_0 = x0), u = 0, slacks and multipliers from init_slack / init_mu
-  primal,       // x, u, s_l, s_u taken from the solution argument; multipliers cold
-  primal_dual,  // also π, λ taken from the solution argument (clipped to be interior)
-};
 
 // Per-stage and flat buffers of the solver; sized by QpRiccatiIpm::setup(). Flat vectors hold
 // all stages back to back at the offsets below.
@@ -98,7 +73,7 @@ struct QpRiccatiIpmWorkspace {
   int m_total = 0;  // number of present inequalities (for the mean complementarity)
 };
 
-class QpRiccatiIpm {
+class QpRiccatiIpm final : public QpSolver {
  public:
   using Settings = QpRiccatiIpmSettings;
   using Workspace = QpRiccatiIpmWorkspace;
@@ -110,19 +85,19 @@ class QpRiccatiIpm {
 
   // Sizes every buffer for dims. Returns false (and solve() then returns invalid_data) when the
   // dims are not valid().
-  bool setup(const OcpQpDims& dims, const Settings& settings = {});
+  bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
 
   // Solves qp (whose dims must equal the setup dims) into sol (sized with the same dims; read
   // as the warm start when requested). Never allocates, throws or prints. On any status other
   // than success, sol holds the last finite iterate (or zeros for invalid_data) and no NaN.
-  QpStatus solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm = QpWarmStart::cold);
+  QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
+                 QpWarmStart warm = QpWarmStart::cold) override;
 
-  Settings& settings() { return settings_; }
-  const Settings& settings() const { return settings_; }
-  const OcpQpDims& dims() const { return ws_.dims; }
+  Settings& settings() override { return settings_; }
+  const Settings& settings() const override { return settings_; }
+  const OcpQpDims& dims() const override { return ws_.dims; }
 
  private:
-  bool data_finite(const OcpQp& qp) const;
   void load(const OcpQp& qp);
   void initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm);
   void linear_residual(const OcpQp& qp, const Eigen::VectorXd& v, const Eigen::VectorXd& pi,

@@ -54,7 +54,7 @@ bool RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   if (!dims.valid()) return false;
   qp_.resize(dims);
   qp_sol_.resize(dims);
-  if (!qp_solver_.setup(dims, settings.qp)) return false;
+  if (!qp_solver().setup(dims, settings.qp)) return false;
 
   // Constant parts of the QP: index lists and slack weights.
   for (int i = 0; i <= N; ++i) {
@@ -213,6 +213,7 @@ RtiStatus RtiSolver::prepare() {
     linearize_cost(i);
     linearize_constraints(i);
   }
+  qp_solver().prepare(qp_);  // the x̄_0-free part of the QP solver's work (condensing)
   stats_.integration_us = std::chrono::duration<double, std::micro>(t1 - t0).count();
   stats_.linearization_us = micros_since(t1);
   stats_.linearization_finite = finite;
@@ -234,7 +235,7 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
     const QpWarmStart warm = settings_.qp_warm_start && have_qp_solution_
                                  ? QpWarmStart::primal_dual
                                  : QpWarmStart::cold;
-    stats_.qp_status = qp_solver_.solve(qp_, qp_sol_, warm);
+    stats_.qp_status = qp_solver().solve(qp_, qp_sol_, warm);
     stats_.qp_iterations = qp_sol_.iterations;
     if (stats_.qp_status == QpStatus::success) {
       for (int i = 0; i <= ocp_->N; ++i) traj_.x[i] += qp_sol_.x[i];

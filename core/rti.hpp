@@ -1,6 +1,7 @@
 #pragma once
-// Real-time iteration NMPC (SPEC §4, thesis Algorithm 1) on an Ocp, with the Riccati IPM as QP
-// solver. The QP is posed in the step (Δx, Δu) around the current trajectory (x̄, ū):
+// Real-time iteration NMPC (SPEC §4, thesis Algorithm 1) on an Ocp, with the Riccati IPM or
+// condensing + a dense IPM as QP solver (RtiSettings::qp_solver). The QP is posed in the step
+// (Δx, Δu) around the current trajectory (x̄, ū):
 //
 //   min Σ ½ [Δx;Δu]ᵀ [JxᵀWJx JxᵀWJu; JuᵀWJx JuᵀWJu] [Δx;Δu] + (JᵀW r)ᵀ[Δx;Δu]   (Gauss-Newton)
 //   s.t. Δx_0 = x̄_0 − x_0,  Δx_{i+1} = A_i Δx_i + B_i Δu_i + (F(x_i,u_i) − x_{i+1}),
@@ -25,7 +26,9 @@
 
 #include "core/ocp.hpp"
 #include "core/ocp_qp.hpp"
+#include "core/qp_condensed_dense.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "core/qp_solver.hpp"
 #include "core/types.hpp"
 
 namespace mixpilot {
@@ -34,6 +37,8 @@ struct RtiSettings {
   QpRiccatiIpmSettings qp{};
   // Primal-dual warm start of the QP from the previous (shifted) QP solution.
   bool qp_warm_start = rti_defaults::kQpWarmStart;
+  // QP solver variant; condensed_dense condenses the Hessian in prepare() (no x̄_0 needed).
+  QpSolverKind qp_solver = rti_defaults::kQpSolver;
 };
 
 enum class RtiStatus {
@@ -119,7 +124,13 @@ class RtiSolver {
   OcpTrajectory traj_;
   OcpQp qp_;
   OcpQpSolution qp_sol_;
-  QpRiccatiIpm qp_solver_;
+  QpSolver& qp_solver() {
+    return settings_.qp_solver == QpSolverKind::condensed_dense
+               ? static_cast<QpSolver&>(qp_dense_)
+               : static_cast<QpSolver&>(qp_riccati_);
+  }
+  QpRiccatiIpm qp_riccati_;    // set up when settings.qp_solver == riccati_ipm
+  QpCondensedDense qp_dense_;  // set up when settings.qp_solver == condensed_dense
   RtiWorkspace ws_;
   const SelectionOutput* selection_output_ = nullptr;    // fast Gauss-Newton path, or null
   const SelectionOutput* selection_terminal_ = nullptr;  // likewise for the terminal output

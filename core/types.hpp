@@ -61,6 +61,15 @@ namespace rti_defaults {
 inline constexpr bool kQpWarmStart = true;
 }  // namespace rti_defaults
 
+// OCP-QP solver variant of the RTI engine (core/qp_solver.hpp, SPEC §4).
+enum class QpSolverKind {
+  riccati_ipm,      // structure-exploiting Riccati IPM: O(N) per iteration, any horizon
+  condensed_dense,  // condensing + dense IPM: short horizons (≲ 10–20 stages, few inputs)
+};
+namespace rti_defaults {
+inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm;
+}  // namespace rti_defaults
+
 // PH index of SPEC §5.4 (Table 7.1).
 namespace ph_defaults {
 inline constexpr double kRadius = 0.175;  // r [m]

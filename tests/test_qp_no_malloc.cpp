@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdlib>
 
+#include "core/qp_condensed_dense.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "qp_random.hpp"
 
@@ -113,6 +114,40 @@ TEST(QpNoMalloc, SolveAllocatesNothing) {
   }
   EXPECT_EQ(cold, QpStatus::success);
   EXPECT_EQ(primal, QpStatus::success);
+  EXPECT_EQ(dual, QpStatus::success);
+  EXPECT_EQ(invalid, QpStatus::invalid_data);
+  EXPECT_EQ(failed, QpStatus::factorization_failed);
+}
+
+TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {
+  testing_qp::RandomQpSpec spec;
+  spec.N = 12;
+  spec.nx_min = 3;
+  spec.nx_max = 6;  // stage-varying dims
+  spec.nu = 2;
+  spec.ng_max = 2;
+  spec.soft_fraction = 0.4;
+  const OcpQp qp = testing_qp::random_qp(spec, 78);
+  OcpQp bad = qp;
+  bad.stage[3].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  OcpQp indefinite = qp;
+  for (auto& s : indefinite.stage) s.R *= -1.0;
+
+  QpCondensedDense solver(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  QpStatus cold, prepared, dual, invalid, failed;
+  {
+    NoMalloc guard;
+    cold = solver.solve(qp, sol);
+    solver.prepare(qp);
+    prepared = solver.solve(qp, sol, QpWarmStart::primal);
+    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
+    invalid = solver.solve(bad, sol);
+    failed = solver.solve(indefinite, sol);
+    EXPECT_EQ(NoMalloc::count(), 0);
+  }
+  EXPECT_EQ(cold, QpStatus::success);
+  EXPECT_EQ(prepared, QpStatus::success);
   EXPECT_EQ(dual, QpStatus::success);
   EXPECT_EQ(invalid, QpStatus::invalid_data);
   EXPECT_EQ(failed, QpStatus::factorization_failed);

@@ -6,6 +6,8 @@
 //   pendubot   nx 4, nu 1, N 10, input bound and two ℓ2²-soft velocity bounds (SPEC §5.1)
 // <problem> is cold-started; <problem>_warm solves the next sampling instant's QP (x0 = predicted
 // x_1 plus a 2 % disturbance) warm-started (primal-dual) from the shifted solution, as in RTI.
+// <problem>_dense: the same with QpCondensedDense (condensing + dense IPM, short horizons); its
+// Hessian condensing is part of every timed solve (in RTI it runs in prepare()).
 // Counter "iterations": IPM iterations per solve.
 //
 // MIXPILOT_DUMP_QP=<file> appends each QP solved here (once per benchmark) to <file> as one JSON
@@ -18,6 +20,7 @@
 #include <string>
 
 #include "core/ocp_qp_io.hpp"
+#include "core/qp_condensed_dense.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "tests/qp_problems.hpp"
 
@@ -49,9 +52,10 @@ void shift(OcpQpSolution& s) {
       sh(s.lam_su);
 }
 
+template <class Solver = QpRiccatiIpm>
 void run(benchmark::State& state, const std::string& name, const OcpQp& base, bool warm) {
   const QpRiccatiIpmSettings settings = bench_settings();
-  QpRiccatiIpm solver(base.dims, settings);
+  Solver solver(base.dims, settings);
   OcpQpSolution sol(base.dims), start(base.dims);
   OcpQp qp = base;
   if (warm) {
@@ -92,12 +96,20 @@ void cf_cold(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie", crazyflie(), 
 void cf_warm(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie_warm", crazyflie(), true); }
 void pb_cold(benchmark::State& s) { run(s, "BM_QpSolve/pendubot", pendubot(), false); }
 void pb_warm(benchmark::State& s) { run(s, "BM_QpSolve/pendubot_warm", pendubot(), true); }
+void pb_dense(benchmark::State& s) { run<QpCondensedDense>(s, "BM_QpSolve/pendubot_dense", pendubot(), false); }
+void pb_dense_warm(benchmark::State& s) {
+  run<QpCondensedDense>(s, "BM_QpSolve/pendubot_dense_warm", pendubot(), true);
+}
+void cf_dense(benchmark::State& s) { run<QpCondensedDense>(s, "BM_QpSolve/crazyflie_dense", crazyflie(), false); }
 BENCHMARK(mi_cold)->Name("BM_QpSolve/mi")->Unit(benchmark::kMicrosecond);
 BENCHMARK(mi_warm)->Name("BM_QpSolve/mi_warm")->Unit(benchmark::kMicrosecond);
 BENCHMARK(cf_cold)->Name("BM_QpSolve/crazyflie")->Unit(benchmark::kMicrosecond);
 BENCHMARK(cf_warm)->Name("BM_QpSolve/crazyflie_warm")->Unit(benchmark::kMicrosecond);
 BENCHMARK(pb_cold)->Name("BM_QpSolve/pendubot")->Unit(benchmark::kMicrosecond);
 BENCHMARK(pb_warm)->Name("BM_QpSolve/pendubot_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(pb_dense)->Name("BM_QpSolve/pendubot_dense")->Unit(benchmark::kMicrosecond);
+BENCHMARK(pb_dense_warm)->Name("BM_QpSolve/pendubot_dense_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(cf_dense)->Name("BM_QpSolve/crazyflie_dense")->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace mixpilot
