@@ -1,0 +1,248 @@
+// Mixed-initiative sessions on the shipped mi_helix scenario (issue 5, SPEC §5.4): the thesis's
+// behaviour with the emulated pilots, the safety constraints against a reckless pilot, plant
+// bounds, determinism, and record → replay → identical telemetry and score.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "core/pilot_emulated.hpp"
+#include "core/scenario_toml.hpp"
+#include "core/score.hpp"
+#include "core/session.hpp"
+#include "core/session_recording.hpp"
+
+namespace mixpilot {
+namespace {
+
+const Scenario& mi_helix() {
+  static const Scenario sc = [] {
+    std::string error;
+    auto s = load_scenario(MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml", error);
+    if (!s) ADD_FAILURE() << error;
+    return s ? *s : Scenario{};
+  }();
+  return sc;
+}
+
+// Extremes of the plant's rotor speeds and torques over a session.
+struct BoundsSink final : TelemetrySink {
+  double omega_min = 1e9, omega_max = -1e9, tau_min = 1e9, tau_max = -1e9;
+  void on_sample(const TelemetrySample& s) override {
+    omega_min = std::min(omega_min, s.x.tail<4>().minCoeff());
+    omega_max = std::max(omega_max, s.x.tail<4>().maxCoeff());
+    tau_min = std::min(tau_min, s.u.minCoeff());
+    tau_max = std::max(tau_max, s.u.maxCoeff());
+  }
+};
+
+std::unique_ptr<PilotSource> make_pilot(const Scenario& sc, const std::string& name) {
+  const models::MikroKopter model;
+  if (name == "reckless")
+    return std::make_unique<RecklessPilot>(model, sc.arena, sc.pilots.at("reckless").max_tilt);
+  auto p = std::make_unique<EmulatedPilot>();
+  PilotProfile profile = sc.pilots.at(name);
+  profile.name = name;
+  EXPECT_TRUE(p->setup(model, profile, sc.reference, sc.controller.dt));
+  return p;
+}
+
+struct Flight {
+  Score score;
+  BoundsSink bounds;
+  bool lost = false;
+};
+
+Flight fly(const Scenario& sc, const std::string& pilot_name) {
+  auto pilot = make_pilot(sc, pilot_name);
+  Session session;
+  std::string error;
+  EXPECT_TRUE(session.setup(sc, *pilot, error)) << error;
+  ScoreAccumulator acc(sc);
+  Flight f;
+  session.add_sink(&acc);
+  session.add_sink(&f.bounds);
+  session.run();
+  f.score = acc.finish();
+  f.lost = session.lost();
+  return f;
+}
+
+void expect_plant_bounds(const Flight& f) {
+  const models::MikroKopterParams p;
+  EXPECT_GE(f.bounds.omega_min, p.omega_min);
+  EXPECT_LE(f.bounds.omega_max, p.omega_max);
+  EXPECT_GE(f.bounds.tau_min, p.tau_min - 1e-9);  // QP tolerance on the input bounds
+  EXPECT_LE(f.bounds.tau_max, p.tau_max + 1e-9);
+}
+
+// Figs. 7.5–7.7: both pilots stay inside B (to 2 cm) and hit nothing; the experienced pilot
+// keeps authority (λ̄ ≥ 0.8), the novice loses it (λ̄ at least 0.15 lower) and scores lower.
+void expect_thesis_behaviour(const Scenario& sc) {
+  const double r = sc.controller.ph.r;
+  const Flight novice = fly(sc, "novice");
+  const Flight experienced = fly(sc, "experienced");
+  for (const Flight* f : {&novice, &experienced}) {
+    EXPECT_FALSE(f->lost);
+    EXPECT_LE(f->score.max_deviation_m, r + 0.02);
+    EXPECT_EQ(f->score.collisions, 0);
+    EXPECT_EQ(f->score.fallbacks, 0);
+    EXPECT_DOUBLE_EQ(f->score.progress, 1.0);
+    expect_plant_bounds(*f);
+  }
+  EXPECT_GE(experienced.score.mean_lambda, 0.8);
+  EXPECT_LE(novice.score.mean_lambda, experienced.score.mean_lambda - 0.15);
+  EXPECT_LT(novice.score.skill, experienced.score.skill);
+  std::printf("safety %s: novice lambda %.3f dev %.3f skill %.1f | experienced lambda %.3f "
+              "dev %.3f skill %.1f\n",
+              sc.controller.safety_constraints ? "on" : "off", novice.score.mean_lambda,
+              novice.score.max_deviation_m, novice.score.skill, experienced.score.mean_lambda,
+              experienced.score.max_deviation_m, experienced.score.skill);
+}
+
+TEST(MixedInitiative, ThesisBehaviourWithSafetyConstraints) {
+  ASSERT_TRUE(mi_helix().controller.safety_constraints);
+  expect_thesis_behaviour(mi_helix());
+}
+
+TEST(MixedInitiative, ThesisBehaviourInThePureFormulation) {
+  Scenario sc = mi_helix();
+  sc.controller.safety_constraints = false;
+  expect_thesis_behaviour(sc);
+}
+
+TEST(MixedInitiative, RecklessPilotHitsNothingAndStaysInTheArena) {
+  const Flight f = fly(mi_helix(), "reckless");
+  EXPECT_FALSE(f.lost);
+  EXPECT_EQ(f.score.collisions, 0);  // obstacles, walls and floor
+  EXPECT_GT(f.score.min_clearance_m, 0.0);
+  EXPECT_LT(f.score.mean_lambda, 0.3);  // the planner has the authority
+  expect_plant_bounds(f);
+  std::printf("reckless: lambda %.3f, min clearance %.3f m, max deviation %.3f m\n",
+              f.score.mean_lambda, f.score.min_clearance_m, f.score.max_deviation_m);
+}
+
+// The safety layer is what stops a pilot when the PH index alone does not: an extra obstacle
+// only 0.3 m from the reference (closer than mi_helix allows) is within the reckless pilot's
+// reach at λ_min. Without the constraints it is hit; with them the clearance holds to 1 mm.
+TEST(MixedInitiative, SafetyConstraintsStopARecklessPilotNearAnObstacle) {
+  Scenario sc = mi_helix();
+  const double a = 0.5236, t = 5.0;  // 30° along the helix, reached at t = 5 s
+  const double R = sc.reference.radius + 0.3 + 0.15;
+  sc.arena.obstacles.push_back(
+      {Eigen::Vector3d(R * std::cos(a), R * std::sin(a), sc.reference.position(t).z()), 0.15});
+  sc.controller.safety_constraints = false;
+  const Flight unsafe = fly(sc, "reckless");
+  sc.controller.safety_constraints = true;
+  const Flight safe = fly(sc, "reckless");
+  std::printf("near obstacle: min clearance %.4f m without, %.4f m with safety constraints\n",
+              unsafe.score.min_clearance_m, safe.score.min_clearance_m);
+  EXPECT_GE(unsafe.score.collisions, 1);
+  EXPECT_LT(unsafe.score.min_clearance_m, -0.05);
+  EXPECT_EQ(safe.score.collisions, 0);
+  EXPECT_GT(safe.score.min_clearance_m, -1e-3);
+  expect_plant_bounds(safe);
+}
+
+// Every sample of a session, for exact comparisons.
+struct TraceSink final : TelemetrySink {
+  std::vector<Eigen::VectorXd> x, u;
+  std::vector<double> lambda;
+  void on_sample(const TelemetrySample& s) override {
+    x.push_back(s.x);
+    u.push_back(s.u);
+    lambda.push_back(s.lambda);
+  }
+};
+
+Score without_timing(Score s) {
+  s.rti_median_us = s.rti_p99_us = 0;
+  s.deadline_misses = 0;
+  return s;
+}
+
+TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
+  Scenario sc = mi_helix();
+  sc.duration = 4.0;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "mixpilot_test_replay.mcap").string();
+
+  TraceSink original;
+  ScoreAccumulator original_score(sc);
+  {
+    auto pilot = make_pilot(sc, "novice");
+    Session session;
+    std::string error;
+    ASSERT_TRUE(session.setup(sc, *pilot, error)) << error;
+    RecordingSink recorder;
+    ASSERT_TRUE(recorder.open(path, sc, pilot->name(), error)) << error;
+    session.add_sink(&original);
+    session.add_sink(&original_score);
+    session.add_sink(&recorder);
+    session.run();
+    ASSERT_TRUE(recorder.close(error)) << error;
+  }
+
+  std::string error;
+  const auto rec = read_recording(path, error);
+  ASSERT_TRUE(rec) << error;
+  ASSERT_EQ(rec->pilot.size(), original.x.size());
+  EXPECT_EQ(rec->metadata.at("scenario"), sc.source_text);
+  EXPECT_EQ(rec->metadata.at("pilot"), "novice");
+
+  // A fresh session of the embedded scenario, driven by the recorded commands.
+  auto embedded = parse_scenario(rec->metadata.at("scenario"), "embedded", error);
+  ASSERT_TRUE(embedded) << error;
+  embedded->duration = sc.duration;
+  ReplayPilot replay(rec->pilot, "replay");
+  TraceSink replayed;
+  ScoreAccumulator replayed_score(*embedded);
+  Session session;
+  ASSERT_TRUE(session.setup(*embedded, replay, error)) << error;
+  session.add_sink(&replayed);
+  session.add_sink(&replayed_score);
+  session.run();
+
+  ASSERT_EQ(replayed.x.size(), original.x.size());
+  for (std::size_t k = 0; k < original.x.size(); ++k) {
+    ASSERT_EQ(replayed.x[k], original.x[k]) << "step " << k;  // bit for bit
+    ASSERT_EQ(replayed.u[k], original.u[k]) << "step " << k;
+    ASSERT_EQ(replayed.lambda[k], original.lambda[k]) << "step " << k;
+    ASSERT_EQ(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(rec->states[k].x.data(), 16)),
+              original.x[k]);
+  }
+  EXPECT_EQ(to_json(without_timing(replayed_score.finish())),
+            to_json(without_timing(original_score.finish())));
+  std::filesystem::remove(path);
+}
+
+TEST(Session, ReplayStopsAtTheEndOfTheRecording) {
+  const Scenario& sc = mi_helix();
+  std::vector<PilotCommandMsg> commands(10);
+  for (std::size_t k = 0; k < commands.size(); ++k) {
+    commands[k].step = k;
+    commands[k].rotor_speed.fill(models::MikroKopter{}.hover_speed());
+  }
+  ReplayPilot replay(commands, "replay");
+  Session session;
+  std::string error;
+  ASSERT_TRUE(session.setup(sc, replay, error)) << error;
+  session.run();
+  EXPECT_EQ(session.steps_done(), 10);
+  EXPECT_TRUE(session.finished());
+}
+
+TEST(Session, RejectsAPlantRateThatDoesNotDivideTheControlPeriod) {
+  Scenario sc = mi_helix();
+  sc.plant.rate_hz = 1234.0;
+  auto pilot = make_pilot(sc, "novice");
+  Session session;
+  std::string error;
+  EXPECT_FALSE(session.setup(sc, *pilot, error));
+  EXPECT_NE(error.find("rate_hz"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace mixpilot
