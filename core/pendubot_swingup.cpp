@@ -254,6 +254,10 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
   Eigen::Vector4d wn = oc.terminal_weights;
   if (c.vec("terminal_weights", wn, non_negative)) oc.terminal_weights = wn;
   const bool ref_given = c.string("reference", sc.reference_path, true);
+  std::string qp;
+  if (c.choice("qp_solver", qp, {"condensed_dense", "riccati_ipm"})) {
+    oc.qp_solver = qp == "riccati_ipm" ? QpSolverKind::riccati_ipm : QpSolverKind::condensed_dense;
+  }
   c.finish();
 
   Section l = s.sub("lqr");
@@ -375,7 +379,9 @@ PendubotRun simulate_pendubot_swingup(const PendubotScenario& sc, bool log) {
   const PendubotLqr lqr = pendubot_lqr(model, oc.dt, sc.lqr.q, sc.lqr.r);
 
   RtiSolver rti;
-  rti.setup(problem.ocp());
+  RtiSettings rti_settings;
+  rti_settings.qp_solver = oc.qp_solver;
+  rti.setup(problem.ocp(), rti_settings);
   // Warm start from the reference itself.
   for (int i = 0; i <= oc.N; ++i) rti.trajectory().x[i] = ref.x[std::min<std::size_t>(i, ref.x.size() - 1)];
   for (int i = 0; i < oc.N; ++i) {
