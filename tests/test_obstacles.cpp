@@ -81,7 +81,9 @@ TEST(Proposition1, SquaredHalfSpaceInsideLclHalfSpaceInsideClearanceSet) {
     ASSERT_NEAR(h2.offset(o), (r * r + d * d) / (2 * r), 1e-12 * (1 + 1 / r));
     ASSERT_GE(h2.offset(o), h1.offset(o) - 1e-12);
     min_gap = std::min(min_gap, h2.offset(o) - h1.offset(o));
-    if (trial % 10 == 0) ASSERT_NEAR(h2.offset(o), h1.offset(o), 1e-12);  // on the boundary
+    if (trial % 10 == 0) {
+      ASSERT_NEAR(h2.offset(o), h1.offset(o), 1e-12);  // on the boundary
+    }
 
     // By sampling: p ∈ H2 ⇒ p ∈ H1 ⇒ p ∈ S.
     for (int s = 0; s < 50; ++s, ++samples) {
@@ -91,7 +93,9 @@ TEST(Proposition1, SquaredHalfSpaceInsideLclHalfSpaceInsideClearanceSet) {
         ++in_h2;
         ASSERT_TRUE(a1) << "p in H2 but not in H1";
       }
-      if (a1) ASSERT_TRUE(in_s) << "p in H1 but not in S";
+      if (a1) {
+        ASSERT_TRUE(in_s) << "p in H1 but not in S";
+      }
       in_h1_only += a1 && !a2;
     }
   }
