@@ -91,6 +91,16 @@ bool RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   ws_.empty_Ju.resize(ocp.ny_terminal(), 0);
   selection_output_ = dynamic_cast<const SelectionOutput*>(ocp.output);
   selection_terminal_ = dynamic_cast<const SelectionOutput*>(ocp.terminal_output);
+  // Index of each selected output in z = (x, u).
+  const auto z_index = [nx](const SelectionOutput& sel) {
+    const Eigen::VectorXi& ix = sel.state_index();
+    const Eigen::VectorXi& iu = sel.input_index();
+    Eigen::VectorXi z(ix.size() + iu.size());
+    z << ix, iu.array() + nx;
+    return z;
+  };
+  if (selection_output_) z_index_ = z_index(*selection_output_);
+  if (selection_terminal_) terminal_z_index_ = z_index(*selection_terminal_);
 
   stats_ = RtiStats{};
   prepared_ = false;
@@ -112,13 +122,16 @@ void RtiSolver::linearize_cost(int i) {
   const Eigen::VectorXd& x = traj_.x[i];
 
   if (sel) {
-    // y selects components of z = (x, u): H[z_k, z_l] += W(k, l), grad[z_k] += (W r)_k.
-    const Eigen::VectorXi& ix = sel->state_index();
-    const Eigen::VectorXi& iu = sel->input_index();
-    const int nyx = int(ix.size());
+    // y selects components of z = (x, u): H[z_k, z_l] += W(k, l), grad[z_k] += (W r)_k, with
+    // z-indices precomputed in setup(); W is read column by column (its storage order).
+    const Eigen::VectorXi& zi = terminal ? terminal_z_index_ : z_index_;
     auto r = ws_.res.head(ny);
-    for (int k = 0; k < nyx; ++k) r(k) = x(ix(k)) - data_.yref[i](k);
-    for (int k = nyx; k < ny; ++k) r(k) = traj_.u[i](iu(k - nyx)) - data_.yref[i](k);
+    for (int k = 0; k < ny; ++k) {
+      const int z = zi(k);
+      r(k) = (z < nx ? x(z) : traj_.u[i](z - nx)) - data_.yref[i](k);
+    }
+    auto wr = ws_.y.head(ny);
+    wr.noalias() = W * r;
     s.Q.setZero();
     s.q.setZero();
     if (!terminal) {
@@ -126,22 +139,26 @@ void RtiSolver::linearize_cost(int i) {
       s.R.setZero();
       s.r.setZero();
     }
-    for (int k = 0; k < ny; ++k) {
-      const bool kx = k < nyx;
-      const int zk = kx ? ix(k) : iu(k - nyx);
-      double wr = 0.0;
-      for (int l = 0; l < ny; ++l) {
-        const double w = W(k, l);
-        wr += w * r(l);
+    for (int l = 0; l < ny; ++l) {
+      const int zl = zi(l);
+      const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
+      for (int k = 0; k < ny; ++k) {
+        const double w = col[k];
         if (w == 0.0) continue;
-        const bool lx = l < nyx;
-        const int zl = lx ? ix(l) : iu(l - nyx);
-        if (kx && lx) s.Q(zk, zl) += w;
-        else if (!kx && lx) s.S(zk, zl) += w;
-        else if (!kx && !lx) s.R(zk, zl) += w;
+        const int zk = zi(k);
+        if (zk < nx) {
+          if (zl < nx) s.Q(zk, zl) += w;
+        } else if (zl < nx) {
+          s.S(zk - nx, zl) += w;
+        } else {
+          s.R(zk - nx, zl - nx) += w;
+        }
       }
-      if (kx) s.q(zk) += wr;
-      else s.r(zk) += wr;
+    }
+    for (int k = 0; k < ny; ++k) {
+      const int z = zi(k);
+      if (z < nx) s.q(z) += wr(k);
+      else s.r(z - nx) += wr(k);
     }
     return;
   }

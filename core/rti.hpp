@@ -134,6 +134,8 @@ class RtiSolver {
   RtiWorkspace ws_;
   const SelectionOutput* selection_output_ = nullptr;    // fast Gauss-Newton path, or null
   const SelectionOutput* selection_terminal_ = nullptr;  // likewise for the terminal output
+  Eigen::VectorXi z_index_;           // ny: index in z = (x, u) of each selected output
+  Eigen::VectorXi terminal_z_index_;  // ny_N
   RtiStats stats_{};
   bool prepared_ = false;
   bool have_qp_solution_ = false;
