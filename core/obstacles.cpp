@@ -258,20 +258,9 @@ double percentile(std::vector<double> v, double q) {
 std::optional<ObstacleScenario> parse_obstacle_scenario(std::string_view text,
                                                         const std::string& source_name,
                                                         std::string& error) {
-  Diagnostics d(source_name);
-  toml::table root;
-  if (!parse_toml(text, source_name, d, root)) {
-    error = d.str();
-    return std::nullopt;
-  }
-  ObstacleScenario sc = read_obstacle_scenario(root, source_name, d);
-  if (!d.empty()) {
-    error = d.str();
-    return std::nullopt;
-  }
-  sc.source_path = source_name;
-  error.clear();
-  return sc;
+  return parse_document<ObstacleScenario>(text, source_name, error, [&](const toml::table& root, Diagnostics& d) {
+    return read_obstacle_scenario(root, source_name, d);
+  });
 }
 
 std::optional<ObstacleScenario> load_obstacle_scenario(const std::string& path,

@@ -328,20 +328,9 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
 std::optional<PendubotScenario> parse_pendubot_scenario(std::string_view text,
                                                         const std::string& source_name,
                                                         std::string& error) {
-  Diagnostics d(source_name);
-  toml::table root;
-  if (!parse_toml(text, source_name, d, root)) {
-    error = d.str();
-    return std::nullopt;
-  }
-  PendubotScenario sc = read_pendubot(root, source_name, d);
-  if (!d.empty()) {
-    error = d.str();
-    return std::nullopt;
-  }
-  sc.source_path = source_name;
-  error.clear();
-  return sc;
+  return parse_document<PendubotScenario>(text, source_name, error, [&](const toml::table& root, Diagnostics& d) {
+    return read_pendubot(root, source_name, d);
+  });
 }
 
 std::optional<PendubotScenario> load_pendubot_scenario(const std::string& path, std::string& error) {

@@ -221,20 +221,11 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
 
 std::optional<Scenario> parse_scenario(std::string_view text, const std::string& source_name,
                                        std::string& error) {
-  Diagnostics d(source_name);
-  toml::table root;
-  if (!parse_toml(text, source_name, d, root)) {
-    error = d.str();
-    return std::nullopt;
-  }
-  Scenario sc = read_scenario(root, d);
-  if (!d.empty()) {
-    error = d.str();
-    return std::nullopt;
-  }
-  sc.source_path = source_name;
-  sc.source_text = std::string(text);
-  error.clear();
+  auto sc = parse_document<Scenario>(text, source_name, error,
+                                    [](const toml::table& root, Diagnostics& d) {
+                                      return read_scenario(root, d);
+                                    });
+  if (sc) sc->source_text = std::string(text);
   return sc;
 }
 

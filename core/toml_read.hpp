@@ -12,6 +12,7 @@
 #include <initializer_list>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -363,6 +364,27 @@ inline bool parse_toml(std::string_view text, const std::string& source_name, Di
     return false;
   }
   return true;
+}
+
+// Parses `text` and reads it with read(root, diagnostics) into a scenario struct T; on any
+// diagnostic returns nullopt with all of them in `error`. Sets T::source_path.
+template <class T, class Read>
+std::optional<T> parse_document(std::string_view text, const std::string& source_name,
+                                std::string& error, Read read) {
+  Diagnostics d(source_name);
+  toml::table root;
+  if (!parse_toml(text, source_name, d, root)) {
+    error = d.str();
+    return std::nullopt;
+  }
+  T value = read(root, d);
+  if (!d.empty()) {
+    error = d.str();
+    return std::nullopt;
+  }
+  value.source_path = source_name;
+  error.clear();
+  return value;
 }
 
 }  // namespace mixpilot::toml_read

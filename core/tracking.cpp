@@ -159,20 +159,9 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
 std::optional<TrackingScenario> parse_tracking_scenario(std::string_view text,
                                                         const std::string& source_name,
                                                         std::string& error) {
-  Diagnostics d(source_name);
-  toml::table root;
-  if (!parse_toml(text, source_name, d, root)) {
-    error = d.str();
-    return std::nullopt;
-  }
-  TrackingScenario sc = read_tracking(root, source_name, d);
-  if (!d.empty()) {
-    error = d.str();
-    return std::nullopt;
-  }
-  sc.source_path = source_name;
-  error.clear();
-  return sc;
+  return parse_document<TrackingScenario>(text, source_name, error, [&](const toml::table& root, Diagnostics& d) {
+    return read_tracking(root, source_name, d);
+  });
 }
 
 std::optional<TrackingScenario> load_tracking_scenario(const std::string& path, std::string& error) {
