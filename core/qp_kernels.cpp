@@ -68,53 +68,52 @@ bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double p
   return true;
 }
 
-void trsv_ln(int n, const double* L, int ldl, const double* inv_diag, double* x) {
-  // Blocks of 4 columns: the 4 x 4 diagonal block by substitution, then the rows below updated
-  // with the block's 4 solved components (4-row AVX2 chunks, the last one masked).
+void trsv_ln(int n, const double* L, int ldl, const double* dinv, int lddinv, double* x) {
+  // Blocks of 4 columns: the block's components z = M_b x_b with the block's inverse (a 4 x 4
+  // matrix-vector product instead of a substitution chain), then the rows below updated with z
+  // (4-row AVX2 chunks, scalar tail).
   for (int jb = 0; jb < n; jb += 4) {
     const int bw = n - jb < 4 ? n - jb : 4;
-    if (bw == 4) {  // unrolled: the generic loop below costs more in loop control than flops
-      const double* l0 = L + jb + static_cast<ptrdiff_t>(jb) * ldl;
-      const double* l1 = l0 + ldl;
-      const double* l2 = l1 + ldl;
-      double* xb = x + jb;
-      const double z0 = xb[0] * inv_diag[jb];
-      const double z1 = (xb[1] - l0[1] * z0) * inv_diag[jb + 1];
-      const double z2 = (xb[2] - l0[2] * z0 - l1[2] * z1) * inv_diag[jb + 2];
-      const double z3 = (xb[3] - l0[3] * z0 - l1[3] * z1 - l2[3] * z2) * inv_diag[jb + 3];
-      xb[0] = z0, xb[1] = z1, xb[2] = z2, xb[3] = z3;
-    } else {
-      for (int c = 0; c < bw; ++c) {
-        const int j = jb + c;
-        const double* lj = L + static_cast<ptrdiff_t>(j) * ldl;
-        const double z = x[j] * inv_diag[j];
-        x[j] = z;
-        for (int r = j + 1; r < jb + bw; ++r) x[r] -= lj[r] * z;
-      }
-    }
-    if (jb + 4 >= n) break;
+    const double* M = dinv + jb;
 #if defined(__AVX2__) && defined(__FMA__)
-    const double* l0 = L + static_cast<ptrdiff_t>(jb) * ldl;
-    const __m256d z0 = _mm256_broadcast_sd(x + jb), z1 = _mm256_broadcast_sd(x + jb + 1),
-                  z2 = _mm256_broadcast_sd(x + jb + 2), z3 = _mm256_broadcast_sd(x + jb + 3);
-    int r = jb + 4;
-    for (; r + 4 <= n; r += 4) {
-      __m256d v = _mm256_loadu_pd(x + r);
-      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + r), z0, v);
-      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + ldl + r), z1, v);
-      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + 2 * ldl + r), z2, v);
-      v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + 3 * ldl + r), z3, v);
-      _mm256_storeu_pd(x + r, v);
-    }
-    for (; r < n; ++r)
-      x[r] -= l0[r] * x[jb] + l0[ldl + r] * x[jb + 1] + l0[2 * ldl + r] * x[jb + 2] +
-              l0[3 * ldl + r] * x[jb + 3];
-#else
-    for (int c = 0; c < 4; ++c) {
-      const double* lc = L + static_cast<ptrdiff_t>(jb + c) * ldl;
-      for (int r = jb + 4; r < n; ++r) x[r] -= lc[r] * x[jb + c];
+    if (bw == 4) {
+      const __m256d x0 = _mm256_broadcast_sd(x + jb), x1 = _mm256_broadcast_sd(x + jb + 1),
+                    x2 = _mm256_broadcast_sd(x + jb + 2), x3 = _mm256_broadcast_sd(x + jb + 3);
+      __m256d z = _mm256_mul_pd(_mm256_loadu_pd(M), x0);
+      __m256d z2 = _mm256_mul_pd(_mm256_loadu_pd(M + lddinv), x1);
+      z = _mm256_fmadd_pd(_mm256_loadu_pd(M + 2 * lddinv), x2, z);
+      z2 = _mm256_fmadd_pd(_mm256_loadu_pd(M + 3 * lddinv), x3, z2);
+      z = _mm256_add_pd(z, z2);
+      _mm256_storeu_pd(x + jb, z);
+      if (jb + 4 >= n) break;
+      const double* l0 = L + static_cast<ptrdiff_t>(jb) * ldl;
+      const __m256d z0 = _mm256_permute4x64_pd(z, 0x00), z1 = _mm256_permute4x64_pd(z, 0x55),
+                    zz2 = _mm256_permute4x64_pd(z, 0xAA), z3 = _mm256_permute4x64_pd(z, 0xFF);
+      int r = jb + 4;
+      for (; r + 4 <= n; r += 4) {
+        __m256d v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + r), z0, _mm256_loadu_pd(x + r));
+        __m256d w = _mm256_mul_pd(_mm256_loadu_pd(l0 + ldl + r), z1);
+        v = _mm256_fnmadd_pd(_mm256_loadu_pd(l0 + 2 * ldl + r), zz2, v);
+        w = _mm256_fmadd_pd(_mm256_loadu_pd(l0 + 3 * ldl + r), z3, w);
+        _mm256_storeu_pd(x + r, _mm256_sub_pd(v, w));
+      }
+      for (; r < n; ++r)
+        x[r] -= l0[r] * x[jb] + l0[ldl + r] * x[jb + 1] + l0[2 * ldl + r] * x[jb + 2] +
+                l0[3 * ldl + r] * x[jb + 3];
+      continue;
     }
 #endif
+    double z[4];
+    for (int r = 0; r < bw; ++r) {
+      double s = 0.0;
+      for (int c = 0; c <= r; ++c) s += M[r + static_cast<ptrdiff_t>(c) * lddinv] * x[jb + c];
+      z[r] = s;
+    }
+    for (int r = 0; r < bw; ++r) x[jb + r] = z[r];
+    for (int c = 0; c < bw; ++c) {
+      const double* lc = L + static_cast<ptrdiff_t>(jb + c) * ldl;
+      for (int r = jb + bw; r < n; ++r) x[r] -= lc[r] * z[c];
+    }
   }
 }
 
@@ -239,6 +238,46 @@ struct SyrkTile {
 
 }  // namespace
 
+namespace {
+// Inverse of L's bw x bw diagonal block at (jb, jb) into dinv (rows jb..jb+3, 4 columns, zero
+// above the diagonal and outside the block): M_ii = 1/L_ii, M_ij = −(Σ_{j≤k<i} L_ik M_kj)/L_ii.
+// A zero pivot (inv_diag 0) gives a zero row and column, as the substitution would.
+inline void diag_block_inverse(int jb, int bw, const double* C, int ldc, const double* inv_diag,
+                               double* dinv, int ldd) {
+  double* M = dinv + jb;
+  if (bw == 4) {  // unrolled: this runs once per block of every factorization
+    const double* l0 = C + jb + static_cast<ptrdiff_t>(jb) * ldc;
+    const double *l1 = l0 + ldc, *l2 = l1 + ldc;
+    const double i0 = inv_diag[jb], i1 = inv_diag[jb + 1], i2 = inv_diag[jb + 2],
+                 i3 = inv_diag[jb + 3];
+    const double m10 = -l0[1] * i0 * i1;
+    const double m21 = -l1[2] * i1 * i2;
+    const double m32 = -l2[3] * i2 * i3;
+    const double m20 = -(l0[2] * i0 + l1[2] * m10) * i2;
+    const double m31 = -(l1[3] * i1 + l2[3] * m21) * i3;
+    const double m30 = -(l0[3] * i0 + l1[3] * m10 + l2[3] * m20) * i3;
+    double* c0 = M;
+    double *c1 = c0 + ldd, *c2 = c1 + ldd, *c3 = c2 + ldd;
+    c0[0] = i0, c0[1] = m10, c0[2] = m20, c0[3] = m30;
+    c1[0] = 0.0, c1[1] = i1, c1[2] = m21, c1[3] = m31;
+    c2[0] = 0.0, c2[1] = 0.0, c2[2] = i2, c2[3] = m32;
+    c3[0] = 0.0, c3[1] = 0.0, c3[2] = 0.0, c3[3] = i3;
+    return;
+  }
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) M[r + static_cast<ptrdiff_t>(c) * ldd] = 0.0;
+  for (int c = 0; c < bw; ++c) {
+    M[c + static_cast<ptrdiff_t>(c) * ldd] = inv_diag[jb + c];
+    for (int r = c + 1; r < bw; ++r) {
+      double s = 0.0;
+      for (int k = c; k < r; ++k)
+        s += C[jb + r + static_cast<ptrdiff_t>(jb + k) * ldc] * M[k + static_cast<ptrdiff_t>(c) * ldd];
+      M[r + static_cast<ptrdiff_t>(c) * ldd] = -s * inv_diag[jb + r];
+    }
+  }
+}
+}  // namespace
+
 void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int ldl, double* Y,
                     int ldy) {
 #if defined(__AVX2__) && defined(__FMA__)
@@ -255,7 +294,7 @@ void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int
 }
 
 bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int ldc, int n_strict,
-                          double* inv_diag, double psd_tol) {
+                          double* inv_diag, double psd_tol, double* dinv, int lddinv) {
 #if defined(__AVX2__) && defined(__FMA__)
   const int np = pad4(n);
   double d0[4];
@@ -307,11 +346,15 @@ bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int
         _mm256_storeu_pd(cj + r, _mm256_mul_pd(v, vis));
       }
     }
+    diag_block_inverse(jb, bw, C, ldc, inv_diag, dinv, lddinv);
   }
   return true;
 #else
   syrk_ln(n, m, Y, ldy, C, ldc);
-  return potrf_l(n, n_strict, C, ldc, inv_diag, psd_tol);
+  if (!potrf_l(n, n_strict, C, ldc, inv_diag, psd_tol)) return false;
+  for (int jb = 0; jb < n; jb += 4)
+    diag_block_inverse(jb, n - jb >= 4 ? 4 : n - jb, C, ldc, inv_diag, dinv, lddinv);
+  return true;
 #endif
 }
 
@@ -322,36 +365,65 @@ inline __m256i tail_mask(int rem) {  // lanes < rem set (rem in 1..4)
   return _mm256_cmpgt_epi64(_mm256_set1_epi64x(rem), _mm256_setr_epi64x(0, 1, 2, 3));
 }
 
-// y(0:m) += A(0:m, 0:n) x with m ≤ 4·NB: NB independent accumulators (one per 4 rows), the last
-// chunk masked; columns split over two accumulator sets to halve the FMA dependency chains.
+// y(0:m) += A(0:m, 0:n) x with m ≤ 4·NB (NB ≤ 8): NB independent accumulators (one per 4 rows),
+// the last chunk masked; columns split over two accumulator sets to halve the FMA dependency
+// chains. The accumulators are named registers: held in an array, GCC 12 stores them back to the
+// stack after every column.
 template <int NB>
 inline void gemv_n_small(int m, int n, const double* A, int lda, const double* x, double* y) {
+  static_assert(NB >= 1 && NB <= 8);
   const int rem = m - 4 * (NB - 1);  // rows in the last chunk, 1..4
   const __m256i mask = tail_mask(rem);
-  __m256d acc[NB], acc2[NB];
-  for (int b = 0; b < NB; ++b) acc2[b] = _mm256_setzero_pd();
-  for (int b = 0; b < NB - 1; ++b) acc[b] = _mm256_loadu_pd(y + 4 * b);
-  acc[NB - 1] = _mm256_maskload_pd(y + 4 * (NB - 1), mask);
+  auto ld = [&](const double* p, int b) {
+    return b == NB - 1 ? _mm256_maskload_pd(p + 4 * b, mask) : _mm256_loadu_pd(p + 4 * b);
+  };
+  __m256d a0, a1, a2, a3, a4, a5, a6, a7;  // only the first NB are used
+  __m256d b0 = _mm256_setzero_pd(), b1 = b0, b2 = b0, b3 = b0, b4 = b0, b5 = b0, b6 = b0, b7 = b0;
+  a0 = ld(y, 0);
+  if constexpr (NB > 1) a1 = ld(y, 1);
+  if constexpr (NB > 2) a2 = ld(y, 2);
+  if constexpr (NB > 3) a3 = ld(y, 3);
+  if constexpr (NB > 4) a4 = ld(y, 4);
+  if constexpr (NB > 5) a5 = ld(y, 5);
+  if constexpr (NB > 6) a6 = ld(y, 6);
+  if constexpr (NB > 7) a7 = ld(y, 7);
+#define MIXPILOT_GEMV_COL(acc, col, xv)                                     \
+  do {                                                                      \
+    acc##0 = _mm256_fmadd_pd(ld(col, 0), xv, acc##0);                       \
+    if constexpr (NB > 1) acc##1 = _mm256_fmadd_pd(ld(col, 1), xv, acc##1); \
+    if constexpr (NB > 2) acc##2 = _mm256_fmadd_pd(ld(col, 2), xv, acc##2); \
+    if constexpr (NB > 3) acc##3 = _mm256_fmadd_pd(ld(col, 3), xv, acc##3); \
+    if constexpr (NB > 4) acc##4 = _mm256_fmadd_pd(ld(col, 4), xv, acc##4); \
+    if constexpr (NB > 5) acc##5 = _mm256_fmadd_pd(ld(col, 5), xv, acc##5); \
+    if constexpr (NB > 6) acc##6 = _mm256_fmadd_pd(ld(col, 6), xv, acc##6); \
+    if constexpr (NB > 7) acc##7 = _mm256_fmadd_pd(ld(col, 7), xv, acc##7); \
+  } while (0)
   int j = 0;
   for (; j + 2 <= n; j += 2) {
     const double* c0 = A + static_cast<ptrdiff_t>(j) * lda;
-    const double* c1 = c0 + lda;
     const __m256d x0 = _mm256_broadcast_sd(x + j), x1 = _mm256_broadcast_sd(x + j + 1);
-    for (int b = 0; b < NB - 1; ++b) {
-      acc[b] = _mm256_fmadd_pd(_mm256_loadu_pd(c0 + 4 * b), x0, acc[b]);
-      acc2[b] = _mm256_fmadd_pd(_mm256_loadu_pd(c1 + 4 * b), x1, acc2[b]);
-    }
-    acc[NB - 1] = _mm256_fmadd_pd(_mm256_maskload_pd(c0 + 4 * (NB - 1), mask), x0, acc[NB - 1]);
-    acc2[NB - 1] = _mm256_fmadd_pd(_mm256_maskload_pd(c1 + 4 * (NB - 1), mask), x1, acc2[NB - 1]);
+    MIXPILOT_GEMV_COL(a, c0, x0);
+    MIXPILOT_GEMV_COL(b, c0 + lda, x1);
   }
   if (j < n) {
-    const double* c0 = A + static_cast<ptrdiff_t>(j) * lda;
     const __m256d x0 = _mm256_broadcast_sd(x + j);
-    for (int b = 0; b < NB - 1; ++b) acc[b] = _mm256_fmadd_pd(_mm256_loadu_pd(c0 + 4 * b), x0, acc[b]);
-    acc[NB - 1] = _mm256_fmadd_pd(_mm256_maskload_pd(c0 + 4 * (NB - 1), mask), x0, acc[NB - 1]);
+    MIXPILOT_GEMV_COL(a, A + static_cast<ptrdiff_t>(j) * lda, x0);
   }
-  for (int b = 0; b < NB - 1; ++b) _mm256_storeu_pd(y + 4 * b, _mm256_add_pd(acc[b], acc2[b]));
-  _mm256_maskstore_pd(y + 4 * (NB - 1), mask, _mm256_add_pd(acc[NB - 1], acc2[NB - 1]));
+#undef MIXPILOT_GEMV_COL
+  auto st = [&](int b, __m256d v) {
+    if (b == NB - 1)
+      _mm256_maskstore_pd(y + 4 * b, mask, v);
+    else
+      _mm256_storeu_pd(y + 4 * b, v);
+  };
+  st(0, _mm256_add_pd(a0, b0));
+  if constexpr (NB > 1) st(1, _mm256_add_pd(a1, b1));
+  if constexpr (NB > 2) st(2, _mm256_add_pd(a2, b2));
+  if constexpr (NB > 3) st(3, _mm256_add_pd(a3, b3));
+  if constexpr (NB > 4) st(4, _mm256_add_pd(a4, b4));
+  if constexpr (NB > 5) st(5, _mm256_add_pd(a5, b5));
+  if constexpr (NB > 6) st(6, _mm256_add_pd(a6, b6));
+  if constexpr (NB > 7) st(7, _mm256_add_pd(a7, b7));
 }
 
 // Horizontal sums of four vectors: (Σa, Σb, Σc, Σd).

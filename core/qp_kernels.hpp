@@ -21,8 +21,9 @@ void syr_lower(int n, double alpha, const double* y, double* C, int ldc);
 // curvature at all — returns false.
 bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol);
 
-// x ← L⁻¹ x (zero pivots give zero components).
-void trsv_ln(int n, const double* L, int ldl, const double* inv_diag, double* x);
+// x ← L⁻¹ x (zero pivots give zero components), with dinv the inverses of L's 4 x 4 diagonal
+// blocks as syrk_potrf_ln_padded stores them.
+void trsv_ln(int n, const double* L, int ldl, const double* dinv, int lddinv, double* x);
 // x ← L⁻ᵀ x.
 void trsv_lt(int n, const double* L, int ldl, const double* inv_diag, double* x);
 
@@ -34,8 +35,11 @@ void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int
                     int ldy);
 // C += Y Yᵀ (Y n x m) and C = L Lᵀ in place, fused (left-looking, 4 columns at a time), with
 // potrf_l's pivot rules; keeps C's strict upper triangle zero.
+// Also stores the inverse of each 4 x 4 diagonal block of L (rows jb..jb+3 of the 4 columns of
+// dinv, zero above the diagonal; ld ≥ pad4(n)) for trsv_ln: its substitution chains become
+// matrix-vector products.
 bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int ldc, int n_strict,
-                          double* inv_diag, double psd_tol);
+                          double* inv_diag, double psd_tol, double* dinv, int lddinv);
 // y (m) += A x (A m x n);  y (n) += Aᵀ x (A m x n). Exact row counts, no padding needed.
 void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
 void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y);

@@ -54,6 +54,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   w.Hbase.assign(n1, {});
   w.Hfull.assign(n1, {});
   w.inv_diag.assign(n1, {});
+  w.Dinv.assign(n1, {});
   w.tmp.assign(n1, {});
   int ov = 0, op = 0, os = 0, om = 0, oc = 0;
   for (int i = 0; i <= N; ++i) {
@@ -82,6 +83,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     w.Hbase[i] = Eigen::MatrixXd::Zero(np, nv);
     w.Hfull[i] = Eigen::MatrixXd::Zero(nv, nv);
     w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
+    w.Dinv[i] = Eigen::MatrixXd::Zero(std::max(np, 4), 4);
     w.tmp[i] = Eigen::VectorXd::Zero(std::max({nv, nx1, nc, 1}));
   }
   for (Eigen::VectorXd* p : {&w.v, &w.dv, &w.res_v, &w.l, &w.gflat, &w.err_v, &w.cv})
@@ -404,7 +406,8 @@ bool QpRiccatiIpm::factorize(const OcpQp& qp) {
                               w.Y[i].data(), static_cast<int>(w.Y[i].rows()));
     }
     if (!kernels::syrk_potrf_ln_padded(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()),
-                                       L.data(), ld, nu, w.inv_diag[i].data(), settings_.psd_tol))
+                                       L.data(), ld, nu, w.inv_diag[i].data(), settings_.psd_tol,
+                                       w.Dinv[i].data(), static_cast<int>(w.Dinv[i].rows())))
       return false;
   }
   return true;
@@ -458,8 +461,8 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
                       rpi.data() + w.off_pi[i], y.data());
       kernels::gemv_n(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()), y.data(), g.data());
     }
-    kernels::trsv_ln(nf, w.L[i].data(), static_cast<int>(w.L[i].rows()), w.inv_diag[i].data(),
-                     g.data());
+    kernels::trsv_ln(nf, w.L[i].data(), static_cast<int>(w.L[i].rows()), w.Dinv[i].data(),
+                     static_cast<int>(w.Dinv[i].rows()), g.data());
   }
   // Forward pass.
   for (int i = 0; i <= d.N; ++i) {

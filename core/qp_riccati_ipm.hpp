@@ -46,6 +46,8 @@ struct QpRiccatiIpmWorkspace {
                                             // block only)
   std::vector<Eigen::MatrixXd> Y;           // np x nx_{i+1}: BAt · Lx_{i+1}
   std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L), 0 for zero pivots
+  std::vector<Eigen::MatrixXd> Dinv;        // max(np, 4) x 4: inverses of L's 4 x 4 diagonal
+                                            // blocks (rows jb..jb+3 for block jb)
   std::vector<Eigen::VectorXd> tmp;         // max(nx_{i+1}, nc): scratch per stage
 
   // Iterate and direction (flat).
