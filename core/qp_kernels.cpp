@@ -35,14 +35,6 @@ void syrk_ln(int n, int m, const double* Y, int ldy, double* C, int ldc) {
   }
 }
 
-void syr_lower(int n, double alpha, const double* y, double* C, int ldc) {
-  for (int j = 0; j < n; ++j) {
-    double* c = C + static_cast<ptrdiff_t>(j) * ldc;
-    const double a = alpha * y[j];
-    for (int r = j; r < n; ++r) c[r] += a * y[r];
-  }
-}
-
 bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol) {
   for (int j = 0; j < n; ++j) {
     double* cj = C + static_cast<ptrdiff_t>(j) * ldc;

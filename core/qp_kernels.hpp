@@ -10,9 +10,6 @@ void trmm_rl(int n, int m, const double* A, int lda, const double* L, int ldl, d
 // C (n x n, lower triangle) += Y Yᵀ, Y n x m.
 void syrk_ln(int n, int m, const double* Y, int ldy, double* C, int ldc);
 
-// C (n x n, lower triangle) += alpha · y yᵀ.
-void syr_lower(int n, double alpha, const double* y, double* C, int ldc);
-
 // In-place lower Cholesky C = L Lᵀ (IPM blocks are ill-conditioned by design, so pivots are not
 // compared with a relative threshold). A pivot p ≤ 0 with p ≥ −psd_tol·|C_jj| zeroes the column
 // (inv_diag = 0, a pseudo-factor) when the column is a state column (j ≥ n_strict: a positive

@@ -79,7 +79,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     w.BAt[i] = Eigen::MatrixXd::Zero(np, nx1);
     w.DCt[i] = Eigen::MatrixXd::Zero(nv, dims.ng[i]);
     w.L[i] = Eigen::MatrixXd::Zero(np, nv);
-    w.Y[i] = Eigen::MatrixXd::Zero(np, nx1);
+    w.Y[i] = Eigen::MatrixXd::Zero(np, nx1 + dims.ng[i]);
     w.Hbase[i] = Eigen::MatrixXd::Zero(np, nv);
     w.Hfull[i] = Eigen::MatrixXd::Zero(nv, nv);
     w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
@@ -390,22 +390,21 @@ bool QpRiccatiIpm::factorize(const OcpQp& qp) {
       const int p = w.var_of_box[i][k];
       if (p < nf) L(p, p) += w.wc[oc + k];
     }
-    for (int k = 0; k < ng; ++k) {
-      const double wk = w.wc[oc + nb + k];
-      if (wk != 0.0) kernels::syr_lower(nf, wk, w.DCt[i].col(k).data(), L.data(), ld);
-    }
-    // Y = BAt · Lx_{i+1};  L L ᵀ = H̃ + Y Yᵀ.
-    int nx1 = 0;
+    // Y = [BAt · Lx_{i+1}, ∇gᵀ W̃_g^½];  L Lᵀ = H + (box terms) + Y Yᵀ: the general
+    // constraints' ∇gᵀ W̃ ∇g joins the one register-blocked rank-(nx+ng) update.
+    const int nx1 = i < d.N ? d.nx[i + 1] : 0;
+    Eigen::MatrixXd& Y = w.Y[i];
+    for (int k = 0; k < ng; ++k)
+      Y.col(nx1 + k).head(nf) = std::sqrt(w.wc[oc + nb + k]) * w.DCt[i].col(k).head(nf);
     if (i < d.N) {
-      nx1 = d.nx[i + 1];
       const int nu1 = d.nu[i + 1];
       const Eigen::MatrixXd& L1 = w.L[i + 1];
       const int ld1 = static_cast<int>(L1.rows());
       kernels::trmm_rl_padded(nf, nx1, w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
                               L1.data() + nu1 + static_cast<std::ptrdiff_t>(nu1) * ld1, ld1,
-                              w.Y[i].data(), static_cast<int>(w.Y[i].rows()));
+                              Y.data(), static_cast<int>(Y.rows()));
     }
-    if (!kernels::syrk_potrf_ln_padded(nf, nx1, w.Y[i].data(), static_cast<int>(w.Y[i].rows()),
+    if (!kernels::syrk_potrf_ln_padded(nf, nx1 + ng, Y.data(), static_cast<int>(Y.rows()),
                                        L.data(), ld, nu, w.inv_diag[i].data(), settings_.psd_tol,
                                        w.Dinv[i].data(), static_cast<int>(w.Dinv[i].rows())))
       return false;

@@ -44,7 +44,7 @@ struct QpRiccatiIpmWorkspace {
   std::vector<Eigen::MatrixXd> L;           // np x (nu+nx): H̃ + Y Yᵀ, then its lower Cholesky
                                             // factor, strict upper triangle zero (stage 0: uu
                                             // block only)
-  std::vector<Eigen::MatrixXd> Y;           // np x nx_{i+1}: BAt · Lx_{i+1}
+  std::vector<Eigen::MatrixXd> Y;           // np x (nx_{i+1} + ng): [BAt · Lx_{i+1}, ∇gᵀ W̃^½]
   std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L), 0 for zero pivots
   std::vector<Eigen::MatrixXd> Dinv;        // max(np, 4) x 4: inverses of L's 4 x 4 diagonal
                                             // blocks (rows jb..jb+3 for block jb)
