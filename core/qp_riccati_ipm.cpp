@@ -296,7 +296,7 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
     if (ng > 0) {
       auto tmp = w.tmp[i].head(ng);
       tmp = lam.segment(om + nc + nb, ng) - lam.segment(om + nb, ng);
-      out_v.segment(ov, nu + nx).noalias() += w.DCt[i] * tmp;
+      kernels::gemv_n(nv, ng, w.DCt[i].data(), nv, tmp.data(), out_v.data() + ov);
     }
     for (int j = 0; j < ns; ++j) {
       const int k = st.idxs[j];
@@ -448,7 +448,7 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
     auto g = w.l.segment(ov, n);
     g = rv.segment(ov, n);
     for (int k = 0; k < nb; ++k) g[w.var_of_box[i][k]] += w.gc[oc + k];
-    if (ng > 0) g.noalias() += w.DCt[i] * w.gc.segment(oc + nb, ng);
+    if (ng > 0) kernels::gemv_n(n, ng, w.DCt[i].data(), n, w.gc.data() + oc + nb, g.data());
     if (i < d.N) {
       const int nx1 = d.nx[i + 1], nu1 = d.nu[i + 1];
       const Eigen::MatrixXd& L1 = w.L[i + 1];
