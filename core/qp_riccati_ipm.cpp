@@ -95,6 +95,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   for (Eigen::VectorXd* p : {&w.t, &w.dt, &w.lam, &w.dlam, &w.res_t, &w.mask, &w.w, &w.rc,
                              &w.rho, &w.dt_aff, &w.dlam_aff, &w.ct, &w.clam, &w.zero_m})
     *p = Eigen::VectorXd::Zero(om);
+  w.inv_t = Eigen::VectorXd::Zero(om);
   for (Eigen::VectorXd* p : {&w.lbnd, &w.ubnd, &w.wc, &w.gc, &w.dd}) *p = Eigen::VectorXd::Zero(oc);
   w.psi_l = Eigen::VectorXd::Zero(os / 2);
   w.psi_u = Eigen::VectorXd::Zero(os / 2);
@@ -358,7 +359,9 @@ double QpRiccatiIpm::stationarity_norm(const Eigen::VectorXd& rv, const Eigen::V
 bool QpRiccatiIpm::factorize(const OcpQp& qp) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
-  w.w = w.mask.cwiseProduct(w.lam).cwiseQuotient(w.t);
+  // 1/t once per iteration: the directions below then multiply instead of divide.
+  w.inv_t = w.mask.cwiseQuotient(w.t);
+  w.w = w.lam.cwiseProduct(w.inv_t);
   for (int i = d.N; i >= 0; --i) {
     const OcpQpStage& st = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
@@ -419,7 +422,7 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
                                    Eigen::VectorXd& dt, Eigen::VectorXd& dlam, bool with_pi) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
-  w.rho = w.mask.cwiseProduct(rc + w.lam.cwiseProduct(rt)).cwiseQuotient(w.t);
+  w.rho = (rc + w.lam.cwiseProduct(rt)).cwiseProduct(w.inv_t);
   // Reduced gradients g̃ and the backward pass l_i = L_i⁻¹(g̃_i + Y_i y).
   for (int i = d.N; i >= 0; --i) {
     const OcpQpStage& st = qp.stage[i];
@@ -522,7 +525,7 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
     }
   }
   dt = dt.cwiseProduct(w.mask);
-  dlam = -w.mask.cwiseProduct(rc + w.lam.cwiseProduct(dt)).cwiseQuotient(w.t);
+  dlam = -(rc + w.lam.cwiseProduct(dt)).cwiseProduct(w.inv_t);
 }
 
 void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine) {

@@ -61,6 +61,7 @@ struct QpRiccatiIpmWorkspace {
   Eigen::VectorXd lbnd, ubnd;   // per constraint (flat nc): bound values, 0 where absent
   Eigen::VectorXd mask;         // per inequality (flat m): 1 present, 0 absent
   Eigen::VectorXd w;            // per inequality: λ/t (0 where absent)
+  Eigen::VectorXd inv_t;        // per inequality: 1/t (0 where absent), set by factorize()
   Eigen::VectorXd rc;           // per inequality: complementarity right-hand side
   Eigen::VectorXd rho;          // per inequality: r_c/t + W r_t
   Eigen::VectorXd wc;           // per constraint: effective weight W̃ after slack elimination
