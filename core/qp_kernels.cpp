@@ -494,4 +494,24 @@ void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y) 
 #endif
 }
 
+void trsv_lt_small(int n, const double* dinv, int lddinv, double* x) {
+#if defined(__AVX2__) && defined(__FMA__)
+  // z_j = Σ_r M_rj x_r: four independent dot products of length 4 (M is zero outside n x n).
+  const __m256i mask = tail_mask(n);
+  const __m256d xv = _mm256_maskload_pd(x, mask);
+  const __m256d z = hsum4(_mm256_mul_pd(_mm256_loadu_pd(dinv), xv),
+                          _mm256_mul_pd(_mm256_loadu_pd(dinv + lddinv), xv),
+                          _mm256_mul_pd(_mm256_loadu_pd(dinv + 2 * lddinv), xv),
+                          _mm256_mul_pd(_mm256_loadu_pd(dinv + 3 * lddinv), xv));
+  _mm256_maskstore_pd(x, mask, z);
+#else
+  double z[4];
+  for (int j = 0; j < n; ++j) {
+    z[j] = 0.0;
+    for (int r = j; r < n; ++r) z[j] += dinv[r + static_cast<ptrdiff_t>(j) * lddinv] * x[r];
+  }
+  for (int j = 0; j < n; ++j) x[j] = z[j];
+#endif
+}
+
 }  // namespace mixpilot::kernels

@@ -478,7 +478,12 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
       du = w.l.segment(ov, nu);
       if (i > 0)
         kernels::gemv_t(nx, nu, L.data() + nu, static_cast<int>(L.rows()), dx.data(), du.data());
-      kernels::trsv_lt(nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(), du.data());
+      if (nu <= 4)  // the forward pass is a chain through the stages: no substitution chain
+        kernels::trsv_lt_small(nu, w.Dinv[i].data(), static_cast<int>(w.Dinv[i].rows()),
+                               du.data());
+      else
+        kernels::trsv_lt(nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(),
+                         du.data());
       du = -du;
     }
     if (i < d.N) {
