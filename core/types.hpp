@@ -14,8 +14,13 @@ inline constexpr double kTolStationarity = 1e-6;
 inline constexpr double kTolEquality = 1e-8;
 inline constexpr double kTolInequality = 1e-8;
 inline constexpr double kTolComplementarity = 1e-8;
-// Fraction-to-boundary factor: the step keeps t, λ > 0 by stopping at this fraction of the way.
+// Fraction-to-boundary factor: the step keeps t, λ > 0 by stopping at least at this fraction
+// of the way (the Riccati IPM may go further, see kStepCentrality).
 inline constexpr double kStepFraction = 0.995;
+// Mehrotra's step-length heuristic (γ_f): the blocking t or λ of a step may go as far as
+// kStepCentrality times the mean complementarity after the step (divided by its partner), but
+// not less far than kStepFraction of the way to the boundary.
+inline constexpr double kStepCentrality = 0.01;
 // The solve stops with min_step when the step length falls below this.
 inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
