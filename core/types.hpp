@@ -40,6 +40,10 @@ inline constexpr double kRefineRatio = 0.1;
 // ... and only while μ < kRefineMuRatio · tol_comp: W = λ/t ≈ λ²/μ is only then large enough for
 // the rounding it amplifies to matter.
 inline constexpr double kRefineMuRatio = 1e3;
+// ... and only while ε‖W‖∞‖Δv‖∞ · kRefineBoundSafety (an a-priori bound on the error, measured
+// 1–3 orders of magnitude above the actual one on the test and controller QPs) exceeds the
+// target; otherwise the error is not even measured.
+inline constexpr double kRefineBoundSafety = 10.0;
 // A bound whose magnitude is ≥ kInfBound is absent (one-sided constraints).
 inline constexpr double kInfBound = 1e20;
 }  // namespace qp_defaults
