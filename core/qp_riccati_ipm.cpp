@@ -584,16 +584,18 @@ double max_step_index(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, doubl
 // shorter than the fixed rule η α_max. Far from the solution this keeps t_p λ_p near γ_f times the
 // mean, like the fixed fraction; near it μ⁺ → 0 and α → α_max: the fixed rule's (1 − η) leftover,
 // which limits the decrease of μ to 1/(1 − η) = 200× per iteration, disappears (fast local
-// convergence needs η_k → 1).
-double step_length(const QpRiccatiIpmWorkspace& w, double eta) {
+// convergence needs η_k → 1). μ⁺ is floored at the tolerance tol_comp: a complementarity below
+// it is of no use, and pushing t_p far below it while stationarity still has to converge makes
+// W = λ/t overflow the solve's accuracy (seen in SQP on an exact-penalty obstacle constraint).
+double step_length(const QpRiccatiIpmWorkspace& w, double eta, double tol_comp) {
   if (w.m_total == 0) return 1.0;  // no inequalities: Δt = Δλ = 0
   constexpr double kBeyond = 1e3;  // α_max is searched up to here (beyond the full step)
   Eigen::Index pt, pl;
   const double at = max_step_index(w.t, w.dt, kBeyond, pt);
   const double al = max_step_index(w.lam, w.dlam, kBeyond, pl);
   const double abar = std::min({1.0, at, al});
-  const double mu_plus =
-      (w.lam + abar * w.dlam).dot(w.t + abar * w.dt) / static_cast<double>(w.m_total);
+  const double mu_plus = std::max(
+      tol_comp, (w.lam + abar * w.dlam).dot(w.t + abar * w.dt) / static_cast<double>(w.m_total));
   const double gf = qp_defaults::kStepCentrality;
   double a_t = std::min(1.0, at), a_l = std::min(1.0, al);
   // std::max keeps η α_max when the target is not finite (0/0 at a degenerate pair).
@@ -666,9 +668,14 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
           (w.lam + a_aff * w.dlam).dot(w.t + a_aff * w.dt) / static_cast<double>(w.m_total);
       const double ratio = mu_ > 0.0 ? mu_aff / mu_ : 0.0;
       const double sigma = std::clamp(ratio * ratio * ratio, 0.0, 1.0);
-      // Corrector: Mehrotra's second-order term and centring, same factorization.
+      // Corrector: Mehrotra's second-order term and centring, same factorization. The centring
+      // target is floored at kCentringFloor · tol_comp: a complementarity below the tolerance
+      // buys nothing, and once μ is there while stationarity still converges (the solve's error
+      // grows with W = λ/t ~ λ²/μ), driving μ on to 1e-20 and below ruins the Newton directions
+      // (SQP on an exact-penalty obstacle constraint ended in factorization_failed).
+      const double target = std::max(sigma * mu_, qp_defaults::kCentringFloor * cfg.tol_comp);
       w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
-                                 Eigen::VectorXd::Constant(w.t.size(), sigma * mu_));
+                                 Eigen::VectorXd::Constant(w.t.size(), target));
       newton_direction(qp, true, refine);
     }
     const double check = w.dv.sum() + w.dpi.sum() + w.ds.sum() + w.dt.sum() + w.dlam.sum();
@@ -676,7 +683,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       status = QpStatus::nan_detected;
       break;
     }
-    const double alpha = step_length(w, cfg.step_fraction);
+    const double alpha = step_length(w, cfg.step_fraction, cfg.tol_comp);
     if (alpha < cfg.min_step) {
       status = QpStatus::min_step;
       break;

@@ -21,6 +21,8 @@ inline constexpr double kStepFraction = 0.995;
 // kStepCentrality times the mean complementarity after the step (divided by its partner), but
 // not less far than kStepFraction of the way to the boundary.
 inline constexpr double kStepCentrality = 0.01;
+// Mehrotra's centring target σμ is floored at kCentringFloor · tol_comp (see the solver).
+inline constexpr double kCentringFloor = 0.1;
 // The solve stops with min_step when the step length falls below this.
 inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
