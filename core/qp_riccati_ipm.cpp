@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/qp_kernels.hpp"
 
@@ -537,16 +538,24 @@ void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine) {
   Workspace& w = ws_;
   solve_direction(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, w.dv, w.dpi, w.ds, w.dt, w.dlam,
                   final);
-  const int refinement_steps = final && refine ? settings_.refinement_steps : 0;
+  int refinement_steps = final && refine ? settings_.refinement_steps : 0;
   // Iterative refinement: Δλ = −W ∇dΔv − ρ cancels to O(λ) from terms of O(W), so rounding in Δv
   // is amplified by W = λ/t → ∞; the error of the unreduced Newton equations is computed and
   // solved for with the same factorization. The t and λ equations hold exactly by construction.
+  const double target = settings_.refine_ratio * std::min(settings_.tol_stat, settings_.tol_eq);
+  // Measuring that error costs a residual evaluation; skip it when the first-order bound
+  // ε‖W‖∞‖Δv‖∞ of the rounding (the backward error of the Cholesky solve, ε‖H̃‖‖Δv‖, with
+  // ‖H̃‖ ≈ ‖W‖ once W dominates; ×kRefineBoundSafety) already lies below the target.
+  if (refinement_steps > 0 && w.m_total > 0) {
+    const double bound = qp_defaults::kRefineBoundSafety * std::numeric_limits<double>::epsilon() *
+                         w.w.lpNorm<Eigen::Infinity>() * w.dv.lpNorm<Eigen::Infinity>();
+    if (bound <= target) refinement_steps = 0;
+  }
   for (int r = 0; r < refinement_steps; ++r) {
     linear_residual(qp, w.dv, w.dpi, w.ds, w.dlam, w.res_v, w.res_s, w.res_pi, w.err_v, w.err_s,
                     w.err_pi);
     const double e = std::max(stationarity_norm(w.err_v, w.err_s),
                               w.err_pi.size() > 0 ? w.err_pi.lpNorm<Eigen::Infinity>() : 0.0);
-    const double target = settings_.refine_ratio * std::min(settings_.tol_stat, settings_.tol_eq);
     if (!(e > target)) break;
     solve_direction(qp, w.err_v, w.err_s, w.err_pi, w.zero_m, w.zero_m, w.cv, w.cpi, w.cs, w.ct,
                     w.clam, true);
@@ -565,6 +574,50 @@ double max_step(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alph
   for (Eigen::Index k = 0; k < m; ++k)
     if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k];
   return alpha;
+}
+
+// As max_step, also the blocking index (−1 if no component blocks before alpha).
+double max_step_index(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alpha,
+                      Eigen::Index& block) {
+  block = -1;
+  const Eigen::Index m = z.size();
+  for (Eigen::Index k = 0; k < m; ++k)
+    if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k], block = k;
+  return alpha;
+}
+
+// Step length along (Δt, Δλ), one for primal and dual (the stationarity couples Δv and Δλ), by
+// Mehrotra's heuristic (Mehrotra 1992; Nocedal & Wright, Numerical Optimization, §14.2). With
+// α_max the largest step keeping t, λ ≥ 0, p its blocking component, ᾱ = min(1, α_max) and
+// μ⁺ = (t + ᾱΔt)ᵀ(λ + ᾱΔλ)/m the complementarity after it, the step stops where the blocking pair
+// keeps γ_f μ⁺: t_p + αΔt_p = γ_f μ⁺ / (λ_p + ᾱΔλ_p) (likewise for a blocking λ_p), but never
+// shorter than the fixed rule η α_max. Far from the solution this keeps t_p λ_p near γ_f times the
+// mean, like the fixed fraction; near it μ⁺ → 0 and α → α_max: the fixed rule's (1 − η) leftover,
+// which limits the decrease of μ to 1/(1 − η) = 200× per iteration, disappears (fast local
+// convergence needs η_k → 1). μ⁺ is floored at the tolerance tol_comp: a complementarity below
+// it is of no use, and pushing t_p far below it while stationarity still has to converge makes
+// W = λ/t overflow the solve's accuracy (seen in SQP on an exact-penalty obstacle constraint).
+double step_length(const QpRiccatiIpmWorkspace& w, double eta, double tol_comp) {
+  if (w.m_total == 0) return 1.0;  // no inequalities: Δt = Δλ = 0
+  constexpr double kBeyond = 1e3;  // α_max is searched up to here (beyond the full step)
+  Eigen::Index pt, pl;
+  const double at = max_step_index(w.t, w.dt, kBeyond, pt);
+  const double al = max_step_index(w.lam, w.dlam, kBeyond, pl);
+  const double abar = std::min({1.0, at, al});
+  const double mu_plus = std::max(
+      tol_comp, (w.lam + abar * w.dlam).dot(w.t + abar * w.dt) / static_cast<double>(w.m_total));
+  const double gf = qp_defaults::kStepCentrality;
+  double a_t = std::min(1.0, at), a_l = std::min(1.0, al);
+  // std::max keeps η α_max when the target is not finite (0/0 at a degenerate pair).
+  if (pt >= 0) {
+    const double target = gf * mu_plus / (w.lam[pt] + abar * w.dlam[pt]);
+    a_t = std::min(1.0, std::max(eta * at, (target - w.t[pt]) / w.dt[pt]));
+  }
+  if (pl >= 0) {
+    const double target = gf * mu_plus / (w.t[pl] + abar * w.dt[pl]);
+    a_l = std::min(1.0, std::max(eta * al, (target - w.lam[pl]) / w.dlam[pl]));
+  }
+  return std::min(a_t, a_l);
 }
 }  // namespace
 
@@ -625,9 +678,14 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
           (w.lam + a_aff * w.dlam).dot(w.t + a_aff * w.dt) / static_cast<double>(w.m_total);
       const double ratio = mu_ > 0.0 ? mu_aff / mu_ : 0.0;
       const double sigma = std::clamp(ratio * ratio * ratio, 0.0, 1.0);
-      // Corrector: Mehrotra's second-order term and centring, same factorization.
+      // Corrector: Mehrotra's second-order term and centring, same factorization. The centring
+      // target is floored at kCentringFloor · tol_comp: a complementarity below the tolerance
+      // buys nothing, and once μ is there while stationarity still converges (the solve's error
+      // grows with W = λ/t ~ λ²/μ), driving μ on to 1e-20 and below ruins the Newton directions
+      // (SQP on an exact-penalty obstacle constraint ended in factorization_failed).
+      const double target = std::max(sigma * mu_, qp_defaults::kCentringFloor * cfg.tol_comp);
       w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
-                                 Eigen::VectorXd::Constant(w.t.size(), sigma * mu_));
+                                 Eigen::VectorXd::Constant(w.t.size(), target));
       newton_direction(qp, true, refine);
     }
     const double check = w.dv.sum() + w.dpi.sum() + w.ds.sum() + w.dt.sum() + w.dlam.sum();
@@ -635,8 +693,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       status = QpStatus::nan_detected;
       break;
     }
-    double alpha = max_step(w.t, w.dt, 1.0 / cfg.step_fraction);
-    alpha = std::min(1.0, cfg.step_fraction * max_step(w.lam, w.dlam, alpha));
+    const double alpha = step_length(w, cfg.step_fraction, cfg.tol_comp);
     if (alpha < cfg.min_step) {
       status = QpStatus::min_step;
       break;

@@ -14,8 +14,15 @@ inline constexpr double kTolStationarity = 1e-6;
 inline constexpr double kTolEquality = 1e-8;
 inline constexpr double kTolInequality = 1e-8;
 inline constexpr double kTolComplementarity = 1e-8;
-// Fraction-to-boundary factor: the step keeps t, λ > 0 by stopping at this fraction of the way.
+// Fraction-to-boundary factor: the step keeps t, λ > 0 by stopping at least at this fraction
+// of the way (the Riccati IPM may go further, see kStepCentrality).
 inline constexpr double kStepFraction = 0.995;
+// Mehrotra's step-length heuristic (γ_f): the blocking t or λ of a step may go as far as
+// kStepCentrality times the mean complementarity after the step (divided by its partner), but
+// not less far than kStepFraction of the way to the boundary.
+inline constexpr double kStepCentrality = 0.01;
+// Mehrotra's centring target σμ is floored at kCentringFloor · tol_comp (see the solver).
+inline constexpr double kCentringFloor = 0.1;
 // The solve stops with min_step when the step length falls below this.
 inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
@@ -35,6 +42,10 @@ inline constexpr double kRefineRatio = 0.1;
 // ... and only while μ < kRefineMuRatio · tol_comp: W = λ/t ≈ λ²/μ is only then large enough for
 // the rounding it amplifies to matter.
 inline constexpr double kRefineMuRatio = 1e3;
+// ... and only while ε‖W‖∞‖Δv‖∞ · kRefineBoundSafety (an a-priori bound on the error, measured
+// 1–3 orders of magnitude above the actual one on the test and controller QPs) exceeds the
+// target; otherwise the error is not even measured.
+inline constexpr double kRefineBoundSafety = 10.0;
 // A bound whose magnitude is ≥ kInfBound is absent (one-sided constraints).
 inline constexpr double kInfBound = 1e20;
 }  // namespace qp_defaults
