@@ -5,10 +5,9 @@
 // leaving a dense QP in U alone (nU = Σ nu_i variables) with the input bounds as boxes, every
 // state-dependent row (state bounds and C x + D u) as a dense general row, and the same soft
 // constraints with the same slacks. That QP is posed as a one-stage OcpQp (N = 0, nx = 0) and
-// solved by the Mehrotra IPM of core/qp_riccati_ipm.hpp, whose one-stage "Riccati recursion" is
-// a dense Cholesky of the condensed Hessian plus the barrier terms — the solver's per-stage
-// overhead is paid once instead of N + 1 times, and its soft-constraint handling, refinement,
-// statuses and tolerances carry over unchanged.
+// solved by core/qp_dense_ipm.hpp: the Mehrotra IPM of core/qp_riccati_ipm.hpp (same
+// soft-constraint handling, refinement, statuses and tolerances) with dense linear algebra on
+// the actual sizes, a Cholesky of the condensed Hessian plus the barrier terms per iteration.
 //
 // Hessian condensing, O(N² nx² nu) (Frison's backward scheme): with the cost-to-go of the tail
 // written as a quadratic in (x_k, U_k = [u_k; …; u_N]) with blocks P_k (x x), M_k (U_k x),
@@ -28,7 +27,7 @@
 #include <Eigen/Core>
 
 #include "core/ocp_qp.hpp"
-#include "core/qp_riccati_ipm.hpp"
+#include "core/qp_dense_ipm.hpp"
 #include "core/qp_solver.hpp"
 
 namespace mixpilot {
@@ -88,7 +87,7 @@ class QpCondensedDense final : public QpSolver {
 
   Settings settings_{};
   Workspace ws_{};
-  QpRiccatiIpm ipm_;
+  QpDenseIpm ipm_;
   bool ready_ = false;
   bool prepared_ = false;  // condense() done by prepare() for the next solve()
 };
