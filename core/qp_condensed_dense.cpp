@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <utility>
 
 namespace mixpilot {
@@ -62,6 +63,87 @@ bool QpCondensedDense::setup(const OcpQpDims& dims, const Settings& settings) {
   return true;
 }
 
+namespace {
+
+// Column-major kernels on the actual (tiny, stage-varying) sizes: C = [C +] A·B, C += AᵀB,
+// y += A x, y += Aᵀx. Dynamic-size Eigen products cost more in dispatch than in flops here, and
+// so do runtime-length loops of 1–8 elements; the length of each kernel's innermost loop is
+// therefore dispatched to a compile-time constant for 1..8 (nx, nu of short-horizon OCPs), so
+// the compiler unrolls it into a few vector instructions. Fixed<0> is the runtime-length loop.
+template <int K>
+using Fixed = std::integral_constant<int, K>;
+
+template <class F>
+void with_length(int len, F&& f) {
+  switch (len) {
+    case 1: f(Fixed<1>{}); break;
+    case 2: f(Fixed<2>{}); break;
+    case 3: f(Fixed<3>{}); break;
+    case 4: f(Fixed<4>{}); break;
+    case 5: f(Fixed<5>{}); break;
+    case 6: f(Fixed<6>{}); break;
+    case 7: f(Fixed<7>{}); break;
+    case 8: f(Fixed<8>{}); break;
+    default: f(Fixed<0>{}); break;
+  }
+}
+
+// C (m x n) = A (m x k) · B (k x n), or C += A·B when acc.
+void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
+             int ldc, bool acc) {
+  with_length(m, [&](auto M) {
+    const int mm = M.value > 0 ? M.value : m;
+    for (int j = 0; j < n; ++j) {
+      double* c = C + std::ptrdiff_t(j) * ldc;
+      const double* b = B + std::ptrdiff_t(j) * ldb;
+      if (!acc)
+        for (int i = 0; i < mm; ++i) c[i] = 0.0;
+      for (int p = 0; p < k; ++p) {
+        const double bp = b[p];
+        const double* a = A + std::ptrdiff_t(p) * lda;
+        for (int i = 0; i < mm; ++i) c[i] += a[i] * bp;
+      }
+    }
+  });
+}
+// C (m x n) += Aᵀ · B with A (k x m), B (k x n).
+void gemm_tn_acc(int m, int n, int k, const double* A, int lda, const double* B, int ldb,
+                 double* C, int ldc) {
+  with_length(k, [&](auto K) {
+    const int kk = K.value > 0 ? K.value : k;
+    for (int j = 0; j < n; ++j) {
+      const double* b = B + std::ptrdiff_t(j) * ldb;
+      double* c = C + std::ptrdiff_t(j) * ldc;
+      for (int i = 0; i < m; ++i) {
+        const double* a = A + std::ptrdiff_t(i) * lda;
+        double v = 0.0;
+        for (int p = 0; p < kk; ++p) v += a[p] * b[p];
+        c[i] += v;
+      }
+    }
+  });
+}
+// y (m) += A (m x n) · x.
+void gemv_n_acc(int m, int n, const double* A, int lda, const double* x, double* y) {
+  gemm_nn(m, 1, n, A, lda, x, n, y, m, true);
+}
+// y (n) += Aᵀ · x with A (m x n).
+void gemv_t_acc(int m, int n, const double* A, int lda, const double* x, double* y) {
+  gemm_tn_acc(n, 1, m, A, lda, x, m, y, n);
+}
+// dst (m x n, ldd) = src (m x n, lds).
+void copy(int m, int n, const double* src, int lds, double* dst, int ldd) {
+  with_length(m, [&](auto M) {
+    const int mm = M.value > 0 ? M.value : m;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < mm; ++i)
+        dst[i + std::ptrdiff_t(j) * ldd] = src[i + std::ptrdiff_t(j) * lds];
+  });
+}
+int ld(const Eigen::MatrixXd& M) { return static_cast<int>(M.outerStride()); }
+
+}  // namespace
+
 // Everything of the condensed QP that does not depend on x0: Hessian, x0-free gradient h, the
 // x0 → gradient map M_0, the constraint rows, input bounds and slack data.
 void QpCondensedDense::condense(const OcpQp& qp) {
@@ -69,72 +151,90 @@ void QpCondensedDense::condense(const OcpQp& qp) {
   const OcpQpDims& d = w.dims;
   const int N = d.N, nU = w.cdims.nu[0], nbu_c = w.cdims.nbu[0];
   OcpQpStage& cs = w.cqp.stage[0];
-  Eigen::MatrixXd& H = cs.R;
+  double* H = cs.R.data();
+  const int ldH = ld(cs.R);
+  const int ldP = ld(w.P), ldM = ld(w.M), ldPA = ld(w.PA), ldPB = ld(w.PB);
   // Backward recursion. Stage N: P = Q_N, p = q_N, M = S_N, h = r_N, H block R_N.
   {
     const OcpQpStage& s = qp.stage[N];
     const int nx = d.nx[N], nu = d.nu[N], r0 = w.off_u[N];
-    w.P.topLeftCorner(nx, nx) = s.Q;
-    w.p.head(nx) = s.q;
+    copy(nx, nx, s.Q.data(), nx, w.P.data(), ldP);
+    for (int i = 0; i < nx; ++i) w.p[i] = s.q[i];
     if (nu > 0) {
-      w.M.block(r0, 0, nu, nx) = s.S;
-      w.h.segment(r0, nu) = s.r;
-      H.block(r0, r0, nu, nu) = s.R;
+      copy(nu, nx, s.S.data(), nu, w.M.data() + r0, ldM);
+      for (int i = 0; i < nu; ++i) w.h[r0 + i] = s.r[i];
+      copy(nu, nu, s.R.data(), nu, H + r0 + std::ptrdiff_t(r0) * ldH, ldH);
     }
   }
   for (int k = N - 1; k >= 0; --k) {
     const OcpQpStage& s = qp.stage[k];
     const int nx = d.nx[k], nx1 = d.nx[k + 1], nu = d.nu[k];
     const int r0 = w.off_u[k], r1 = w.off_u[k + 1], nr = nU - r1;
-    auto P = w.P.topLeftCorner(nx1, nx1);
-    auto PA = w.PA.topLeftCorner(nx1, nx);
-    auto PB = w.PB.topLeftCorner(nx1, nu);
-    auto pb = w.pb.head(nx1);
-    PA.noalias() = P * s.A;
-    PB.noalias() = P * s.B;
-    pb = w.p.head(nx1);
-    pb.noalias() += P * s.b;
-    auto Mn = w.M.block(r1, 0, nr, nx1);  // M_{k+1}
+    const double* A = s.A.data();
+    const double* B = s.B.data();
+    const double* P = w.P.data();
+    double* PA = w.PA.data();
+    double* PB = w.PB.data();
+    double* pb = w.pb.data();
+    gemm_nn(nx1, nx, nx1, P, ldP, A, nx1, PA, ldPA, false);  // P_{k+1} A_k
+    gemm_nn(nx1, nu, nx1, P, ldP, B, nx1, PB, ldPB, false);  // P_{k+1} B_k
+    for (int i = 0; i < nx1; ++i) pb[i] = w.p[i];            // p_{k+1} + P_{k+1} b_k
+    gemv_n_acc(nx1, nx1, P, ldP, s.b.data(), pb);
+    const double* Mn = w.M.data() + r1;  // M_{k+1} (nr x nx1)
     // Hessian column block of u_k (lower part; mirrored at the end).
-    H.block(r0, r0, nu, nu) = s.R;
-    H.block(r0, r0, nu, nu).noalias() += s.B.transpose() * PB;
-    H.block(r1, r0, nr, nu).noalias() = Mn * s.B;
+    double* Hkk = H + r0 + std::ptrdiff_t(r0) * ldH;
+    copy(nu, nu, s.R.data(), nu, Hkk, ldH);
+    gemm_tn_acc(nu, nu, nx1, B, nx1, PB, ldPB, Hkk, ldH);
+    gemm_nn(nr, nu, nx1, Mn, ldM, B, nx1, H + r1 + std::ptrdiff_t(r0) * ldH, ldH, false);
     // Linear terms.
-    w.h.segment(r0, nu) = s.r;
-    w.h.segment(r0, nu).noalias() += s.B.transpose() * pb;
-    w.h.segment(r1, nr).noalias() += Mn * s.b;
-    w.p1.head(nx) = s.q;
-    w.p1.head(nx).noalias() += s.A.transpose() * pb;
-    // Cross terms M_k and P_k.
-    w.M1.block(r0, 0, nu, nx) = s.S;
-    w.M1.block(r0, 0, nu, nx).noalias() += PB.transpose() * s.A;
-    w.M1.block(r1, 0, nr, nx).noalias() = Mn * s.A;
+    for (int i = 0; i < nu; ++i) w.h[r0 + i] = s.r[i];
+    gemv_t_acc(nx1, nu, B, nx1, pb, w.h.data() + r0);
+    gemv_n_acc(nr, nx1, Mn, ldM, s.b.data(), w.h.data() + r1);
+    for (int i = 0; i < nx; ++i) w.p1[i] = s.q[i];
+    gemv_t_acc(nx1, nx, A, nx1, pb, w.p1.data());
+    // Cross terms M_k = [S_k + PBᵀA; M_{k+1} A] and P_k = Q_k + AᵀPA.
+    double* M1 = w.M1.data();
+    copy(nu, nx, s.S.data(), nu, M1 + r0, ldM);
+    gemm_tn_acc(nu, nx, nx1, PB, ldPB, A, nx1, M1 + r0, ldM);
+    gemm_nn(nr, nx, nx1, Mn, ldM, A, nx1, M1 + r1, ldM, false);
     if (k > 0) {
-      w.P1.topLeftCorner(nx, nx) = s.Q;
-      w.P1.topLeftCorner(nx, nx).noalias() += s.A.transpose() * PA;
+      copy(nx, nx, s.Q.data(), nx, w.P1.data(), ldP);
+      gemm_tn_acc(nx, nx, nx1, A, nx1, PA, ldPA, w.P1.data(), ldP);
     }
     std::swap(w.P, w.P1);
     std::swap(w.M, w.M1);
     std::swap(w.p, w.p1);
   }
-  w.M0 = w.M.leftCols(d.nx[0]);
-  H.triangularView<Eigen::StrictlyUpper>() = H.transpose();
+  copy(nU, d.nx[0], w.M.data(), ldM, w.M0.data(), ld(w.M0));
+  for (int c = 1; c < nU; ++c)
+    for (int r = 0; r < c; ++r) H[r + std::ptrdiff_t(c) * ldH] = H[c + std::ptrdiff_t(r) * ldH];
   // Γ_{i+1} = A_i Γ_i + B_i E_i (columns of u_0..u_{i−1}, then B_i; the rest stays zero).
   for (int i = 0; i < N; ++i) {
     const OcpQpStage& s = qp.stage[i];
-    const int c0 = w.off_u[i];
-    if (c0 > 0) w.Gam[i + 1].leftCols(c0).noalias() = s.A * w.Gam[i].leftCols(c0);
-    w.Gam[i + 1].middleCols(c0, d.nu[i]) = s.B;
+    const int c0 = w.off_u[i], nx = d.nx[i], nx1 = d.nx[i + 1];
+    Eigen::MatrixXd& G1 = w.Gam[i + 1];
+    if (c0 > 0)
+      gemm_nn(nx1, c0, nx, s.A.data(), nx1, w.Gam[i].data(), ld(w.Gam[i]), G1.data(), ld(G1),
+              false);
+    copy(nx1, d.nu[i], s.B.data(), nx1, G1.data() + std::ptrdiff_t(c0) * ld(G1), ld(G1));
   }
   // Rows: state bounds Γ_i[idx, :], general rows C_i Γ_i + D_i E_i; input boxes; slacks.
+  double* D = cs.D.data();
+  const int ldD = ld(cs.D);
   for (int i = 0; i <= N; ++i) {
     const OcpQpStage& s = qp.stage[i];
-    const int nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i], ns = d.ns[i];
+    const int nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i], ns = d.ns[i], nx = d.nx[i];
     const int c0 = w.off_u[i], g0 = w.off_g[i], b0 = w.off_bu[i], s0 = w.off_s[i];
-    for (int k = 0; k < nbx; ++k) cs.D.row(g0 + k).head(c0) = w.Gam[i].row(s.idxbx[k]).head(c0);
+    const Eigen::MatrixXd& G = w.Gam[i];
+    for (int k = 0; k < nbx; ++k) {
+      const int ix = s.idxbx[k];
+      for (int c = 0; c < c0; ++c)
+        D[g0 + k + std::ptrdiff_t(c) * ldD] = G.data()[ix + std::ptrdiff_t(c) * ld(G)];
+    }
     if (ng > 0) {
-      if (c0 > 0) cs.D.block(g0 + nbx, 0, ng, c0).noalias() = s.C * w.Gam[i].leftCols(c0);
-      cs.D.block(g0 + nbx, c0, ng, d.nu[i]) = s.D;
+      double* Dg = D + g0 + nbx;
+      if (c0 > 0) gemm_nn(ng, c0, nx, s.C.data(), ng, G.data(), ld(G), Dg, ldD, false);
+      copy(ng, d.nu[i], s.D.data(), ng, Dg + std::ptrdiff_t(c0) * ldD, ldD);
     }
     for (int k = 0; k < nbu; ++k) {
       cs.idxbu[b0 + k] = c0 + s.idxbu[k];
@@ -158,28 +258,33 @@ void QpCondensedDense::embed_x0(const OcpQp& qp) {
   const OcpQpDims& d = w.dims;
   OcpQpStage& cs = w.cqp.stage[0];
   const double big = settings_.inf_bound;
-  cs.r = w.h;
-  cs.r.noalias() += w.M0 * qp.x0;
-  w.xi.head(d.nx[0]) = qp.x0;
+  const int nU = w.cdims.nu[0], nx0 = d.nx[0];
+  for (int i = 0; i < nU; ++i) cs.r[i] = w.h[i];
+  gemv_n_acc(nU, nx0, w.M0.data(), ld(w.M0), qp.x0.data(), cs.r.data());
+  double* xi = w.xi.data();
+  for (int i = 0; i < nx0; ++i) xi[i] = qp.x0[i];
   for (int i = 0; i < d.N; ++i) {
-    auto xn = w.xi.segment(w.off_x[i + 1], d.nx[i + 1]);
-    xn = qp.stage[i].b;
-    xn.noalias() += qp.stage[i].A * w.xi.segment(w.off_x[i], d.nx[i]);
+    const OcpQpStage& s = qp.stage[i];
+    const int nx1 = d.nx[i + 1];
+    double* xn = xi + w.off_x[i + 1];
+    for (int r = 0; r < nx1; ++r) xn[r] = s.b[r];
+    gemv_n_acc(nx1, d.nx[i], s.A.data(), nx1, xi + w.off_x[i], xn);
   }
   auto shifted = [big](double b, double c) {
     return std::isfinite(b) && std::abs(b) < big ? b - c : b;  // absent sides stay absent
   };
   for (int i = 0; i <= d.N; ++i) {
     const OcpQpStage& s = qp.stage[i];
-    const int nbx = d.nbx[i], ng = d.ng[i], g0 = w.off_g[i];
-    const auto xi = w.xi.segment(w.off_x[i], d.nx[i]);
+    const int nbx = d.nbx[i], ng = d.ng[i], g0 = w.off_g[i], nx = d.nx[i];
+    const double* x = xi + w.off_x[i];
     for (int k = 0; k < nbx; ++k) {
-      const double c = xi[s.idxbx[k]];
+      const double c = x[s.idxbx[k]];
       cs.lg[g0 + k] = shifted(s.lbx[k], c);
       cs.ug[g0 + k] = shifted(s.ubx[k], c);
     }
     for (int k = 0; k < ng; ++k) {
-      const double c = s.C.row(k).dot(xi);
+      double c = 0.0;
+      for (int j = 0; j < nx; ++j) c += s.C(k, j) * x[j];
       cs.lg[g0 + nbx + k] = shifted(s.lg[k], c);
       cs.ug[g0 + nbx + k] = shifted(s.ug[k], c);
     }
@@ -213,53 +318,67 @@ void QpCondensedDense::recover(const OcpQp& qp, OcpQpSolution& sol) {
   const OcpQpDims& d = w.dims;
   const OcpQpSolution& c = w.csol;
   const int nbu_c = w.cdims.nbu[0];
+  const double* U = c.u[0].data();
   // Inputs, slacks, multipliers; states by forward simulation.
-  sol.x[0] = qp.x0;
+  for (int i = 0; i < d.nx[0]; ++i) sol.x[0][i] = qp.x0[i];
   for (int i = 0; i <= d.N; ++i) {
-    const int nbu = d.nbu[i], nc = d.nc(i), ns = d.ns[i], s0 = w.off_s[i];
-    sol.u[i] = c.u[0].segment(w.off_u[i], d.nu[i]);
+    const int nu = d.nu[i], nbu = d.nbu[i], nc = d.nc(i), ns = d.ns[i], s0 = w.off_s[i];
+    for (int j = 0; j < nu; ++j) sol.u[i][j] = U[w.off_u[i] + j];
     for (int k = 0; k < nc; ++k) {
       const int kc = k < nbu ? w.off_bu[i] + k : nbu_c + w.off_g[i] + (k - nbu);
       sol.lam_l[i][k] = c.lam_l[0][kc];
       sol.lam_u[i][k] = c.lam_u[0][kc];
     }
-    sol.sl[i] = c.sl[0].segment(s0, ns);
-    sol.su[i] = c.su[0].segment(s0, ns);
-    sol.lam_sl[i] = c.lam_sl[0].segment(s0, ns);
-    sol.lam_su[i] = c.lam_su[0].segment(s0, ns);
+    for (int j = 0; j < ns; ++j) {
+      sol.sl[i][j] = c.sl[0][s0 + j];
+      sol.su[i][j] = c.su[0][s0 + j];
+      sol.lam_sl[i][j] = c.lam_sl[0][s0 + j];
+      sol.lam_su[i][j] = c.lam_su[0][s0 + j];
+    }
     if (i < d.N) {
       const OcpQpStage& s = qp.stage[i];
-      sol.x[i + 1] = s.b;
-      sol.x[i + 1].noalias() += s.A * sol.x[i];
-      sol.x[i + 1].noalias() += s.B * sol.u[i];
+      const int nx1 = d.nx[i + 1];
+      double* xn = sol.x[i + 1].data();
+      for (int r = 0; r < nx1; ++r) xn[r] = s.b[r];
+      gemv_n_acc(nx1, d.nx[i], s.A.data(), nx1, sol.x[i].data(), xn);
+      gemv_n_acc(nx1, nu, s.B.data(), nx1, sol.u[i].data(), xn);
     }
   }
   // π and λ_x0 from the x-stationarity, backwards; the objective on the way.
   double f = 0.0;
   for (int i = d.N; i >= 0; --i) {
     const OcpQpStage& s = qp.stage[i];
-    const int nx = d.nx[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i], nc = d.nc(i);
-    const auto& x = sol.x[i];
-    const auto& u = sol.u[i];
-    auto gx = w.gx.head(nx);
-    auto dl = w.dl.head(nc);
-    dl = sol.lam_u[i] - sol.lam_l[i];
-    gx.noalias() = s.Q * x;
-    f += 0.5 * x.dot(gx) + s.q.dot(x);
-    gx += s.q;
-    gx.noalias() += s.S.transpose() * u;
-    if (i < d.N) gx.noalias() += s.A.transpose() * sol.pi[i];
-    for (int k = 0; k < nbx; ++k) gx[s.idxbx[k]] += dl[nbu + k];
-    if (ng > 0) gx.noalias() += s.C.transpose() * dl.tail(ng);
-    if (i > 0)
-      sol.pi[i - 1] = gx;
-    else
-      sol.lam_x0 = gx;
-    if (d.nu[i] > 0) {  // ½uᵀRu + uᵀS x + rᵀu through a preallocated buffer
-      auto gu = w.gu.head(d.nu[i]);
-      gu.noalias() = s.S * x;
-      gu.noalias() += 0.5 * s.R * u;
-      f += u.dot(gu) + s.r.dot(u);
+    const int nx = d.nx[i], nu = d.nu[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i];
+    const double* x = sol.x[i].data();
+    const double* u = sol.u[i].data();
+    double* gx = i > 0 ? sol.pi[i - 1].data() : sol.lam_x0.data();
+    // gx = Q x (½xᵀQx + qᵀx into f), then + q + Sᵀu + Aᵀπ_i + ∇_x dᵀ(λ_u − λ_l).
+    for (int r = 0; r < nx; ++r) gx[r] = 0.0;
+    gemv_n_acc(nx, nx, s.Q.data(), nx, x, gx);
+    for (int r = 0; r < nx; ++r) {
+      f += (0.5 * gx[r] + s.q[r]) * x[r];
+      gx[r] += s.q[r];
+    }
+    gemv_t_acc(nu, nx, s.S.data(), nu, u, gx);
+    if (i < d.N) gemv_t_acc(d.nx[i + 1], nx, s.A.data(), d.nx[i + 1], sol.pi[i].data(), gx);
+    const double* ll = sol.lam_l[i].data();
+    const double* lu = sol.lam_u[i].data();
+    for (int k = 0; k < nbx; ++k) gx[s.idxbx[k]] += lu[nbu + k] - ll[nbu + k];
+    if (ng > 0) {
+      double* dl = w.dl.data();
+      for (int k = 0; k < ng; ++k) dl[k] = lu[nbu + nbx + k] - ll[nbu + nbx + k];
+      gemv_t_acc(ng, nx, s.C.data(), ng, dl, gx);
+    }
+    if (nu > 0) {  // ½uᵀRu + uᵀS x + rᵀu
+      double* gu = w.gu.data();
+      for (int r = 0; r < nu; ++r) gu[r] = s.r[r];
+      gemv_n_acc(nu, nx, s.S.data(), nu, x, gu);
+      for (int j = 0; j < nu; ++j) {
+        double ru = 0.0;
+        for (int r = 0; r < nu; ++r) ru += s.R(j, r) * u[r];
+        gu[j] += 0.5 * ru;
+      }
+      for (int r = 0; r < nu; ++r) f += u[r] * gu[r];
     }
     for (int j = 0; j < d.ns[i]; ++j) {
       f += (0.5 * s.Zl[j] * sol.sl[i][j] + s.zl[j]) * sol.sl[i][j];
