@@ -18,17 +18,35 @@ namespace mixpilot {
 
 namespace {
 
-// Largest α ∈ (0, alpha] with z + α dz ≥ 0 componentwise (z > 0).
-double max_step(int m, const double* z, const double* dz, double alpha) {
-  for (int k = 0; k < m; ++k)
-    if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k];
-  return alpha;
+// Largest α ∈ (0, alpha] with z + α dz ≥ 0 componentwise (z > 0), from inv_z = 1/z:
+// α = min(alpha, 1 / max_k(−dz_k/z_k)); four accumulators so the loop vectorizes.
+double max_step(int m, const double* __restrict dz, const double* __restrict inv_z, double alpha) {
+  double r[4] = {0.0, 0.0, 0.0, 0.0};
+  int k = 0;
+  for (; k + 4 <= m; k += 4)
+    for (int l = 0; l < 4; ++l) r[l] = std::max(r[l], -dz[k + l] * inv_z[k + l]);
+  for (; k < m; ++k) r[0] = std::max(r[0], -dz[k] * inv_z[k]);
+  const double q = std::max(std::max(r[0], r[1]), std::max(r[2], r[3]));
+  return q * alpha > 1.0 ? 1.0 / q : alpha;
 }
 
 double norm_inf(int n, const double* x) {
-  double r = 0.0;
-  for (int k = 0; k < n; ++k) r = std::max(r, std::abs(x[k]));
-  return r;
+  double r[4] = {0.0, 0.0, 0.0, 0.0};
+  int k = 0;
+  for (; k + 4 <= n; k += 4)
+    for (int l = 0; l < 4; ++l) r[l] = std::max(r[l], std::abs(x[k + l]));
+  for (; k < n; ++k) r[0] = std::max(r[0], std::abs(x[k]));
+  return std::max(std::max(r[0], r[1]), std::max(r[2], r[3]));
+}
+
+// Σ_k x_k y_k (y = nullptr: Σ_k x_k), four accumulators.
+double dot(int n, const double* x, const double* y) {
+  double r[4] = {0.0, 0.0, 0.0, 0.0};
+  int k = 0;
+  for (; k + 4 <= n; k += 4)
+    for (int l = 0; l < 4; ++l) r[l] += x[k + l] * (y ? y[k + l] : 1.0);
+  for (; k < n; ++k) r[0] += x[k] * (y ? y[k] : 1.0);
+  return (r[0] + r[1]) + (r[2] + r[3]);
 }
 
 }  // namespace
@@ -55,7 +73,7 @@ bool QpDenseIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   for (Eigen::VectorXd* p : {&w.s, &w.ds, &w.res_s, &w.err_s, &w.cs, &w.zflat})
     *p = Eigen::VectorXd::Zero(2 * w.ns);
   for (Eigen::VectorXd* p : {&w.t, &w.dt, &w.lam, &w.dlam, &w.res_t, &w.mask, &w.w, &w.rc,
-                             &w.rho, &w.ct, &w.clam, &w.zero_m})
+                             &w.rho, &w.ct, &w.clam, &w.zero_m, &w.inv_t, &w.inv_lam})
     *p = Eigen::VectorXd::Zero(w.m);
   for (Eigen::VectorXd* p : {&w.lbnd, &w.ubnd, &w.wc, &w.gc, &w.dd})
     *p = Eigen::VectorXd::Zero(w.nc);
@@ -222,16 +240,23 @@ void QpDenseIpm::residuals(const OcpQpStage& st) {
   for (int j = 0; j < 2 * ns; ++j) rt[2 * nc + j] = mask[2 * nc + j] * (s[j] - t[2 * nc + j]);
   res_stat_ = stationarity_norm(w.res_u.data(), w.res_s.data());
   res_ineq_ = norm_inf(m, rt);
-  double lt = 0.0;
-  for (int k = 0; k < m; ++k) lt += w.lam[k] * t[k];
-  mu_ = w.m_total > 0 ? lt / w.m_total : 0.0;
+  mu_ = w.m_total > 0 ? dot(m, w.lam.data(), t) / w.m_total : 0.0;
 }
 
 bool QpDenseIpm::factorize(const OcpQpStage& st) {
   Workspace& w = ws_;
   const int n = w.n, nb = w.nb, ng = w.ng, nc = w.nc, ns = w.ns, m = w.m;
-  double* W = w.w.data();
-  for (int k = 0; k < m; ++k) W[k] = w.mask[k] * w.lam[k] / w.t[k];
+  double* __restrict W = w.w.data();
+  double* __restrict inv_t = w.inv_t.data();
+  double* __restrict inv_lam = w.inv_lam.data();
+  const double* __restrict mask = w.mask.data();
+  const double* __restrict lam = w.lam.data();
+  const double* __restrict t = w.t.data();
+  for (int k = 0; k < m; ++k) {  // absent sides: t = 1, λ = 0, so W = 0 and 1/λ := 0
+    inv_t[k] = 1.0 / t[k];
+    inv_lam[k] = mask[k] / (lam[k] + (1.0 - mask[k]));
+    W[k] = mask[k] * lam[k] * inv_t[k];
+  }
   double* wc = w.wc.data();
   for (int k = 0; k < nc; ++k) wc[k] = W[k] + W[nc + k];
   for (int j = 0; j < ns; ++j) {
@@ -253,11 +278,11 @@ bool QpDenseIpm::factorize(const OcpQpStage& st) {
   for (int k = 0; k < ng; ++k) {
     const double wk = wc[nb + k];
     if (wk == 0.0) continue;
-    const double* y = Dt + std::ptrdiff_t(k) * n;
+    const double* __restrict y = Dt + std::ptrdiff_t(k) * n;
     const int len = w.len[k];
     for (int c = 0; c < len; ++c) {
       const double a = wk * y[c];
-      double* col = L + std::ptrdiff_t(c) * n;
+      double* __restrict col = L + std::ptrdiff_t(c) * n;
       for (int r = c; r < len; ++r) col[r] += a * y[r];
     }
   }
@@ -284,7 +309,7 @@ bool QpDenseIpm::factorize(const OcpQpStage& st) {
     for (int r = j + 1; r < n; ++r) cj[r] *= is;
     for (int c = j + 1; c < n; ++c) {
       const double a = cj[c];
-      double* col = L + std::ptrdiff_t(c) * n;
+      double* __restrict col = L + std::ptrdiff_t(c) * n;
       for (int r = c; r < n; ++r) col[r] -= a * cj[r];
     }
   }
@@ -298,10 +323,10 @@ void QpDenseIpm::solve_direction(const OcpQpStage& st, const double* ru, const d
   const int n = w.n, nb = w.nb, ng = w.ng, nc = w.nc, ns = w.ns, m = w.m;
   const double* mask = w.mask.data();
   const double* lam = w.lam.data();
-  const double* t = w.t.data();
   const double* W = w.w.data();
-  double* rho = w.rho.data();
-  for (int k = 0; k < m; ++k) rho[k] = mask[k] * (rc[k] + lam[k] * rt[k]) / t[k];
+  double* __restrict rho = w.rho.data();
+  const double* __restrict inv_t = w.inv_t.data();
+  for (int k = 0; k < m; ++k) rho[k] = mask[k] * (rc[k] + lam[k] * rt[k]) * inv_t[k];
   double* gc = w.gc.data();
   for (int k = 0; k < nc; ++k) gc[k] = rho[k] - rho[nc + k];
   for (int j = 0; j < ns; ++j) {
@@ -361,7 +386,7 @@ void QpDenseIpm::solve_direction(const OcpQpStage& st, const double* ru, const d
   }
   for (int k = 0; k < m; ++k) {
     dt[k] *= mask[k];
-    dlam[k] = -mask[k] * (rc[k] + lam[k] * dt[k]) / t[k];
+    dlam[k] = -mask[k] * (rc[k] + lam[k] * dt[k]) * inv_t[k];
   }
 }
 
@@ -443,27 +468,27 @@ QpStatus QpDenseIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm
     const bool refine = mu_ < qp_defaults::kRefineMuRatio * cfg.tol_comp;
     newton_direction(st, w.m_total == 0, refine);
     if (w.m_total > 0) {
-      double a_aff = max_step(m, t, dt, 1.0);
-      a_aff = max_step(m, lam, dlam, a_aff);
-      double lt = 0.0;
-      for (int k = 0; k < m; ++k) lt += (lam[k] + a_aff * dlam[k]) * (t[k] + a_aff * dt[k]);
-      const double mu_aff = lt / static_cast<double>(w.m_total);
+      double a_aff = max_step(m, dt, w.inv_t.data(), 1.0);
+      a_aff = max_step(m, dlam, w.inv_lam.data(), a_aff);
+      double* aff = w.rho.data();  // λ + α Δλ (ρ is recomputed by the corrector)
+      for (int k = 0; k < m; ++k) aff[k] = lam[k] + a_aff * dlam[k];
+      double* aft = w.ct.data();  // t + α Δt (scratch of the refinement)
+      for (int k = 0; k < m; ++k) aft[k] = t[k] + a_aff * dt[k];
+      const double mu_aff = dot(m, aff, aft) / static_cast<double>(w.m_total);
       const double ratio = mu_ > 0.0 ? mu_aff / mu_ : 0.0;
       const double sigma = std::clamp(ratio * ratio * ratio, 0.0, 1.0);
       const double smu = sigma * mu_;
       for (int k = 0; k < m; ++k) rc[k] = mask[k] * (lam[k] * t[k] + dlam[k] * dt[k] - smu);
       newton_direction(st, true, refine);
     }
-    double check = 0.0;
-    for (int r = 0; r < w.n; ++r) check += w.du[r];
-    for (int j = 0; j < 2 * w.ns; ++j) check += w.ds[j];
-    for (int k = 0; k < m; ++k) check += dt[k] + dlam[k];
+    const double check = dot(w.n, w.du.data(), nullptr) + dot(2 * w.ns, w.ds.data(), nullptr) +
+                         dot(m, dt, nullptr) + dot(m, dlam, nullptr);
     if (!std::isfinite(check)) {
       status = QpStatus::nan_detected;
       break;
     }
-    double alpha = max_step(m, t, dt, 1.0 / cfg.step_fraction);
-    alpha = std::min(1.0, cfg.step_fraction * max_step(m, lam, dlam, alpha));
+    double alpha = max_step(m, dt, w.inv_t.data(), 1.0 / cfg.step_fraction);
+    alpha = std::min(1.0, cfg.step_fraction * max_step(m, dlam, w.inv_lam.data(), alpha));
     if (alpha < cfg.min_step) {
       status = QpStatus::min_step;
       break;

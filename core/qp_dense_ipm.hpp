@@ -41,6 +41,7 @@ struct QpDenseIpmWorkspace {
   Eigen::VectorXd lbnd, ubnd;           // nc: bounds, 0 where absent
   Eigen::VectorXd mask;                 // m: 1 present, 0 absent
   Eigen::VectorXd w, rc, rho;           // m: λ/t, complementarity rhs, r_c/t + W r_t
+  Eigen::VectorXd inv_t, inv_lam;       // m: 1/t, 1/λ (0 where absent) of the iterate
   Eigen::VectorXd wc, gc, dd;           // nc: W̃, g̃, ∇d Δu (and d(u))
   Eigen::VectorXd psi_l, psi_u;         // ns: Ψ⁻¹
   Eigen::VectorXd l;                    // n: right-hand side / solution of the reduced system
