@@ -10,6 +10,7 @@
 
 #include "core/ocp_qp_io.hpp"
 #include "core/qp_condensed_dense.hpp"
+#include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "qp_dense_reference.hpp"
 #include "qp_problems.hpp"
@@ -552,6 +553,108 @@ OcpQp small_qp() {
   s.absent_side = 0.0;
   return testing_qp::random_qp(s, 51);
 }
+
+// --- Dense IPM (core/qp_dense_ipm) on condensed QPs: the Riccati IPM's algorithm at N = 0. ---
+
+// The condensed (one-stage, state-free) QP of qp, as QpCondensedDense poses it.
+OcpQp condensed(const OcpQp& qp) {
+  QpCondensedDense dense(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  dense.solve(qp, sol);  // condenses and embeds x0
+  return dense.condensed_qp();
+}
+
+class DenseIpmQp : public ::testing::TestWithParam<Case> {};
+
+TEST_P(DenseIpmQp, MatchesCertifiedDenseReferenceAndRiccatiIpm) {
+  const Case& c = GetParam();
+  RandomQpSpec s = c.spec;
+  if (c.seed % 2 == 0) {  // pure ℓ1, SPEC §5.3-sized weights, one-sided
+    s.pure_l1 = true;
+    s.l1_scale = 1.45e4;
+    s.absent_side = 0.5;
+  }
+  const OcpQp qp = condensed(testing_qp::random_qp(s, c.seed));
+  ASSERT_EQ(qp.dims.N, 0);
+  ASSERT_EQ(qp.dims.nx[0], 0);
+  const OcpQpSolution sol = expect_matches_reference<QpDenseIpm>(qp);
+  // Same iteration as the Riccati IPM on the one-stage QP: same iterate up to rounding.
+  QpRiccatiIpm riccati(qp.dims, tight());
+  OcpQpSolution r(qp.dims);
+  ASSERT_EQ(riccati.solve(qp, r), QpStatus::success);
+  EXPECT_NEAR(sol.iterations, r.iterations, 1);
+  EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-8);
+  // Warm start from the solution of a perturbed QP: same solution, fewer iterations.
+  OcpQp qp2 = qp;
+  qp2.stage[0].r += 1e-3 * Eigen::VectorXd::Ones(qp.dims.nu[0]);
+  QpDenseIpm solver(qp.dims, tight());
+  OcpQpSolution cold(qp.dims), warm = sol;
+  ASSERT_EQ(solver.solve(qp2, cold), QpStatus::success);
+  ASSERT_EQ(solver.solve(qp2, warm, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_LE((warm.u[0] - cold.u[0]).lpNorm<Eigen::Infinity>(), 1e-7);
+  EXPECT_LT(warm.iterations, cold.iterations);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Sizes, DenseIpmQp,
+    ::testing::Values(Case{spec(3, 3, 3, 2, 2, 0.5), 201}, Case{spec(10, 4, 4, 1, 2, 0.5), 202},
+                      Case{spec(10, 6, 6, 2, 2, 0.3, true), 203},
+                      Case{spec(12, 2, 6, 2, 1, 0.3), 204}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      const RandomQpSpec& s = info.param.spec;
+      std::ostringstream name;
+      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
+      return name.str();
+    });
+
+TEST(QpDenseIpm, PendubotCondensedQp) {
+  const OcpQp qp = condensed(testing_qp::pendubot_qp());
+  const OcpQpSolution sol = expect_matches_reference<QpDenseIpm>(qp);
+  int active = 0;
+  active += (sol.lam_l[0].array() > 1e-6).count() + (sol.lam_u[0].array() > 1e-6).count();
+  EXPECT_GT(active, 0);
+}
+
+TEST(QpDenseIpm, FailureStatusesWithoutNan) {
+  // Only one-stage, state-free dims are accepted.
+  QpDenseIpm staged;
+  EXPECT_FALSE(staged.setup(OcpQpDims::uniform(3, 2, 1)));
+  OcpQpDims d1(0);
+  d1.nx[0] = 2;
+  d1.nu[0] = 1;
+  EXPECT_FALSE(staged.setup(d1));
+  const OcpQp qp = condensed(small_qp());
+  OcpQpSolution sol(qp.dims);
+  EXPECT_EQ(staged.solve(qp, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+
+  QpDenseIpm solver(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
+  OcpQp indefinite = qp;  // negative curvature beyond any barrier weight of the cold start
+  indefinite.stage[0].R = -1e4 * Eigen::MatrixXd::Identity(qp.dims.nu[0], qp.dims.nu[0]);
+  EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
+  EXPECT_TRUE(all_finite(sol));
+  OcpQp bad = qp;
+  bad.stage[0].D(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+  bad = qp;
+  bad.stage[0].idxbu[0] = qp.dims.nu[0];
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  // Inconsistent hard bounds on an input: infeasible, stops with a finite iterate.
+  OcpQp infeasible = qp;
+  infeasible.stage[0].lbu[0] = 1.0;
+  infeasible.stage[0].ubu[0] = -1.0;
+  const QpStatus st = solver.solve(infeasible, sol);
+  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
+  EXPECT_TRUE(all_finite(sol));
+  QpSettings few;
+  few.max_iterations = 1;
+  QpDenseIpm limited(qp.dims, few);
+  EXPECT_EQ(limited.solve(qp, sol), QpStatus::max_iterations);
+  EXPECT_TRUE(all_finite(sol));
+}
+
 
 TEST(QpRiccatiIpmFailure, InfeasibleHardConstraints) {
   OcpQp qp = small_qp();

@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "core/qp_condensed_dense.hpp"
+#include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "qp_random.hpp"
 
@@ -148,6 +149,43 @@ TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {
   }
   EXPECT_EQ(cold, QpStatus::success);
   EXPECT_EQ(prepared, QpStatus::success);
+  EXPECT_EQ(dual, QpStatus::success);
+  EXPECT_EQ(invalid, QpStatus::invalid_data);
+  EXPECT_EQ(failed, QpStatus::factorization_failed);
+}
+
+
+TEST(QpNoMalloc, DenseIpmSolveAllocatesNothing) {
+  testing_qp::RandomQpSpec spec;
+  spec.N = 10;
+  spec.nx_min = spec.nx_max = 4;
+  spec.nu = 1;
+  spec.ng_max = 2;
+  spec.soft_fraction = 0.5;
+  const OcpQp ocp = testing_qp::random_qp(spec, 79);
+  QpCondensedDense condenser(ocp.dims);
+  OcpQpSolution osol(ocp.dims);
+  ASSERT_EQ(condenser.solve(ocp, osol), QpStatus::success);
+  const OcpQp qp = condenser.condensed_qp();
+  OcpQp bad = qp;
+  bad.stage[0].R(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  OcpQp indefinite = qp;
+  indefinite.stage[0].R *= -1.0;
+
+  QpDenseIpm solver(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  QpStatus cold, primal, dual, invalid, failed;
+  {
+    NoMalloc guard;
+    cold = solver.solve(qp, sol);
+    primal = solver.solve(qp, sol, QpWarmStart::primal);
+    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
+    invalid = solver.solve(bad, sol);
+    failed = solver.solve(indefinite, sol);
+    EXPECT_EQ(NoMalloc::count(), 0);
+  }
+  EXPECT_EQ(cold, QpStatus::success);
+  EXPECT_EQ(primal, QpStatus::success);
   EXPECT_EQ(dual, QpStatus::success);
   EXPECT_EQ(invalid, QpStatus::invalid_data);
   EXPECT_EQ(failed, QpStatus::factorization_failed);
