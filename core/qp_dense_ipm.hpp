@@ -5,9 +5,10 @@
 //   min ½uᵀRu + rᵀu + Σ_j ½Zl s_l² + zl s_l + ½Zu s_u² + zu s_u
 //   s.t. lb − J_l s_l ≤ d(u) = [u[idxbu]; D u] ≤ ub + J_u s_u,   s ≥ 0 (where it matters).
 //
-// The algorithm is that of core/qp_riccati_ipm.hpp on such a QP, step for step (Mehrotra
+// The algorithm is that of core/qp_riccati_ipm.hpp on such a QP as of 0a53bf5 (Mehrotra
 // predictor-corrector, the same slack elimination, starting points, warm starts, iterative
-// refinement, tolerances and statuses; see the notation there), so the two agree to rounding.
+// refinement, tolerances and statuses; see the notation there) with the fixed step fraction;
+// the Riccati IPM's later step-length heuristic and centring floor (1867f26) are not ported yet.
 // Only the linear algebra differs: the reduced Hessian
 //   H̃ = R + Σ_box W̃_k e_k e_kᵀ + Dᵀ diag(W̃_g) D
 // is formed and Cholesky-factored in place with plain loops on the actual sizes (no padding,

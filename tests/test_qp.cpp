@@ -578,11 +578,10 @@ TEST_P(DenseIpmQp, MatchesCertifiedDenseReferenceAndRiccatiIpm) {
   ASSERT_EQ(qp.dims.N, 0);
   ASSERT_EQ(qp.dims.nx[0], 0);
   const OcpQpSolution sol = expect_matches_reference<QpDenseIpm>(qp);
-  // Same iteration as the Riccati IPM on the one-stage QP: same iterate up to rounding.
+  // Same solution as the Riccati IPM on the one-stage QP.
   QpRiccatiIpm riccati(qp.dims, tight());
   OcpQpSolution r(qp.dims);
   ASSERT_EQ(riccati.solve(qp, r), QpStatus::success);
-  EXPECT_NEAR(sol.iterations, r.iterations, 1);
   EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-8);
   // Warm start from the solution of a perturbed QP: same solution, fewer iterations.
   OcpQp qp2 = qp;
