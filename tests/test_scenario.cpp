@@ -36,6 +36,26 @@ Scenario parse_ok(const std::string& body) {
   return sc ? *sc : Scenario{};
 }
 
+// mi_helix_slow (the 60 s headless speed check of the README) is mi_helix at half speed: same
+// arena, obstacles and reference curve, so mi_helix's clearance checks below cover it.
+TEST(Scenario, ShippedMiHelixSlowIsMiHelixAtHalfSpeed) {
+  std::string error;
+  const auto fast = load_scenario(kMiHelix, error);
+  ASSERT_TRUE(fast) << error;
+  const auto slow = load_scenario(MIXPILOT_SOURCE_DIR "/scenarios/mi_helix_slow.toml", error);
+  ASSERT_TRUE(slow) << error;
+  EXPECT_EQ(slow->duration, 2 * fast->duration);
+  ASSERT_EQ(slow->arena.obstacles.size(), fast->arena.obstacles.size());
+  for (std::size_t k = 0; k < fast->arena.obstacles.size(); ++k) {
+    EXPECT_EQ(slow->arena.obstacles[k].center, fast->arena.obstacles[k].center);
+    EXPECT_EQ(slow->arena.obstacles[k].radius, fast->arena.obstacles[k].radius);
+  }
+  EXPECT_EQ(slow->arena.min, fast->arena.min);
+  EXPECT_EQ(slow->arena.max, fast->arena.max);
+  for (double t = 0; t <= fast->duration; t += 0.5)  // the rates are rounded to 5 digits
+    EXPECT_LE((slow->reference.position(2 * t) - fast->reference.position(t)).norm(), 1e-3) << t;
+}
+
 TEST(Scenario, ShippedMiHelixLoads) {
   std::string error;
   const auto sc = load_scenario(kMiHelix, error);
