@@ -161,15 +161,14 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     }
     // s ≥ 0 is implied at the optimum when z = 0 < Z (stationarity gives s = λ/Z ≥ 0); imposing
     // it would make s·λ_s = 0 degenerate (both → 0 like √μ) for every inactive ℓ2²-soft side.
-    // Every slack stays in the iteration, also on a side whose bound is absent (there it only
-    // meets s ≥ 0): the cold start puts λ_s on the slack's stationarity, which is what pure ℓ1
-    // sides (Z = 0) need. Solving such decoupled sides in closed form and dropping them from the
-    // iteration saved 1–3 iterations but let μ collapse before stationarity converged on an
-    // active obstacle constraint (SQP in test_obstacles ended with factorization_failed), so
-    // the slive/sfix machinery below is kept with every side live until that is understood.
+    // A slack whose bound side is absent is decoupled from everything else: min ½Z s² + z s over
+    // s ≥ 0, solved in closed form (s = max(0, −z/Z), s = 0 for Z = 0) and kept out of the
+    // iteration ("dead"). (Keeping them live had masked the μ collapse that the centring floor
+    // of the solve loop now prevents.)
     const int os = w.off_s[i];
     for (int j = 0; j < ns; ++j) {
-      constexpr bool live_l = true, live_u = true;
+      const int k = s.idxs[j];
+      const bool live_l = w.mask[om + k] != 0.0, live_u = w.mask[om + nc + k] != 0.0;
       w.slive[os + j] = live_l ? 1.0 : 0.0;
       w.slive[os + ns + j] = live_u ? 1.0 : 0.0;
       w.sfix[os + j] = live_l || s.Zl[j] <= 0.0 ? 0.0 : std::max(0.0, -s.zl[j] / s.Zl[j]);
