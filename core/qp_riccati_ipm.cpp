@@ -672,6 +672,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
     // end; the predictor only sets σ and the second-order term and is never refined.
     const bool refine = mu_ < qp_defaults::kRefineMuRatio * cfg.tol_comp;
     newton_direction(qp, w.m_total == 0, refine);
+    double target = 0.0;  // centring target of the corrector
     if (w.m_total > 0) {
       double a_aff = max_step(w.t, w.dt, 1.0);
       a_aff = max_step(w.lam, w.dlam, a_aff);
@@ -684,7 +685,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       // buys nothing, and once μ is there while stationarity still converges (the solve's error
       // grows with W = λ/t ~ λ²/μ), driving μ on to 1e-20 and below ruins the Newton directions
       // (SQP on an exact-penalty obstacle constraint ended in factorization_failed).
-      const double target = std::max(sigma * mu_, qp_defaults::kCentringFloor * cfg.tol_comp);
+      target = std::max(sigma * mu_, qp_defaults::kCentringFloor * cfg.tol_comp);
       w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
                                  Eigen::VectorXd::Constant(w.t.size(), target));
       newton_direction(qp, true, refine);
@@ -694,7 +695,25 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       status = QpStatus::nan_detected;
       break;
     }
-    const double alpha = step_length(w, cfg.step_fraction, cfg.tol_comp);
+    double alpha = step_length(w, cfg.step_fraction, cfg.tol_comp);
+    if (w.m_total > 0 && target <= cfg.tol_comp && alpha >= qp_defaults::kFinalStepMin) {
+      // Would this step end the solve? Linear residuals shrink to (1 − α) of theirs.
+      const double left = 1.0 - alpha;
+      const double mu_plus =
+          (w.lam + alpha * w.dlam).dot(w.t + alpha * w.dt) / static_cast<double>(w.m_total);
+      if (mu_plus > cfg.tol_comp && left * res_stat_ <= cfg.tol_stat &&
+          left * res_eq_ <= cfg.tol_eq && left * res_ineq_ <= cfg.tol_ineq) {
+        // Only μ would miss: correct with the corrector's own second-order term Δλ∘Δt.
+        w.rc = w.mask.cwiseProduct(w.lam.cwiseProduct(w.t) + w.dlam.cwiseProduct(w.dt) -
+                                   Eigen::VectorXd::Constant(w.t.size(), target));
+        newton_direction(qp, true, refine);
+        if (!std::isfinite(w.dv.sum() + w.dpi.sum() + w.ds.sum() + w.dt.sum() + w.dlam.sum())) {
+          status = QpStatus::nan_detected;
+          break;
+        }
+        alpha = step_length(w, cfg.step_fraction, cfg.tol_comp);
+      }
+    }
     if (alpha < cfg.min_step) {
       status = QpStatus::min_step;
       break;

@@ -23,6 +23,11 @@ inline constexpr double kStepFraction = 0.995;
 inline constexpr double kStepCentrality = 0.01;
 // Mehrotra's centring target σμ is floored at kCentringFloor · tol_comp (see the solver).
 inline constexpr double kCentringFloor = 0.1;
+// A step that aims below tol_comp, is at least kFinalStepMin long (so the linear residuals
+// shrink to (1 − α) of theirs and would pass) but leaves μ above tol_comp gets one more
+// corrector with the corrector's own second-order term (Carpenter et al. 1993): one more
+// solve instead of one more iteration.
+inline constexpr double kFinalStepMin = 0.9;
 // The solve stops with min_step when the step length falls below this.
 inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
