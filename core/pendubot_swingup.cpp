@@ -255,8 +255,10 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
   if (c.vec("terminal_weights", wn, non_negative)) oc.terminal_weights = wn;
   const bool ref_given = c.string("reference", sc.reference_path, true);
   std::string qp;
-  if (c.choice("qp_solver", qp, {"condensed_dense", "riccati_ipm"})) {
-    oc.qp_solver = qp == "riccati_ipm" ? QpSolverKind::riccati_ipm : QpSolverKind::condensed_dense;
+  if (c.choice("qp_solver", qp, {"condensed_active_set", "condensed_dense", "riccati_ipm"})) {
+    oc.qp_solver = qp == "riccati_ipm"       ? QpSolverKind::riccati_ipm
+                   : qp == "condensed_dense" ? QpSolverKind::condensed_dense
+                                             : QpSolverKind::condensed_active_set;
   }
   c.finish();
 

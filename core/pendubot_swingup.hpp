@@ -43,8 +43,9 @@ struct PendubotOcpSettings {
   double slack_weight = pendubot_defaults::kSlackWeight;  // ρ, ℓ2² per side
   Eigen::Matrix<double, 5, 1> weights{3.0, 3.0, 1.0, 1.0, 5.0};  // W on (x, u)
   Eigen::Vector4d terminal_weights{3.0, 3.0, 1.0, 1.0};          // W_N on x
-  // QP of the RTI: condensing + dense IPM suits N = 10 with one input (SPEC §4).
-  QpSolverKind qp_solver = QpSolverKind::condensed_dense;
+  // QP of the RTI: condensing suits N = 10 with one input (SPEC §4); the warm-started active set
+  // confirms the previous step's active set in one or two factorizations (IPM as fallback).
+  QpSolverKind qp_solver = QpSolverKind::condensed_active_set;
 };
 
 class PendubotSwingup {

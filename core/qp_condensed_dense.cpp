@@ -59,6 +59,8 @@ bool QpCondensedDense::setup(const OcpQpDims& dims, const Settings& settings) {
   Settings inner = settings;
   inner.check_data = false;  // the OCP-QP itself is checked before condensing
   if (!ipm_.setup(c, inner)) return false;
+  if (method_ == CondensedQpMethod::active_set && !active_set_.setup(c, inner)) return false;
+  ipm_fallbacks_ = 0;
   ready_ = true;
   return true;
 }
@@ -425,6 +427,19 @@ QpStatus QpCondensedDense::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStar
   if (!prepared) condense(qp);
   embed_x0(qp);
   if (warm != QpWarmStart::cold) warm_start(sol, warm);
+  if (method_ == CondensedQpMethod::active_set) {
+    QpSettings& as = active_set_.settings();
+    as = settings_;
+    as.check_data = false;
+    const QpStatus status = active_set_.solve(w.cqp, w.csol, warm);
+    if (status == QpStatus::success) {
+      recover(qp, sol);
+      sol.status = status;
+      return status;
+    }
+    ++ipm_fallbacks_;  // the IPM from the same warm start
+    if (warm != QpWarmStart::cold) warm_start(sol, warm);
+  }
   QpSettings& inner = ipm_.settings();
   inner = settings_;
   inner.check_data = false;

@@ -21,12 +21,20 @@
 //   π_{i−1} = Q_i x_i + S_iᵀu_i + q_i + A_iᵀπ_i + ∇_x d_iᵀ(λ_u,i − λ_l,i),
 // so the OcpQpSolution is complete and its KKT residuals equal those of the condensed QP.
 //
+// The dense QP is solved by the IPM, or (CondensedQpMethod::active_set) by the warm-started
+// primal-dual active-set method of core/qp_dense_active_set.hpp, which in closed loop confirms
+// the previous active set with one or two factorizations; whenever it fails (iteration limit,
+// dependent active rows, unsupported slack weights) the IPM solves the QP from the same warm
+// start.
+//
 // setup() sizes every buffer; prepare() and solve() allocate nothing.
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "core/ocp_qp.hpp"
+#include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
 #include "core/qp_solver.hpp"
 
@@ -58,15 +66,28 @@ struct QpCondensedDenseWorkspace {
   OcpQpSolution csol;          // its solution (and warm start)
 };
 
+enum class CondensedQpMethod {
+  ipm,         // QpDenseIpm
+  active_set,  // QpDenseActiveSet, QpDenseIpm as fallback
+};
+
 class QpCondensedDense final : public QpSolver {
  public:
   using Settings = QpSettings;
   using Workspace = QpCondensedDenseWorkspace;
 
   QpCondensedDense() = default;
-  explicit QpCondensedDense(const OcpQpDims& dims, const Settings& settings = {}) {
+  explicit QpCondensedDense(const OcpQpDims& dims, const Settings& settings = {},
+                            CondensedQpMethod method = CondensedQpMethod::ipm)
+      : method_(method) {
     setup(dims, settings);
   }
+
+  // Dense QP method of the following setup() calls.
+  void set_method(CondensedQpMethod method) { method_ = method; }
+  CondensedQpMethod method() const { return method_; }
+  // Number of solves the active-set method handed over to the IPM since setup().
+  std::int64_t ipm_fallbacks() const { return ipm_fallbacks_; }
 
   bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
   // Condenses the Hessian, the x0-free linear terms and the constraint rows of qp.
@@ -88,6 +109,9 @@ class QpCondensedDense final : public QpSolver {
   Settings settings_{};
   Workspace ws_{};
   QpDenseIpm ipm_;
+  QpDenseActiveSet active_set_;
+  CondensedQpMethod method_ = CondensedQpMethod::ipm;
+  std::int64_t ipm_fallbacks_ = 0;
   bool ready_ = false;
   bool prepared_ = false;  // condense() done by prepare() for the next solve()
 };

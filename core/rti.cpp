@@ -54,6 +54,9 @@ bool RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   if (!dims.valid()) return false;
   qp_.resize(dims);
   qp_sol_.resize(dims);
+  qp_dense_.set_method(settings.qp_solver == QpSolverKind::condensed_active_set
+                           ? CondensedQpMethod::active_set
+                           : CondensedQpMethod::ipm);
   if (!qp_solver().setup(dims, settings.qp)) return false;
 
   // Constant parts of the QP: index lists and slack weights.

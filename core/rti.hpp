@@ -37,7 +37,7 @@ struct RtiSettings {
   QpRiccatiIpmSettings qp{};
   // Primal-dual warm start of the QP from the previous (shifted) QP solution.
   bool qp_warm_start = rti_defaults::kQpWarmStart;
-  // QP solver variant; condensed_dense condenses the Hessian in prepare() (no x̄_0 needed).
+  // QP solver variant; condensed_* condense the Hessian in prepare() (no x̄_0 needed).
   QpSolverKind qp_solver = rti_defaults::kQpSolver;
 };
 
@@ -125,12 +125,12 @@ class RtiSolver {
   OcpQp qp_;
   OcpQpSolution qp_sol_;
   QpSolver& qp_solver() {
-    return settings_.qp_solver == QpSolverKind::condensed_dense
+    return settings_.qp_solver != QpSolverKind::riccati_ipm
                ? static_cast<QpSolver&>(qp_dense_)
                : static_cast<QpSolver&>(qp_riccati_);
   }
   QpRiccatiIpm qp_riccati_;    // set up when settings.qp_solver == riccati_ipm
-  QpCondensedDense qp_dense_;  // set up when settings.qp_solver == condensed_dense
+  QpCondensedDense qp_dense_;  // set up when settings.qp_solver is condensed_*
   RtiWorkspace ws_;
   const SelectionOutput* selection_output_ = nullptr;    // fast Gauss-Newton path, or null
   const SelectionOutput* selection_terminal_ = nullptr;  // likewise for the terminal output

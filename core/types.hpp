@@ -81,6 +81,8 @@ inline constexpr bool kQpWarmStart = true;
 enum class QpSolverKind {
   riccati_ipm,      // structure-exploiting Riccati IPM: O(N) per iteration, any horizon
   condensed_dense,  // condensing + dense IPM: short horizons (≲ 10–20 stages, few inputs)
+  condensed_active_set,  // condensing + warm-started dense active set (IPM fallback): short
+                         // horizons in closed loop, where the active set rarely changes
 };
 namespace rti_defaults {
 inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm;

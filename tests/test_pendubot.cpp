@@ -53,6 +53,7 @@ TEST(Pendubot, ShippedScenarioSwingsUpAndHolds) {
   EXPECT_FALSE(sc.sensor.quantization);
   EXPECT_EQ(sc.controller.N, 10);
   EXPECT_EQ(sc.controller.dt, 0.002);
+  EXPECT_EQ(sc.controller.qp_solver, QpSolverKind::condensed_active_set);
   expect_swings_up_and_holds(sc);
 }
 
