@@ -29,6 +29,7 @@ bool QpDenseActiveSet::setup(const OcpQpDims& dims, const Settings& settings) {
   const int n = w.n, ng = w.ng, nc = w.nc;
   w.Dt = Eigen::MatrixXd::Zero(n, ng);
   w.len = Eigen::VectorXi::Zero(ng);
+  w.row_norm = Eigen::VectorXd::Ones(ng);
   w.box = Eigen::VectorXi::Zero(w.nb);
   w.soft_of = Eigen::VectorXi::Constant(nc, -1);
   w.bnd = w.Zs = w.zs = w.lam = Eigen::VectorXd::Zero(2 * nc);
@@ -56,6 +57,9 @@ bool QpDenseActiveSet::load(const OcpQpStage& st) {
       if (col[c] != 0.0) len = c + 1;
     }
     w.len[k] = len;
+    double nrm = 0.0;
+    for (int c = 0; c < len; ++c) nrm += col[c] * col[c];
+    w.row_norm[k] = nrm > 0.0 ? std::sqrt(nrm) : 1.0;
   }
   for (int k = 0; k < nb; ++k) w.box[k] = st.idxbu[k];
   for (int k = 0; k < nc; ++k) {
@@ -165,7 +169,10 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     const int k = s < nc ? s : s - nc;
     if (k >= nb || state[s] != kHold) continue;
     const int c = w.box[k];
-    if (fixed[c] >= 0) return QpStatus::min_step;  // two bounds on one variable
+    if (fixed[c] >= 0) {  // two bounds on one variable: drop this one, as a dependent row
+      w.state[s] = kInactive;
+      return QpStatus::min_step;
+    }
     fixed[c] = s;
     u[c] = w.bnd[s];
   }
@@ -251,8 +258,12 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
         const double yq = Y[q + std::ptrdiff_t(p) * n];
         scale += yq * yq;
       }
-      if (!(piv > 1e-12 * scale) || !std::isfinite(piv))
-        return QpStatus::min_step;  // dependent rows in hold
+      if (!(piv > 1e-12 * scale) || !std::isfinite(piv)) {
+        // Row p depends on the fixed variables and rows 0..p−1: drop it and solve again (if it
+        // was consistent with them it is implied; if not, the states cycle to max_iterations).
+        w.state[hold[p]] = kInactive;
+        return QpStatus::min_step;
+      }
       const double d = std::sqrt(piv), inv = 1.0 / d;
       sp[p] = d;
       for (int r = p + 1; r < nh; ++r) sp[r] *= inv;
@@ -320,6 +331,8 @@ bool QpDenseActiveSet::update_states() {
   const double tol_p = settings_.tol_ineq, tol_d = settings_.tol_stat;
   int* state = w.state.data();
   bool moved = false;
+  int add = -1;  // the most violated inactive general side that would go to hold
+  double add_v = 0.0;
   for (int s = 0; s < 2 * nc; ++s) {
     if (!w.present[s]) continue;
     const int k = s < nc ? s : s - nc;
@@ -328,7 +341,14 @@ bool QpDenseActiveSet::update_states() {
     const double lam = w.lam[s], z = w.zs[s];
     int next = state[s];
     if (state[s] == kInactive) {
-      if (v > tol_p) next = soft && z <= 0.0 ? kPenalty : kHold;
+      if (v > tol_p) {
+        next = soft && z <= 0.0 ? kPenalty : kHold;
+        if (next == kHold && k >= w.nb) {
+          const double scaled = v / w.row_norm[k - w.nb];
+          if (scaled > add_v) add_v = scaled, add = s;
+          next = kInactive;
+        }
+      }
     } else if (state[s] == kHold) {
       if (lam < -tol_d)
         next = kInactive;
@@ -339,6 +359,12 @@ bool QpDenseActiveSet::update_states() {
     }
     moved = moved || next != state[s];
     state[s] = next;
+  }
+  // General rows enter the hold set one at a time (most violated first, relative to ‖a‖): all at
+  // once, the violated rows of a cold start are typically dependent.
+  if (add >= 0) {
+    state[add] = kHold;
+    moved = true;
   }
   return moved;
 }
@@ -431,6 +457,7 @@ QpStatus QpDenseActiveSet::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStar
   while (it < settings_.max_iterations) {
     ++it;
     status = solve_states(st);
+    if (status == QpStatus::min_step && it < settings_.max_iterations) continue;  // row dropped
     if (status != QpStatus::success) break;
     if (!update_states()) break;  // no state moved: KKT point
     status = QpStatus::max_iterations;

@@ -18,17 +18,20 @@
 // in hold enter through their Schur complement (A_h H̃_FF⁻¹ A_hᵀ) — then moves every side whose
 // state the solution contradicts (violated inactive side → hold (penalty if z = 0); hold side
 // with λ < 0 → inactive, with λ > z → penalty; penalty side with v < 0 → hold (inactive if
-// z = 0)), with the tolerances tol_ineq on v and tol_stat on λ. When no state moves, the
+// z = 0)), with the tolerances tol_ineq on v and tol_stat on λ; violated general rows enter the
+// hold set one per iteration (the most violated relative to ‖a‖), since the many rows a cold
+// start violates are typically dependent. When no state moves, the
 // iterate is the exact KKT point of the QP (residuals at rounding level), complementarity holds
 // by construction. Warm start: the states are read from the solution passed in (multipliers and
 // slacks), so in closed loop, where the active set rarely changes, one iteration — one
 // factorization — confirms it.
 //
-// The method is not globally convergent (it may cycle on adversarial QPs): it stops after
-// max_iterations with max_iterations, or with factorization_failed (H̃_FF not positive
-// definite), min_step (hold rows linearly dependent or two bounds fixing one variable: typically
-// infeasible hard constraints) or invalid_data (also for negative slack weights, which it does
-// not support); the caller then falls back to QpDenseIpm (QpCondensedDense does). The solution
+// A hold row that is linearly dependent on the others (or a second bound fixing a variable) is
+// dropped and the iteration repeated. The method is not globally convergent (it may cycle on
+// adversarial QPs): it stops after max_iterations with max_iterations (min_step if the last
+// iteration dropped a row: typically infeasible hard constraints), factorization_failed (H̃_FF
+// not positive definite) or invalid_data (also for negative slack weights, which it does not
+// support); the caller then falls back to QpDenseIpm (QpCondensedDense does). The solution
 // argument then holds the last finite iterate, never NaN.
 //
 // setup() sizes every buffer; solve() allocates nothing, throws nothing, prints nothing.
@@ -44,6 +47,7 @@ struct QpDenseActiveSetWorkspace {
   int n = 0, nb = 0, ng = 0, nc = 0, ns = 0;
   Eigen::MatrixXd Dt;       // n x ng: Dᵀ (row k of D contiguous)
   Eigen::VectorXi len;      // ng: 1 + index of the last nonzero of row k of D
+  Eigen::VectorXd row_norm; // ng: ‖row k of D‖₂ (1 for a zero row)
   Eigen::VectorXi box;      // nb: variable of each box
   Eigen::VectorXi soft_of;  // nc: slack j of row k, or −1
   Eigen::VectorXd bnd;      // 2 nc: [lb; ub], 0 where absent

@@ -74,24 +74,26 @@ TEST(NoMalloc, RtiPrepareFeedbackShift) {
 }
 
 TEST(NoMalloc, RtiPrepareFeedbackShiftCondensedDense) {
-  CrazyflieTracking problem(10, 0.015);  // a short horizon, where condensing pays
-  RtiSolver rti;
-  RtiSettings settings;
-  settings.qp_solver = QpSolverKind::condensed_dense;
-  ASSERT_TRUE(rti.setup(problem.ocp(), settings));
-  problem.set_hover_target(rti.data(), {0.1, -0.1, 0.5});
-  problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
-  Eigen::VectorXd x = problem.model().hover_state({0, 0, 0.4});
-  Eigen::VectorXd u(4);
-  for (int k = 0; k < 5; ++k) {
-    NoMalloc guard;
-    ASSERT_EQ(rti.prepare(), RtiStatus::success);
-    ASSERT_EQ(rti.feedback(x), RtiStatus::success);
-    u = rti.control();
-    rti.shift();
-    x(2) += 0.01;  // a new measurement
+  for (QpSolverKind kind : {QpSolverKind::condensed_dense, QpSolverKind::condensed_active_set}) {
+    CrazyflieTracking problem(10, 0.015);  // a short horizon, where condensing pays
+    RtiSolver rti;
+    RtiSettings settings;
+    settings.qp_solver = kind;
+    ASSERT_TRUE(rti.setup(problem.ocp(), settings));
+    problem.set_hover_target(rti.data(), {0.1, -0.1, 0.5});
+    problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
+    Eigen::VectorXd x = problem.model().hover_state({0, 0, 0.4});
+    Eigen::VectorXd u(4);
+    for (int k = 0; k < 5; ++k) {
+      NoMalloc guard;
+      ASSERT_EQ(rti.prepare(), RtiStatus::success);
+      ASSERT_EQ(rti.feedback(x), RtiStatus::success);
+      u = rti.control();
+      rti.shift();
+      x(2) += 0.01;  // a new measurement
+    }
+    EXPECT_TRUE(u.allFinite());
   }
-  EXPECT_TRUE(u.allFinite());
 }
 
 }  // namespace

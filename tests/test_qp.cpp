@@ -10,6 +10,7 @@
 
 #include "core/ocp_qp_io.hpp"
 #include "core/qp_condensed_dense.hpp"
+#include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "qp_dense_reference.hpp"
@@ -654,6 +655,231 @@ TEST(QpDenseIpm, FailureStatusesWithoutNan) {
   EXPECT_TRUE(all_finite(sol));
 }
 
+
+// --- Dense active set (core/qp_dense_active_set) on condensed QPs, and inside QpCondensedDense. ---
+
+// QpCondensedDense with the active-set method, constructible like the other solvers.
+class CondensedActiveSet final : public QpSolver {
+ public:
+  explicit CondensedActiveSet(const OcpQpDims& dims, const QpSettings& settings = {})
+      : inner_(dims, settings, CondensedQpMethod::active_set) {}
+  bool setup(const OcpQpDims& dims, const QpSettings& settings) override {
+    return inner_.setup(dims, settings);
+  }
+  void prepare(const OcpQp& qp) override { inner_.prepare(qp); }
+  QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
+                 QpWarmStart warm = QpWarmStart::cold) override {
+    return inner_.solve(qp, sol, warm);
+  }
+  QpSettings& settings() override { return inner_.settings(); }
+  const QpSettings& settings() const override { return inner_.settings(); }
+  const OcpQpDims& dims() const override { return inner_.dims(); }
+  const QpCondensedDense& inner() const { return inner_; }
+
+ private:
+  QpCondensedDense inner_;
+};
+
+// The random OCP-QP of case c (pure ℓ1, one-sided, for even seeds) with x0 shifted by dx0.
+OcpQp random_case(const Case& c, double dx0 = 0.0) {
+  RandomQpSpec s = c.spec;
+  if (c.seed % 2 == 0) {
+    s.pure_l1 = true;
+    s.l1_scale = 1.45e4;
+    s.absent_side = 0.5;
+  }
+  OcpQp qp = testing_qp::random_qp(s, c.seed);
+  qp.x0 += dx0 * Eigen::VectorXd::Ones(qp.x0.size());
+  return qp;
+}
+
+class DenseActiveSetQp : public ::testing::TestWithParam<Case> {};
+
+// Hard input bounds and soft (ℓ2², ℓ1 or both) general rows, the structure of the Pendubot QP,
+// where the active set converges from a cold start too. (Hard general rows can make it cycle
+// from a cold start: see HardGeneralRowsFailCleanly; QpCondensedDense then uses the IPM.)
+TEST_P(DenseActiveSetQp, MatchesCertifiedDenseReferenceColdAndWarm) {
+  const Case& c = GetParam();
+  // Cold: the exact KKT point of the condensed QP, the IPM's solution.
+  const OcpQp qp = condensed(random_case(c));
+  const OcpQpSolution sol = expect_matches_reference<QpDenseActiveSet>(qp, tight());
+  QpDenseIpm ipm(qp.dims, tight());
+  OcpQpSolution r(qp.dims);
+  ASSERT_EQ(ipm.solve(qp, r), QpStatus::success);
+  EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-7);
+  // Warm from that solution on the QP of a changed x0 (the closed-loop case): the same
+  // solution as a cold solve, certified, in fewer iterations.
+  const OcpQp qp2 = condensed(random_case(c, 0.05));
+  const OcpQpSolution cold2 = expect_matches_reference<QpDenseActiveSet>(qp2, tight());
+  QpDenseActiveSet solver(qp2.dims, tight());
+  OcpQpSolution warm = sol;
+  ASSERT_EQ(solver.solve(qp2, warm, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_LE((warm.u[0] - cold2.u[0]).lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_LE(warm.iterations, cold2.iterations);
+  const Kkt k = kkt_residuals(qp2, warm);
+  EXPECT_LE(k.max(), 1e-8);
+  // Warm from its own solution: one iteration confirms the active set.
+  ASSERT_EQ(solver.solve(qp2, warm, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_EQ(warm.iterations, 1);
+  OcpQpSolution primal = sol;
+  ASSERT_EQ(solver.solve(qp2, primal, QpWarmStart::primal), QpStatus::success);
+  EXPECT_LE((primal.u[0] - cold2.u[0]).lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Sizes, DenseActiveSetQp,
+    ::testing::Values(Case{spec(1, 2, 2, 1, 1, 1.0), 301}, Case{spec(3, 3, 3, 2, 2, 1.0), 303},
+                      Case{spec(5, 4, 4, 1, 1, 1.0), 305}, Case{spec(10, 4, 4, 1, 2, 1.0), 307},
+                      Case{spec(10, 6, 6, 2, 2, 1.0, true), 309},
+                      Case{spec(12, 2, 6, 2, 1, 1.0), 311}, Case{spec(10, 4, 4, 1, 2, 1.0), 313},
+                      Case{spec(20, 5, 5, 1, 2, 1.0), 315}, Case{spec(10, 4, 4, 1, 2, 0.5), 304}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      const RandomQpSpec& s = info.param.spec;
+      std::ostringstream name;
+      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
+      return name.str();
+    });
+
+class CondensedActiveSetQp : public ::testing::TestWithParam<Case> {};
+
+TEST_P(CondensedActiveSetQp, MatchesCertifiedDenseReferenceColdAndWarm) {
+  const Case& c = GetParam();
+  const OcpQp qp = random_case(c);
+  const OcpQpSolution sol = expect_matches_reference<CondensedActiveSet>(qp, dense_tight());
+  // Warm start with a changed x0 through the OCP-QP solution (as RtiSolver does).
+  const OcpQp qp2 = random_case(c, 0.05);
+  const OcpQpSolution cold2 = expect_matches_reference<CondensedActiveSet>(qp2, dense_tight());
+  CondensedActiveSet solver(qp2.dims, dense_tight());
+  OcpQpSolution warm = sol;
+  solver.prepare(qp2);
+  ASSERT_EQ(solver.solve(qp2, warm, QpWarmStart::primal_dual), QpStatus::success);
+  double dx = 0;
+  for (int i = 0; i <= qp2.dims.N; ++i)
+    dx = std::max(dx, (warm.x[i] - cold2.x[i]).lpNorm<Eigen::Infinity>());
+  EXPECT_LE(dx, 1e-8);
+  EXPECT_LE(kkt_residuals(qp2, warm).max(), 1e-8);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Sizes, CondensedActiveSetQp,
+    ::testing::Values(Case{spec(3, 3, 3, 2, 2, 0.5), 311}, Case{spec(10, 4, 4, 1, 2, 0.5), 312},
+                      Case{spec(10, 6, 6, 2, 2, 0.3, true), 313},
+                      Case{spec(20, 5, 5, 1, 2, 1.0), 314}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      const RandomQpSpec& s = info.param.spec;
+      std::ostringstream name;
+      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
+      return name.str();
+    });
+
+TEST(QpDenseActiveSet, HardGeneralRowsFailCleanly) {
+  // Random QPs with hard state rows, cold: either the certified solution or a failure status
+  // with a finite iterate (the caller's cue to fall back to the IPM).
+  int solved = 0;
+  for (unsigned seed = 321; seed < 329; ++seed) {
+    const OcpQp qp = condensed(random_case(Case{spec(10, 4, 4, 2, 2, 0.3), seed}));
+    QpDenseActiveSet solver(qp.dims, tight());
+    OcpQpSolution sol(qp.dims);
+    const QpStatus st = solver.solve(qp, sol);
+    EXPECT_TRUE(all_finite(sol));
+    if (st != QpStatus::success) {
+      EXPECT_TRUE(st == QpStatus::max_iterations || st == QpStatus::min_step) << to_string(st);
+      continue;
+    }
+    ++solved;
+    EXPECT_LE(kkt_residuals(qp, sol).max(), 1e-8) << "seed " << seed;
+    QpDenseIpm ipm(qp.dims, tight());
+    OcpQpSolution r(qp.dims);
+    ASSERT_EQ(ipm.solve(qp, r), QpStatus::success);
+    EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-7) << "seed " << seed;
+  }
+  RecordProperty("solved", solved);
+}
+
+TEST(QpDenseActiveSet, PendubotQpColdAndWarmWithChangedX0) {
+  const OcpQp ocp = testing_qp::pendubot_qp();
+  const OcpQp qp = condensed(ocp);
+  const OcpQpSolution sol = expect_matches_reference<QpDenseActiveSet>(qp, tight());
+  int active = 0;
+  active += (sol.lam_l[0].array() > 1e-6).count() + (sol.lam_u[0].array() > 1e-6).count();
+  EXPECT_GT(active, 0);
+  OcpQp ocp2 = ocp;
+  ocp2.x0 += 0.02 * Eigen::VectorXd::Ones(ocp.x0.size());
+  const OcpQp qp2 = condensed(ocp2);
+  const OcpQpSolution cold2 = expect_matches_reference<QpDenseActiveSet>(qp2, tight());
+  QpDenseActiveSet solver(qp2.dims, tight());
+  OcpQpSolution warm = sol;
+  ASSERT_EQ(solver.solve(qp2, warm, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_LE((warm.u[0] - cold2.u[0]).lpNorm<Eigen::Infinity>(), 1e-9);
+  EXPECT_LE(warm.iterations, 2);
+  EXPECT_LE(kkt_residuals(qp2, warm).max(), 1e-8);
+  // And through QpCondensedDense on the OCP-QP.
+  expect_matches_reference<CondensedActiveSet>(ocp2, dense_tight());
+}
+
+TEST(QpDenseActiveSet, FailureStatusesWithoutNan) {
+  QpDenseActiveSet staged;
+  EXPECT_FALSE(staged.setup(OcpQpDims::uniform(3, 2, 1)));
+  const OcpQp qp = condensed(testing_qp::pendubot_qp());
+  OcpQpSolution sol(qp.dims);
+  EXPECT_EQ(staged.solve(qp, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+
+  QpDenseActiveSet solver(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
+  ASSERT_GT(sol.iterations, 1);  // some constraint is active
+  OcpQp indefinite = qp;
+  indefinite.stage[0].R = -Eigen::MatrixXd::Identity(qp.dims.nu[0], qp.dims.nu[0]);
+  EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
+  EXPECT_TRUE(all_finite(sol));
+  OcpQp bad = qp;
+  bad.stage[0].D(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+  bad = qp;
+  bad.stage[0].idxbu[0] = qp.dims.nu[0];
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+  // Inconsistent hard bounds on an input: both sides end in hold on one variable.
+  OcpQp infeasible = qp;
+  infeasible.stage[0].lbu[0] = 1.0;
+  infeasible.stage[0].ubu[0] = -1.0;
+  const QpStatus st = solver.solve(infeasible, sol);
+  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
+  EXPECT_TRUE(all_finite(sol));
+  QpSettings few;
+  few.max_iterations = 1;
+  QpDenseActiveSet limited(qp.dims, few);
+  EXPECT_EQ(limited.solve(qp, sol), QpStatus::max_iterations);
+  EXPECT_TRUE(all_finite(sol));
+  // Negative slack weights are not supported.
+  OcpQp negative = qp;
+  negative.stage[0].zl[0] = -1.0;
+  EXPECT_EQ(solver.solve(negative, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+}
+
+TEST(QpCondensedDense, ActiveSetFallsBackToTheIpm) {
+  // A negative ℓ1 weight (unsupported by the active set) and an iteration limit of the active
+  // set's size: the IPM solves the QP, to the same solution as the IPM variant.
+  OcpQp qp = testing_qp::pendubot_qp();
+  qp.stage[3].zl[0] = -1.0;
+  QpCondensedDense ipm(qp.dims, tight());
+  OcpQpSolution r(qp.dims);
+  ASSERT_EQ(ipm.solve(qp, r), QpStatus::success);
+  CondensedActiveSet solver(qp.dims, tight());
+  OcpQpSolution sol(qp.dims);
+  ASSERT_EQ(solver.solve(qp, sol, QpWarmStart::cold), QpStatus::success);
+  EXPECT_EQ(solver.inner().ipm_fallbacks(), 1);
+  EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_TRUE(all_finite(sol));
+  QpCondensedDense failing(qp.dims, QpSettings{}, CondensedQpMethod::active_set);
+  OcpQp indefinite = qp;
+  for (auto& st : indefinite.stage) st.R *= -1e4;
+  EXPECT_EQ(failing.solve(indefinite, sol), QpStatus::factorization_failed);
+  EXPECT_EQ(failing.ipm_fallbacks(), 1);
+  EXPECT_TRUE(all_finite(sol));
+}
 
 TEST(QpRiccatiIpmFailure, InfeasibleHardConstraints) {
   OcpQp qp = small_qp();

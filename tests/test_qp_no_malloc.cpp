@@ -8,8 +8,10 @@
 #include <cstdlib>
 
 #include "core/qp_condensed_dense.hpp"
+#include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "qp_problems.hpp"
 #include "qp_random.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -154,6 +156,41 @@ TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {
   EXPECT_EQ(failed, QpStatus::factorization_failed);
 }
 
+TEST(QpNoMalloc, CondensedActiveSetPrepareAndSolveAllocateNothing) {
+  // QpDenseActiveSet inside QpCondensedDense, warm starts, and the IPM fallback.
+  const OcpQp qp = testing_qp::pendubot_qp();
+  OcpQp moved = qp;
+  moved.x0 += 0.02 * Eigen::VectorXd::Ones(qp.x0.size());
+  OcpQp negative = qp;  // a negative ℓ1 weight: the active set hands over to the IPM
+  negative.stage[3].zl[0] = -1.0;
+  OcpQp indefinite = qp;
+  for (auto& s : indefinite.stage) s.R *= -1e4;
+
+  QpCondensedDense solver(qp.dims, QpSettings{}, CondensedQpMethod::active_set);
+  QpDenseActiveSet dense(solver.condensed_qp().dims);
+  OcpQpSolution sol(qp.dims), dsol(solver.condensed_qp().dims);
+  QpStatus cold, warm, primal, fallback, failed, dcold, dwarm;
+  {
+    NoMalloc guard;
+    cold = solver.solve(qp, sol);
+    solver.prepare(moved);
+    warm = solver.solve(moved, sol, QpWarmStart::primal_dual);
+    primal = solver.solve(qp, sol, QpWarmStart::primal);
+    fallback = solver.solve(negative, sol, QpWarmStart::primal_dual);
+    failed = solver.solve(indefinite, sol);
+    dcold = dense.solve(solver.condensed_qp(), dsol);
+    dwarm = dense.solve(solver.condensed_qp(), dsol, QpWarmStart::primal_dual);
+    EXPECT_EQ(NoMalloc::count(), 0);
+  }
+  EXPECT_EQ(cold, QpStatus::success);
+  EXPECT_EQ(warm, QpStatus::success);
+  EXPECT_EQ(primal, QpStatus::success);
+  EXPECT_EQ(fallback, QpStatus::success);
+  EXPECT_EQ(failed, QpStatus::factorization_failed);
+  EXPECT_EQ(solver.ipm_fallbacks(), 2);
+  EXPECT_EQ(dcold, QpStatus::factorization_failed);  // the indefinite QP, condensed last
+  EXPECT_EQ(dwarm, QpStatus::factorization_failed);
+}
 
 TEST(QpNoMalloc, DenseIpmSolveAllocatesNothing) {
   testing_qp::RandomQpSpec spec;
