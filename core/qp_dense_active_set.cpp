@@ -27,9 +27,8 @@ bool QpDenseActiveSet::setup(const OcpQpDims& dims, const Settings& settings) {
   w.nc = w.nb + w.ng;
   w.ns = dims.ns[0];
   const int n = w.n, ng = w.ng, nc = w.nc;
-  w.Dt = Eigen::MatrixXd::Zero(n, ng);
-  w.len = Eigen::VectorXi::Zero(ng);
-  w.row_norm = Eigen::VectorXd::Ones(ng);
+  w.D = nullptr;
+  w.dl = Eigen::VectorXd::Zero(ng);
   w.box = Eigen::VectorXi::Zero(w.nb);
   w.soft_of = Eigen::VectorXi::Constant(nc, -1);
   w.bnd = w.Zs = w.zs = w.lam = Eigen::VectorXd::Zero(2 * nc);
@@ -47,20 +46,9 @@ bool QpDenseActiveSet::setup(const OcpQpDims& dims, const Settings& settings) {
 
 bool QpDenseActiveSet::load(const OcpQpStage& st) {
   Workspace& w = ws_;
-  const int n = w.n, nb = w.nb, ng = w.ng, nc = w.nc, ns = w.ns;
+  const int nb = w.nb, nc = w.nc, ns = w.ns;
   const double big = settings_.inf_bound;
-  for (int k = 0; k < ng; ++k) {
-    double* col = w.Dt.data() + std::ptrdiff_t(k) * n;
-    int len = 0;
-    for (int c = 0; c < n; ++c) {
-      col[c] = st.D(k, c);
-      if (col[c] != 0.0) len = c + 1;
-    }
-    w.len[k] = len;
-    double nrm = 0.0;
-    for (int c = 0; c < len; ++c) nrm += col[c] * col[c];
-    w.row_norm[k] = nrm > 0.0 ? std::sqrt(nrm) : 1.0;
-  }
+  w.D = st.D.data();
   for (int k = 0; k < nb; ++k) w.box[k] = st.idxbu[k];
   for (int k = 0; k < nc; ++k) {
     w.soft_of[k] = -1;
@@ -99,12 +87,12 @@ void QpDenseActiveSet::initialize(const OcpQpStage& st, const OcpQpSolution& sol
   // (a soft side with a positive slack in penalty).
   const double* u = sol.u[0].data();
   for (int k = 0; k < nc; ++k) {
-    double dk = 0.0;
-    if (k < nb) {
+    double dk = 0.0;  // d_k(u), for the primal warm start
+    if (warm == QpWarmStart::primal && k < nb) {
       dk = u[w.box[k]];
-    } else {
-      const double* a = w.Dt.data() + std::ptrdiff_t(k - nb) * n;
-      for (int c = 0; c < w.len[k - nb]; ++c) dk += a[c] * u[c];
+    } else if (warm == QpWarmStart::primal) {
+      const double* a = w.D + (k - nb);  // row k − nb of D, stride ng
+      for (int c = 0; c < n; ++c) dk += a[std::ptrdiff_t(c) * w.ng] * u[c];
     }
     const int j = w.soft_of[k];
     for (int side = 0; side < 2; ++side) {
@@ -152,13 +140,14 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
       H[c + std::ptrdiff_t(c) * n] += Z;
       g[c] += gc;
     } else {
-      const double* a = w.Dt.data() + std::ptrdiff_t(k - nb) * n;
-      const int len = w.len[k - nb];
-      for (int c = 0; c < len; ++c) {
-        const double za = Z * a[c];
+      const double* a = w.D + (k - nb);  // row k − nb of D, stride ng
+      const int ng = w.ng;
+      for (int c = 0; c < n; ++c) {
+        const double ac = a[std::ptrdiff_t(c) * ng];
+        if (ac == 0.0) continue;  // condensed state rows are causal: trailing zeros
         double* hc = H + std::ptrdiff_t(c) * n;
-        for (int r = 0; r < len; ++r) hc[r] += za * a[r];
-        g[c] += gc * a[c];
+        for (int r = 0; r < n; ++r) hc[r] += Z * ac * a[std::ptrdiff_t(r) * ng];
+        g[c] += gc * ac;
       }
     }
   }
@@ -229,12 +218,13 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     const int ldS = static_cast<int>(w.S.outerStride());
     for (int h = 0; h < nh; ++h) {
       const int s = hold[h], k = (s < nc ? s : s - nc) - nb;
-      const double* a = w.Dt.data() + std::ptrdiff_t(k) * n;
+      const double* a = w.D + k;  // row k of D, stride ng
+      const std::ptrdiff_t ng = w.ng;
       double* yh = Y + std::ptrdiff_t(h) * n;
       double b = w.bnd[s];
       for (int x = 0; x < n; ++x)
-        if (fixed[x] >= 0) b -= a[x] * u[x];
-      for (int p = 0; p < nf; ++p) yh[p] = a[F[p]];
+        if (fixed[x] >= 0) b -= a[x * ng] * u[x];
+      for (int p = 0; p < nf; ++p) yh[p] = a[F[p] * ng];
       forward(yh);
       double r = -b;
       for (int p = 0; p < nf; ++p) r += yh[p] * y[p];
@@ -296,11 +286,15 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
   double* dd = w.d.data();
   double* lam = w.lam.data();
   for (int k = 0; k < nb; ++k) dd[k] = u[w.box[k]];
-  for (int k = 0; k < w.ng; ++k) {
-    const double* a = w.Dt.data() + std::ptrdiff_t(k) * n;
-    double v = 0.0;
-    for (int c = 0; c < w.len[k]; ++c) v += a[c] * u[c];
-    dd[nb + k] = v;
+  {
+    const int ng = w.ng;
+    double* dg = dd + nb;
+    for (int k = 0; k < ng; ++k) dg[k] = 0.0;
+    for (int c = 0; c < n; ++c) {  // D u as axpys over the columns of D
+      const double uc = u[c];
+      const double* col = w.D + std::ptrdiff_t(c) * ng;
+      for (int k = 0; k < ng; ++k) dg[k] += col[k] * uc;
+    }
   }
   for (int s = 0; s < 2 * nc; ++s) {
     const int k = s < nc ? s : s - nc;
@@ -316,7 +310,7 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     for (int r = 0; r < n; ++r) v += H[c + std::ptrdiff_t(r) * n] * u[r];  // H̃ symmetric
     for (int h = 0; h < nh; ++h) {
       const int k = (hold[h] < nc ? hold[h] : hold[h] - nc) - nb;
-      v += w.Dt(c, k) * nu[h];
+      v += w.D[k + std::ptrdiff_t(c) * w.ng] * nu[h];
     }
     lam[fixed[c]] = fixed[c] < nc ? v : -v;
   }
@@ -344,7 +338,13 @@ bool QpDenseActiveSet::update_states() {
       if (v > tol_p) {
         next = soft && z <= 0.0 ? kPenalty : kHold;
         if (next == kHold && k >= w.nb) {
-          const double scaled = v / w.row_norm[k - w.nb];
+          const double* a = w.D + (k - w.nb);
+          double nrm = 0.0;
+          for (int c = 0; c < w.n; ++c) {
+            const double ac = a[std::ptrdiff_t(c) * w.ng];
+            nrm += ac * ac;
+          }
+          const double scaled = nrm > 0.0 ? v / std::sqrt(nrm) : v;
           if (scaled > add_v) add_v = scaled, add = s;
           next = kInactive;
         }
@@ -388,13 +388,10 @@ void QpDenseActiveSet::write_solution(const OcpQpStage& st, OcpQpSolution& sol) 
     const double ll = w.lam[k], lu = w.lam[nc + k];
     sol.lam_l[0][k] = ll;
     sol.lam_u[0][k] = lu;
-    const double dl = lu - ll;
-    if (k < nb) {
-      grad[w.box[k]] += dl;
-    } else {
-      const double* a = w.Dt.data() + std::ptrdiff_t(k - nb) * n;
-      for (int c = 0; c < w.len[k - nb]; ++c) grad[c] += a[c] * dl;
-    }
+    if (k < nb)
+      grad[w.box[k]] += lu - ll;
+    else
+      w.dl[k - nb] = lu - ll;
     const int j = w.soft_of[k];
     for (int side = 0; side < 2; ++side) {
       const int s = side * nc + k;
@@ -422,7 +419,12 @@ void QpDenseActiveSet::write_solution(const OcpQpStage& st, OcpQpSolution& sol) 
     f += (0.5 * st.Zl[j] * sl + st.zl[j]) * sl + (0.5 * st.Zu[j] * su + st.zu[j]) * su;
   }
   double res_stat = 0.0;
-  for (int c = 0; c < n; ++c) res_stat = std::max(res_stat, std::abs(grad[c]));
+  for (int c = 0; c < n; ++c) {  // + Dᵀ(λ_u − λ_l) of the general rows
+    const double* col = w.D + std::ptrdiff_t(c) * w.ng;
+    double v = 0.0;
+    for (int k = 0; k < w.ng; ++k) v += col[k] * w.dl[k];
+    res_stat = std::max(res_stat, std::abs(grad[c] + v));
+  }
   sol.objective = f;
   sol.res_stat = res_stat;
   sol.res_eq = 0.0;  // no equality constraints

@@ -45,9 +45,7 @@ namespace mixpilot {
 struct QpDenseActiveSetWorkspace {
   OcpQpDims dims;
   int n = 0, nb = 0, ng = 0, nc = 0, ns = 0;
-  Eigen::MatrixXd Dt;       // n x ng: Dᵀ (row k of D contiguous)
-  Eigen::VectorXi len;      // ng: 1 + index of the last nonzero of row k of D
-  Eigen::VectorXd row_norm; // ng: ‖row k of D‖₂ (1 for a zero row)
+  const double* D = nullptr;  // the QP's D (ng x n, column-major), during solve()
   Eigen::VectorXi box;      // nb: variable of each box
   Eigen::VectorXi soft_of;  // nc: slack j of row k, or −1
   Eigen::VectorXd bnd;      // 2 nc: [lb; ub], 0 where absent
@@ -65,6 +63,7 @@ struct QpDenseActiveSetWorkspace {
   Eigen::MatrixXd Y;        // n x ng: L⁻¹ a_h (nf x nh used)
   Eigen::MatrixXd S;        // ng x ng: YᵀY, then its Cholesky factor
   Eigen::VectorXd u, y, nu, grad;  // n, n, ng, n
+  Eigen::VectorXd dl;              // ng: λ_u − λ_l of the general rows
 };
 
 class QpDenseActiveSet final : public QpSolver {
