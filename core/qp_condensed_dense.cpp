@@ -296,23 +296,37 @@ void QpCondensedDense::embed_x0(const OcpQp& qp) {
 void QpCondensedDense::warm_start(const OcpQpSolution& sol, QpWarmStart warm) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
-  const int nbu_c = w.cdims.nbu[0], nc_c = w.cdims.nc(0);
+  const int nbu_c = w.cdims.nbu[0];
   OcpQpSolution& c = w.csol;
+  const bool dual = warm == QpWarmStart::primal_dual;
+  double* U = c.u[0].data();
+  double *sl = c.sl[0].data(), *su = c.su[0].data();
+  double *ll = c.lam_l[0].data(), *lu = c.lam_u[0].data();
+  double *lsl = c.lam_sl[0].data(), *lsu = c.lam_su[0].data();
   for (int i = 0; i <= d.N; ++i) {
-    const int nbu = d.nbu[i], nc = d.nc(i), ns = d.ns[i], s0 = w.off_s[i];
-    c.u[0].segment(w.off_u[i], d.nu[i]) = sol.u[i];
-    c.sl[0].segment(s0, ns) = sol.sl[i];
-    c.su[0].segment(s0, ns) = sol.su[i];
-    if (warm != QpWarmStart::primal_dual) continue;
-    for (int k = 0; k < nc; ++k) {
-      const int kc = k < nbu ? w.off_bu[i] + k : nbu_c + w.off_g[i] + (k - nbu);
-      c.lam_l[0][kc] = sol.lam_l[i][k];
-      c.lam_u[0][kc] = sol.lam_u[i][k];
+    const int nu = d.nu[i], nbu = d.nbu[i], nc = d.nc(i), ns = d.ns[i], s0 = w.off_s[i];
+    for (int j = 0; j < nu; ++j) U[w.off_u[i] + j] = sol.u[i].data()[j];
+    for (int j = 0; j < ns; ++j) {
+      sl[s0 + j] = sol.sl[i].data()[j];
+      su[s0 + j] = sol.su[i].data()[j];
     }
-    c.lam_sl[0].segment(s0, ns) = sol.lam_sl[i];
-    c.lam_su[0].segment(s0, ns) = sol.lam_su[i];
+    if (!dual) continue;
+    const double* li = sol.lam_l[i].data();
+    const double* ui = sol.lam_u[i].data();
+    const int b0 = w.off_bu[i], g0 = nbu_c + w.off_g[i] - nbu;
+    for (int k = 0; k < nbu; ++k) {
+      ll[b0 + k] = li[k];
+      lu[b0 + k] = ui[k];
+    }
+    for (int k = nbu; k < nc; ++k) {
+      ll[g0 + k] = li[k];
+      lu[g0 + k] = ui[k];
+    }
+    for (int j = 0; j < ns; ++j) {
+      lsl[s0 + j] = sol.lam_sl[i].data()[j];
+      lsu[s0 + j] = sol.lam_su[i].data()[j];
+    }
   }
-  (void)nc_c;
 }
 
 void QpCondensedDense::recover(const OcpQp& qp, OcpQpSolution& sol) {

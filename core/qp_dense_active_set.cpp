@@ -36,7 +36,7 @@ bool QpDenseActiveSet::setup(const OcpQpDims& dims, const Settings& settings) {
   w.d = Eigen::VectorXd::Zero(nc);
   w.H = w.L = Eigen::MatrixXd::Zero(n, n);
   w.g = w.u = w.y = w.grad = Eigen::VectorXd::Zero(n);
-  w.fixed = w.freev = Eigen::VectorXi::Zero(n);
+  w.fixed = w.freev = w.fixv = Eigen::VectorXi::Zero(n);
   w.hold = Eigen::VectorXi::Zero(nc);
   w.Y = Eigen::MatrixXd::Zero(n, ng);
   w.S = Eigen::MatrixXd::Zero(ng, ng);
@@ -166,17 +166,21 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     u[c] = w.bnd[s];
   }
   int* F = w.freev.data();
-  int nf = 0;
-  for (int c = 0; c < n; ++c)
-    if (fixed[c] < 0) F[nf++] = c;
+  int* X = w.fixv.data();
+  int nf = 0, nx = 0;
+  for (int c = 0; c < n; ++c) {
+    if (fixed[c] < 0)
+      F[nf++] = c;
+    else
+      X[nx++] = c;
+  }
   // y = −(g_F + H_FX u_X); L = chol(H_FF) in place, column by column.
   double* y = w.y.data();
   double* L = w.L.data();
   for (int p = 0; p < nf; ++p) {
     const int c = F[p];
     double v = g[c];
-    for (int x = 0; x < n; ++x)
-      if (fixed[x] >= 0) v += H[c + std::ptrdiff_t(x) * n] * u[x];
+    for (int q = 0; q < nx; ++q) v += H[c + std::ptrdiff_t(X[q]) * n] * u[X[q]];
     y[p] = -v;
     for (int q = p; q < nf; ++q) L[q + std::ptrdiff_t(p) * n] = H[F[q] + std::ptrdiff_t(c) * n];
   }
@@ -222,8 +226,7 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
       const std::ptrdiff_t ng = w.ng;
       double* yh = Y + std::ptrdiff_t(h) * n;
       double b = w.bnd[s];
-      for (int x = 0; x < n; ++x)
-        if (fixed[x] >= 0) b -= a[x * ng] * u[x];
+      for (int q = 0; q < nx; ++q) b -= a[X[q] * ng] * u[X[q]];
       for (int p = 0; p < nf; ++p) yh[p] = a[F[p] * ng];
       forward(yh);
       double r = -b;
@@ -304,8 +307,8 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
   for (int h = 0; h < nh; ++h) lam[hold[h]] = hold[h] < nc ? -nu[h] : nu[h];
   // Fixed variables: the box multiplier closes the stationarity of their row,
   // ν_c = −(H̃ u + g̃ + Σ_h a_h ν_h)_c.
-  for (int c = 0; c < n; ++c) {
-    if (fixed[c] < 0) continue;
+  for (int q = 0; q < nx; ++q) {
+    const int c = X[q];
     double v = g[c];
     for (int r = 0; r < n; ++r) v += H[c + std::ptrdiff_t(r) * n] * u[r];  // H̃ symmetric
     for (int h = 0; h < nh; ++h) {

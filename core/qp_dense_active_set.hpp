@@ -59,6 +59,7 @@ struct QpDenseActiveSetWorkspace {
   Eigen::MatrixXd L;        // n x n: Cholesky factor of H̃_FF (nf x nf used)
   Eigen::VectorXi fixed;    // n: side index (0..2nc) of the box fixing variable c, or −1
   Eigen::VectorXi freev;    // n: free variables
+  Eigen::VectorXi fixv;     // n: fixed variables
   Eigen::VectorXi hold;     // nc: sides of general rows in hold
   Eigen::MatrixXd Y;        // n x ng: L⁻¹ a_h (nf x nh used)
   Eigen::MatrixXd S;        // ng x ng: YᵀY, then its Cholesky factor
