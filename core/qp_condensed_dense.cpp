@@ -56,6 +56,9 @@ bool QpCondensedDense::setup(const OcpQpDims& dims, const Settings& settings) {
   w.dl = Eigen::VectorXd::Zero(nc_max);
   w.cqp.resize(c);
   w.csol.resize(c);
+  w.uniform = N > 0 && dims.nu[N] == 0;
+  for (int i = 0; i <= N; ++i)
+    w.uniform = w.uniform && dims.nx[i] == dims.nx[0] && (i == N || dims.nu[i] == dims.nu[0]);
   Settings inner = settings;
   inner.check_data = false;  // the OCP-QP itself is checked before condensing
   if (!ipm_.setup(c, inner)) return false;
@@ -146,6 +149,61 @@ int ld(const Eigen::MatrixXd& M) { return static_cast<int>(M.outerStride()); }
 
 }  // namespace
 
+// The backward recursion for stages k < N and the Γ recursion when every stage has nx = NX and
+// nu = NU (nu_N = 0): the same formulas with compile-time sizes, so every product with A, B, P
+// is an unrolled fixed-size product and only the M, H, Γ blocks have a runtime dimension.
+template <int NX, int NU>
+void condense_fixed(const OcpQp& qp, QpCondensedDenseWorkspace& w, double* H, int ldH) {
+  using MX = Eigen::Matrix<double, NX, NX>;
+  using MB = Eigen::Matrix<double, NX, NU>;
+  using VX = Eigen::Matrix<double, NX, 1>;
+  using VU = Eigen::Matrix<double, NU, 1>;
+  using Stride = Eigen::OuterStride<>;
+  using Rows = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, NX>, 0, Stride>;
+  const int N = w.dims.N, nU = w.cdims.nu[0], ldM = ld(w.M);
+  for (int k = N - 1; k >= 0; --k) {
+    const OcpQpStage& s = qp.stage[k];
+    const int r0 = w.off_u[k], r1 = w.off_u[k + 1], nr = nU - r1;
+    const Eigen::Map<const MX> A(s.A.data());
+    const Eigen::Map<const MB> B(s.B.data());
+    const Eigen::Map<const VX> b(s.b.data());
+    const Eigen::Map<const MX> P(w.P.data());  // nx_max = NX: P is NX x NX
+    const Eigen::Map<const VX> p(w.p.data());
+    const MX PA = P * A;
+    const MB PB = P * B;
+    const VX pb = p + P * b;
+    const Rows Mn(w.M.data() + r1, nr, NX, Stride(ldM));
+    Eigen::Map<Eigen::Matrix<double, NU, NU>, 0, Stride>(H + r0 + std::ptrdiff_t(r0) * ldH,
+                                                         Stride(ldH)) =
+        Eigen::Map<const Eigen::Matrix<double, NU, NU>>(s.R.data()) + B.transpose() * PB;
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, NU>, 0, Stride>(
+        H + r1 + std::ptrdiff_t(r0) * ldH, nr, NU, Stride(ldH))
+        .noalias() = Mn.lazyProduct(B);
+    Eigen::Map<VU>(w.h.data() + r0) = Eigen::Map<const VU>(s.r.data()) + B.transpose() * pb;
+    Eigen::Map<Eigen::VectorXd>(w.h.data() + r1, nr).noalias() += Mn.lazyProduct(b);
+    Eigen::Map<VX>(w.p1.data()) = Eigen::Map<const VX>(s.q.data()) + A.transpose() * pb;
+    // (an NU x NX block with stride ldM; a 1 x NX Eigen matrix would be row-major, so by hand)
+    const Eigen::Matrix<double, NU, NX> Mk =
+        Eigen::Map<const Eigen::Matrix<double, NU, NX>>(s.S.data()) + PB.transpose() * A;
+    for (int j = 0; j < NX; ++j)
+      for (int i = 0; i < NU; ++i) w.M1.data()[r0 + i + std::ptrdiff_t(j) * ldM] = Mk(i, j);
+    Rows(w.M1.data() + r1, nr, NX, Stride(ldM)).noalias() = Mn.lazyProduct(A);
+    if (k > 0) Eigen::Map<MX>(w.P1.data()) = Eigen::Map<const MX>(s.Q.data()) + A.transpose() * PA;
+    std::swap(w.P, w.P1);
+    std::swap(w.M, w.M1);
+    std::swap(w.p, w.p1);
+  }
+  for (int i = 0; i < N; ++i) {  // Γ_{i+1} = [A_i Γ_i, B_i, 0] (Γ_i is NX x nU, ld NX)
+    const int c0 = w.off_u[i];
+    const Eigen::Map<const MX> A(qp.stage[i].A.data());
+    Eigen::Map<Eigen::Matrix<double, NX, Eigen::Dynamic>> G1(w.Gam[i + 1].data(), NX, nU);
+    G1.leftCols(c0).noalias() =
+        A.lazyProduct(Eigen::Map<const Eigen::Matrix<double, NX, Eigen::Dynamic>>(
+            w.Gam[i].data(), NX, c0));
+    G1.template middleCols<NU>(c0) = Eigen::Map<const MB>(qp.stage[i].B.data());
+  }
+}
+
 // Everything of the condensed QP that does not depend on x0: Hessian, x0-free gradient h, the
 // x0 → gradient map M_0, the constraint rows, input bounds and slack data.
 void QpCondensedDense::condense(const OcpQp& qp) {
@@ -168,7 +226,13 @@ void QpCondensedDense::condense(const OcpQp& qp) {
       copy(nu, nu, s.R.data(), nu, H + r0 + std::ptrdiff_t(r0) * ldH, ldH);
     }
   }
-  for (int k = N - 1; k >= 0; --k) {
+  // Uniform stage dims with a compile-time instance below: the fixed-size recursions.
+  bool fixed = true;
+  if (w.uniform && d.nx[0] == 4 && d.nu[0] == 1)  // the Pendubot (SPEC §5.1)
+    condense_fixed<4, 1>(qp, w, H, ldH);
+  else
+    fixed = false;
+  for (int k = fixed ? -1 : N - 1; k >= 0; --k) {
     const OcpQpStage& s = qp.stage[k];
     const int nx = d.nx[k], nx1 = d.nx[k + 1], nu = d.nu[k];
     const int r0 = w.off_u[k], r1 = w.off_u[k + 1], nr = nU - r1;
@@ -211,7 +275,7 @@ void QpCondensedDense::condense(const OcpQp& qp) {
   for (int c = 1; c < nU; ++c)
     for (int r = 0; r < c; ++r) H[r + std::ptrdiff_t(c) * ldH] = H[c + std::ptrdiff_t(r) * ldH];
   // Γ_{i+1} = A_i Γ_i + B_i E_i (columns of u_0..u_{i−1}, then B_i; the rest stays zero).
-  for (int i = 0; i < N; ++i) {
+  for (int i = 0; i < (fixed ? 0 : N); ++i) {
     const OcpQpStage& s = qp.stage[i];
     const int c0 = w.off_u[i], nx = d.nx[i], nx1 = d.nx[i + 1];
     Eigen::MatrixXd& G1 = w.Gam[i + 1];

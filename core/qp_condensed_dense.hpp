@@ -16,7 +16,8 @@
 // and the linear terms (for x0 = 0; b enters here) p_k, h_k likewise; the gradient is then
 // h_0 + M_0 x0. x0 enters only that gradient and the state rows' bounds (via ξ), so prepare()
 // condenses everything else before x0 is known (the RTI preparation phase), and solve() adds the
-// O(N nx² + nU nx) x0 part. The multipliers are mapped back; the states are recovered by a forward
+// O(N nx² + nU nx) x0 part. When every stage has (nx, nu) = (4, 1) (the Pendubot), the backward
+// and Γ recursions run on compile-time-sized Eigen maps (40k -> 17.5k instructions per step). The multipliers are mapped back; the states are recovered by a forward
 // simulation (dynamics exact) and π_i, λ_x0 by the backward pass of the x-stationarity
 //   π_{i−1} = Q_i x_i + S_iᵀu_i + q_i + A_iᵀπ_i + ∇_x d_iᵀ(λ_u,i − λ_l,i),
 // so the OcpQpSolution is complete and its KKT residuals equal those of the condensed QP.
@@ -62,6 +63,7 @@ struct QpCondensedDenseWorkspace {
   Eigen::VectorXd gx;          // nx_max: x-stationarity of one stage (π recovery)
   Eigen::VectorXd gu;          // nu_max: scratch of the objective
   Eigen::VectorXd dl;          // nc_max: λ_u − λ_l of one stage
+  bool uniform = false;        // nx_i = nx_0, nu_i = nu_0 (i < N), nu_N = 0
   OcpQp cqp;                   // the condensed QP (dims cdims)
   OcpQpSolution csol;          // its solution (and warm start)
 };
