@@ -159,6 +159,26 @@ bool ocp_qp_indices_valid(const OcpQp& qp) {
   return true;
 }
 
+bool ocp_qp_dims_equal(const OcpQpDims& a, const OcpQpDims& b) {
+  return a.N == b.N && a.nx == b.nx && a.nu == b.nu && a.nbx == b.nbx && a.nbu == b.nbu &&
+         a.ng == b.ng && a.ns == b.ns;
+}
+
+bool ocp_qp_valid_for(const OcpQp& qp, const OcpQpDims& dims, bool check_data) {
+  return ocp_qp_dims_equal(qp.dims, dims) && ocp_qp_indices_valid(qp) &&
+         (!check_data || ocp_qp_data_finite(qp));
+}
+
+QpStatus OcpQpSolution::set_invalid_data() {
+  for (auto* vs : {&x, &u, &pi, &lam_l, &lam_u, &sl, &su, &lam_sl, &lam_su})
+    for (auto& v : *vs) v.setZero();
+  lam_x0.setZero();
+  iterations = 0;
+  objective = res_stat = res_eq = res_ineq = res_comp = 0.0;
+  status = QpStatus::invalid_data;
+  return status;
+}
+
 bool ocp_qp_data_finite(const OcpQp& qp) {
   if (!finite(qp.x0)) return false;
   for (int i = 0; i <= qp.dims.N; ++i) {

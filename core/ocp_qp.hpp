@@ -97,6 +97,11 @@ struct OcpQp {
 // constraints they index; no NaN/Inf in the data (bounds may be ±inf: absent sides, not NaN).
 bool ocp_qp_indices_valid(const OcpQp& qp);
 bool ocp_qp_data_finite(const OcpQp& qp);
+// Same sizes everywhere (N, nx, nu, nbx, nbu, ng, ns).
+bool ocp_qp_dims_equal(const OcpQpDims& a, const OcpQpDims& b);
+// The input check every solver starts with: qp has the setup dims, valid indices and, when
+// check_data, no NaN/Inf.
+bool ocp_qp_valid_for(const OcpQp& qp, const OcpQpDims& dims, bool check_data);
 
 enum class QpStatus {
   success,               // all residuals below their tolerances
@@ -141,6 +146,8 @@ struct OcpQpSolution {
   OcpQpSolution() = default;
   explicit OcpQpSolution(const OcpQpDims& d) { resize(d); }
   void resize(const OcpQpDims& d);  // sizes and zeroes everything
+  // A solver's answer to invalid input: every output zero, status invalid_data (returned).
+  QpStatus set_invalid_data();
 };
 
 }  // namespace mixpilot

@@ -487,21 +487,8 @@ QpStatus QpCondensedDense::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStar
   Workspace& w = ws_;
   const bool prepared = prepared_;
   prepared_ = false;
-  auto fail_invalid = [&] {
-    for (auto* vs : {&sol.x, &sol.u, &sol.pi, &sol.lam_l, &sol.lam_u, &sol.sl, &sol.su,
-                     &sol.lam_sl, &sol.lam_su})
-      for (auto& v : *vs) v.setZero();
-    sol.lam_x0.setZero();
-    sol.iterations = 0;
-    sol.objective = sol.res_stat = sol.res_eq = sol.res_ineq = sol.res_comp = 0.0;
-    sol.status = QpStatus::invalid_data;
-    return sol.status;
-  };
-  if (!ready_ || qp.dims.N != w.dims.N || qp.dims.nx != w.dims.nx || qp.dims.nu != w.dims.nu ||
-      qp.dims.nbx != w.dims.nbx || qp.dims.nbu != w.dims.nbu || qp.dims.ng != w.dims.ng ||
-      qp.dims.ns != w.dims.ns || !ocp_qp_indices_valid(qp))
-    return fail_invalid();
-  if (settings_.check_data && !ocp_qp_data_finite(qp)) return fail_invalid();
+  if (!ready_ || !ocp_qp_valid_for(qp, w.dims, settings_.check_data))
+    return sol.set_invalid_data();
   if (!prepared) condense(qp);
   embed_x0(qp);
   if (warm != QpWarmStart::cold) warm_start(sol, warm);
@@ -522,7 +509,7 @@ QpStatus QpCondensedDense::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStar
   inner = settings_;
   inner.check_data = false;
   const QpStatus status = ipm_.solve(w.cqp, w.csol, warm);
-  if (status == QpStatus::invalid_data) return fail_invalid();
+  if (status == QpStatus::invalid_data) return sol.set_invalid_data();
   recover(qp, sol);
   sol.status = status;
   return status;

@@ -414,22 +414,8 @@ void QpDenseIpm::newton_direction(const OcpQpStage& st, bool final, bool refine)
 
 QpStatus QpDenseIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
   Workspace& w = ws_;
-  auto fail_invalid = [&] {
-    for (auto* vs : {&sol.x, &sol.u, &sol.pi, &sol.lam_l, &sol.lam_u, &sol.sl, &sol.su,
-                     &sol.lam_sl, &sol.lam_su})
-      for (auto& v : *vs) v.setZero();
-    sol.lam_x0.setZero();
-    sol.iterations = 0;
-    sol.objective = sol.res_stat = sol.res_eq = sol.res_ineq = sol.res_comp = 0.0;
-    sol.status = QpStatus::invalid_data;
-    return sol.status;
-  };
-  if (!ready_ || qp.dims.N != w.dims.N || qp.dims.nx != w.dims.nx || qp.dims.nu != w.dims.nu ||
-      qp.dims.nbx != w.dims.nbx || qp.dims.nbu != w.dims.nbu || qp.dims.ng != w.dims.ng ||
-      qp.dims.ns != w.dims.ns)
-    return fail_invalid();
-  if (!ocp_qp_indices_valid(qp)) return fail_invalid();
-  if (settings_.check_data && !ocp_qp_data_finite(qp)) return fail_invalid();
+  if (!ready_ || !ocp_qp_valid_for(qp, w.dims, settings_.check_data))
+    return sol.set_invalid_data();
   const OcpQpStage& st = qp.stage[0];
   load(st);
   initialize(st, sol, warm);
