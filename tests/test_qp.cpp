@@ -134,6 +134,14 @@ void PrintTo(const Case& c, std::ostream* os) {
       << " ng<=" << c.spec.ng_max << " soft=" << c.spec.soft_fraction << " seed=" << c.seed;
 }
 
+// gtest parameter names of the random cases: N…_nx…_nu…_seed….
+std::string case_name(const ::testing::TestParamInfo<Case>& info) {
+  const RandomQpSpec& s = info.param.spec;
+  std::ostringstream name;
+  name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
+  return name.str();
+}
+
 class RandomQp : public ::testing::TestWithParam<Case> {};
 
 // tight() with the complementarity the primal comparison needs: on a degenerate pair (t and λ
@@ -218,12 +226,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{spec(40, 8, 8, 3, 2, 0.3), 9}, Case{spec(60, 3, 5, 1, 1, 0.3), 10},
                       Case{spec(60, 6, 6, 2, 0, 0.5), 11}, Case{spec(15, 12, 16, 4, 2, 0.5), 12},
                       Case{spec(25, 5, 5, 4, 3, 1.0), 13}, Case{spec(60, 4, 4, 2, 1, 0.0), 14}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      const RandomQpSpec& s = info.param.spec;
-      std::ostringstream name;
-      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
-      return name.str();
-    });
+    case_name);
 
 // Pure ℓ1 soft constraints (Zl = Zu = 0: the exact penalty of SPEC §5.3), half the bound sides
 // absent: a soft side without a bound has a slack decoupled from everything (cost z·s, s ≥ 0
@@ -475,12 +478,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{spec(5, 4, 4, 1, 1, 0.4), 103}, Case{spec(10, 4, 4, 1, 2, 0.5), 104},
                       Case{spec(10, 6, 6, 2, 2, 0.3, true), 105}, Case{spec(12, 2, 6, 2, 1, 0.3), 106},
                       Case{spec(20, 6, 6, 2, 1, 0.3), 109}, Case{spec(20, 5, 5, 1, 2, 1.0), 108}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      const RandomQpSpec& s = info.param.spec;
-      std::ostringstream name;
-      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
-      return name.str();
-    });
+    case_name);
 
 TEST(QpCondensedDense, PendubotQpAndPrepareSplit) {
   // The Pendubot QP (SPEC §5.1): the result equals the Riccati IPM's, and prepare() (before x0 is
@@ -600,12 +598,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{spec(3, 3, 3, 2, 2, 0.5), 201}, Case{spec(10, 4, 4, 1, 2, 0.5), 202},
                       Case{spec(10, 6, 6, 2, 2, 0.3, true), 203},
                       Case{spec(12, 2, 6, 2, 1, 0.3), 204}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      const RandomQpSpec& s = info.param.spec;
-      std::ostringstream name;
-      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
-      return name.str();
-    });
+    case_name);
 
 TEST(QpDenseIpm, PendubotCondensedQp) {
   const OcpQp qp = condensed(testing_qp::pendubot_qp());
@@ -733,12 +726,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{spec(10, 6, 6, 2, 2, 1.0, true), 309},
                       Case{spec(12, 2, 6, 2, 1, 1.0), 311}, Case{spec(10, 4, 4, 1, 2, 1.0), 313},
                       Case{spec(20, 5, 5, 1, 2, 1.0), 315}, Case{spec(10, 4, 4, 1, 2, 0.5), 304}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      const RandomQpSpec& s = info.param.spec;
-      std::ostringstream name;
-      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
-      return name.str();
-    });
+    case_name);
 
 class CondensedActiveSetQp : public ::testing::TestWithParam<Case> {};
 
@@ -765,12 +753,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{spec(3, 3, 3, 2, 2, 0.5), 311}, Case{spec(10, 4, 4, 1, 2, 0.5), 312},
                       Case{spec(10, 6, 6, 2, 2, 0.3, true), 313},
                       Case{spec(20, 5, 5, 1, 2, 1.0), 314}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      const RandomQpSpec& s = info.param.spec;
-      std::ostringstream name;
-      name << "N" << s.N << "_nx" << s.nx_max << "_nu" << s.nu << "_seed" << info.param.seed;
-      return name.str();
-    });
+    case_name);
 
 TEST(QpDenseActiveSet, HardGeneralRowsFailCleanly) {
   // Random QPs with hard state rows, cold: either the certified solution or a failure status
