@@ -628,11 +628,25 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
     return sol.set_invalid_data();
   load(qp);
   initialize(qp, sol, warm);
+  int it = 0;
+  QpStatus status = iterate(qp, settings_.max_iterations, it);
+  if (status == QpStatus::min_step && warm != QpWarmStart::cold) {
+    int it_cold = 0;
+    initialize(qp, sol, QpWarmStart::cold);
+    status = iterate(qp, settings_.max_iterations - it, it_cold);
+    it += it_cold;
+  }
+  sol.iterations = it;
+  write_solution(qp, sol);
+  sol.status = status;
+  return status;
+}
 
+QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it) {
+  Workspace& w = ws_;
   const Settings& cfg = settings_;
   QpStatus status = QpStatus::max_iterations;
-  int it = 0;
-  for (;; ++it) {
+  for (it = 0;; ++it) {
     residuals(qp);
     if (!(std::isfinite(res_stat_) && std::isfinite(res_eq_) && std::isfinite(res_ineq_) &&
           std::isfinite(mu_))) {
@@ -644,7 +658,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
       status = QpStatus::success;
       break;
     }
-    if (it >= cfg.max_iterations) {
+    if (it >= max_iterations) {
       status = QpStatus::max_iterations;
       break;
     }
@@ -710,9 +724,6 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
     w.t += alpha * w.dt;
     w.lam += alpha * w.dlam;
   }
-  sol.iterations = it;
-  write_solution(qp, sol);
-  sol.status = status;
   return status;
 }
 

@@ -93,6 +93,9 @@ class QpRiccatiIpm final : public QpSolver {
   // Solves qp (whose dims must equal the setup dims) into sol (sized with the same dims; read
   // as the warm start when requested). Never allocates, throws or prints. On any status other
   // than success, sol holds the last finite iterate (or zeros for invalid_data) and no NaN.
+  // A warm start that ends in min_step (an iterate far from the new problem's central path: a
+  // large λ on a constraint the new data violate, its t clipped to warm_start_floor) is
+  // restarted cold with the iterations left; sol.iterations counts both.
   QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
                  QpWarmStart warm = QpWarmStart::cold) override;
 
@@ -103,6 +106,9 @@ class QpRiccatiIpm final : public QpSolver {
  private:
   void load(const OcpQp& qp);
   void initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm);
+  // Mehrotra iterations from the initialized point until a status, at most max_iterations;
+  // `it` receives the number taken.
+  QpStatus iterate(const OcpQp& qp, int max_iterations, int& it);
   void linear_residual(const OcpQp& qp, const Eigen::VectorXd& v, const Eigen::VectorXd& pi,
                        const Eigen::VectorXd& s, const Eigen::VectorXd& lam,
                        const Eigen::VectorXd& g, const Eigen::VectorXd& z,

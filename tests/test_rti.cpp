@@ -106,6 +106,30 @@ TEST(RtiClosedLoop, CrazyflieStepSettles) {
   EXPECT_NEAR(rti.settle_time, sqp.settle_time, 0.3);
 }
 
+// A hard 1.5 m step (the reference jumps to the target at once) is beyond what one Gauss-Newton
+// step per sample can follow, and the vehicle tumbles; its QPs must still all be solved. The
+// primal-dual warm start from a trajectory that swings between samples used to end in min_step
+// at the first iteration (steps 44, 51, 57, 59: four fallbacks); QpRiccatiIpm now restarts such a
+// solve cold.
+TEST(RtiFailurePolicy, WarmStartFarFromTheNewQpDoesNotFallBack) {
+  CrazyflieTracking problem(kN, kDt);
+  RtiSolver rti;
+  ASSERT_TRUE(rti.setup(problem.ocp()));
+  problem.hover_guess(rti.trajectory(), Eigen::Vector3d(0, 0, 0.4));
+  problem.set_hover_target(rti.data(), Eigen::Vector3d(1, -1, 1));
+  models::Crazyflie::State x = problem.model().hover_state(Eigen::Vector3d(0, 0, 0.4)), xn;
+  for (int k = 0; k < 60; ++k) {  // plant: the model's own ERK4 step
+    rti.prepare();
+    rti.feedback(x);
+    EXPECT_EQ(rti.stats().status, RtiStatus::success)
+        << "step " << k << ": " << to_string(rti.stats().qp_status);
+    problem.integrator().step(x, models::Crazyflie::Input(rti.control()), kDt, xn);
+    x = xn;
+    rti.shift();
+  }
+  EXPECT_EQ(rti.stats().fallbacks, 0);
+}
+
 // A converged SQP iterate is only as stationary as its QPs: with weights as small as 1e-5 (SPEC
 // §5.2), the RTI default (1e-6) leaves primal errors ~1e-5, so fully converged runs tighten it.
 RtiSettings converged_settings() {
