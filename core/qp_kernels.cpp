@@ -514,4 +514,15 @@ void trsv_lt_small(int n, const double* dinv, int lddinv, double* x) {
 #endif
 }
 
+void trsv_lt_blocked(int n, const double* L, int ldl, const double* dinv, int lddinv, double* x) {
+  for (int jb = n - 4; jb >= 0; jb -= 4) {
+    if (jb + 4 < n) {
+      double t[4] = {0.0, 0.0, 0.0, 0.0};
+      gemv_t(n - jb - 4, 4, L + (jb + 4) + static_cast<ptrdiff_t>(jb) * ldl, ldl, x + jb + 4, t);
+      for (int r = 0; r < 4; ++r) x[jb + r] -= t[r];
+    }
+    trsv_lt_small(4, dinv + jb, lddinv, x + jb);
+  }
+}
+
 }  // namespace mixpilot::kernels

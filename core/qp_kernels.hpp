@@ -26,6 +26,9 @@ void trsv_lt(int n, const double* L, int ldl, const double* inv_diag, double* x)
 // x ← L⁻ᵀ x for n ≤ 4 from the inverse M of L (dinv as syrk_potrf_ln_padded stores it): x ← Mᵀx,
 // four independent dot products instead of a substitution chain.
 void trsv_lt_small(int n, const double* dinv, int lddinv, double* x);
+// Lᵀ x = b for n a multiple of 4, with the inverses of L's 4 x 4 diagonal blocks (as
+// trsv_ln): per block from the last, x_b ← M_bᵀ (x_b − L_{>b,b}ᵀ x_{>b}); no scalar chain.
+void trsv_lt_blocked(int n, const double* L, int ldl, const double* dinv, int lddinv, double* x);
 
 // Register-blocked (AVX2/FMA) variants on row-padded storage: all row counts are rounded up to
 // a multiple of 4, so every ld must be ≥ pad4(rows) and padding rows must be readable (inputs'

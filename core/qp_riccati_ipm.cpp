@@ -483,6 +483,9 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
       if (nu <= 4)  // the forward pass is a chain through the stages: no substitution chain
         kernels::trsv_lt_small(nu, w.Dinv[i].data(), static_cast<int>(w.Dinv[i].rows()),
                                du.data());
+      else if (nu % 4 == 0)
+        kernels::trsv_lt_blocked(nu, L.data(), static_cast<int>(L.rows()), w.Dinv[i].data(),
+                                 static_cast<int>(w.Dinv[i].rows()), du.data());
       else
         kernels::trsv_lt(nu, L.data(), static_cast<int>(L.rows()), w.inv_diag[i].data(),
                          du.data());
