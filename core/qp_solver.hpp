@@ -2,7 +2,9 @@
 // Common interface of the OCP-QP solvers (SPEC §4): the structure-exploiting Riccati IPM
 // (core/qp_riccati_ipm.hpp, the default, O(N) per iteration) and condensing + a dense IPM
 // (core/qp_condensed_dense.hpp, for short horizons, where the Riccati recursion's per-stage
-// overhead dominates). Both solve the OcpQp of core/ocp_qp.hpp to the same tolerances and
+// overhead dominates), and the Riccati IPM behind partial condensing of stage pairs
+// (core/qp_riccati_ipm_pairs.hpp, half the recursion's sequential steps). All solve the OcpQp of
+// core/ocp_qp.hpp to the same tolerances and
 // return the same OcpQpSolution layout, so RtiSolver can use either (RtiSettings::qp_solver).
 //
 // Contract of every implementation: setup() sizes every buffer (may allocate); prepare() and

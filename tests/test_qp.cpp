@@ -13,6 +13,7 @@
 #include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "core/qp_riccati_ipm_pairs.hpp"
 #include "qp_dense_reference.hpp"
 #include "qp_problems.hpp"
 #include "qp_random.hpp"
@@ -217,16 +218,28 @@ RandomQpSpec spec(int N, int nx_min, int nx_max, int nu, int ng_max, double soft
   return s;
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Sizes, RandomQp,
-    ::testing::Values(Case{spec(1, 2, 2, 1, 1, 0.5), 1}, Case{spec(1, 16, 16, 4, 2, 0.3, true), 2},
-                      Case{spec(2, 3, 3, 2, 0, 0.0), 3}, Case{spec(5, 4, 4, 1, 1, 0.4), 4},
-                      Case{spec(10, 6, 6, 3, 2, 0.3), 5}, Case{spec(10, 2, 8, 2, 1, 0.3), 6},
-                      Case{spec(20, 16, 16, 4, 1, 0.2), 7}, Case{spec(30, 4, 4, 2, 1, 0.3), 8},
-                      Case{spec(40, 8, 8, 3, 2, 0.3), 9}, Case{spec(60, 3, 5, 1, 1, 0.3), 10},
-                      Case{spec(60, 6, 6, 2, 0, 0.5), 11}, Case{spec(15, 12, 16, 4, 2, 0.5), 12},
-                      Case{spec(25, 5, 5, 4, 3, 1.0), 13}, Case{spec(60, 4, 4, 2, 1, 0.0), 14}),
-    case_name);
+const Case kRandomCases[] = {
+    Case{spec(1, 2, 2, 1, 1, 0.5), 1},    Case{spec(1, 16, 16, 4, 2, 0.3, true), 2},
+    Case{spec(2, 3, 3, 2, 0, 0.0), 3},    Case{spec(5, 4, 4, 1, 1, 0.4), 4},
+    Case{spec(10, 6, 6, 3, 2, 0.3), 5},   Case{spec(10, 2, 8, 2, 1, 0.3), 6},
+    Case{spec(20, 16, 16, 4, 1, 0.2), 7}, Case{spec(30, 4, 4, 2, 1, 0.3), 8},
+    Case{spec(40, 8, 8, 3, 2, 0.3), 9},   Case{spec(60, 3, 5, 1, 1, 0.3), 10},
+    Case{spec(60, 6, 6, 2, 0, 0.5), 11},  Case{spec(15, 12, 16, 4, 2, 0.5), 12},
+    Case{spec(25, 5, 5, 4, 3, 1.0), 13},  Case{spec(60, 4, 4, 2, 1, 0.0), 14}};
+
+INSTANTIATE_TEST_SUITE_P(Sizes, RandomQp, ::testing::ValuesIn(kRandomCases), case_name);
+
+// The same cases through partial condensing (core/qp_riccati_ipm_pairs): odd and even N, N = 1
+// and 2 (nothing or one pair to condense), stage-varying nx, soft and general constraints on the
+// eliminated stages; the expanded solution, multipliers included, is checked as above.
+class PairsRandomQp : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PairsRandomQp, MatchesCertifiedDenseReference) {
+  const Case& c = GetParam();
+  expect_matches_reference<QpRiccatiIpmPairs>(testing_qp::random_qp(c.spec, c.seed));
+}
+
+INSTANTIATE_TEST_SUITE_P(Sizes, PairsRandomQp, ::testing::ValuesIn(kRandomCases), case_name);
 
 // Pure ℓ1 soft constraints (Zl = Zu = 0: the exact penalty of SPEC §5.3), half the bound sides
 // absent: a soft side without a bound has a slack decoupled from everything (cost z·s, s ≥ 0
@@ -862,6 +875,63 @@ TEST(QpCondensedDense, ActiveSetFallsBackToTheIpm) {
   EXPECT_EQ(failing.solve(indefinite, sol), QpStatus::factorization_failed);
   EXPECT_EQ(failing.ipm_fallbacks(), 1);
   EXPECT_TRUE(all_finite(sol));
+}
+
+// The benchmark QPs through partial condensing: the same solution as the plain Riccati IPM,
+// and a primal-dual warm start with a changed x0 as in the RTI feedback phase.
+TEST_P(ControllerQp, PairsMatchThePlainSolverColdAndWarm) {
+  const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
+                   : GetParam() == 1 ? testing_qp::crazyflie_qp()
+                                     : testing_qp::pendubot_qp();
+  QpRiccatiIpm plain(qp.dims, tight());
+  QpRiccatiIpmPairs pairs(qp.dims, tight());
+  OcpQpSolution a(qp.dims), b(qp.dims);
+  ASSERT_EQ(plain.solve(qp, a), QpStatus::success);
+  ASSERT_EQ(pairs.solve(qp, b), QpStatus::success);
+  EXPECT_LE(kkt_residuals(qp, b).max(), 1e-8);
+  auto max_diff = [&](const OcpQpSolution& p, const OcpQpSolution& q) {  // relative, as above
+    double d = 0, scale = 1.0;
+    for (int i = 0; i <= qp.dims.N; ++i) {
+      d = std::max({d, (p.x[i] - q.x[i]).lpNorm<Eigen::Infinity>(),
+                    (p.u[i] - q.u[i]).lpNorm<Eigen::Infinity>()});
+      scale = std::max({scale, p.x[i].lpNorm<Eigen::Infinity>(), p.u[i].lpNorm<Eigen::Infinity>()});
+    }
+    return d / scale;
+  };
+  EXPECT_LE(max_diff(a, b), 1e-7);
+  EXPECT_NEAR(a.objective, b.objective, 1e-9 * std::max(1.0, std::abs(a.objective)));
+  OcpQp qp2 = qp;
+  qp2.x0 += 1e-3 * Eigen::VectorXd::Ones(qp.x0.size());
+  ASSERT_EQ(plain.solve(qp2, a), QpStatus::success);
+  pairs.prepare(qp2);
+  OcpQpSolution w = b;
+  ASSERT_EQ(pairs.solve(qp2, w, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_LE(max_diff(a, w), 1e-7);
+  EXPECT_LE(kkt_residuals(qp2, w).max(), 1e-8);
+  EXPECT_LT(w.iterations, b.iterations);
+}
+
+TEST(QpRiccatiIpmPairs, FailureStatusesWithoutNan) {
+  const OcpQp qp = testing_qp::random_qp(spec(9, 4, 4, 2, 1, 0.3), 51);
+  QpRiccatiIpmPairs solver(qp.dims);
+  OcpQpSolution sol(qp.dims);
+  OcpQp nan = qp;
+  nan.stage[3].Q(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(solver.solve(nan, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+  OcpQp indefinite = qp;
+  for (auto& s : indefinite.stage) s.R *= -1.0;
+  EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
+  EXPECT_TRUE(all_finite(sol));
+  OcpQp infeasible = qp;  // inconsistent bounds on an eliminated (odd) stage's input
+  infeasible.stage[3].lbu.setConstant(1.0);
+  infeasible.stage[3].ubu.setConstant(-1.0);
+  const QpStatus st = solver.solve(infeasible, sol);
+  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
+  EXPECT_TRUE(all_finite(sol));
+  EXPECT_EQ(solver.solve(qp, sol), QpStatus::success);
+  QpRiccatiIpmPairs other(OcpQpDims::uniform(4, 3, 2));
+  EXPECT_EQ(other.solve(qp, sol), QpStatus::invalid_data);
 }
 
 TEST(QpRiccatiIpmFailure, InfeasibleHardConstraints) {

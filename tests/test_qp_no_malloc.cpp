@@ -11,6 +11,7 @@
 #include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "core/qp_riccati_ipm_pairs.hpp"
 #include "qp_problems.hpp"
 #include "qp_random.hpp"
 
@@ -89,9 +90,12 @@ TEST(QpNoMalloc, GuardsAreLive) {
 #endif
 }
 
-TEST(QpNoMalloc, SolveAllocatesNothing) {
+// Cold, primal and primal-dual warm starts (after a prepare() where the solver has one), invalid
+// data and a failed factorization: none allocates.
+template <class Solver>
+void expect_solves_allocate_nothing() {
   testing_qp::RandomQpSpec spec;
-  spec.N = 20;
+  spec.N = 21;      // odd: QpRiccatiIpmPairs then has a lone last dynamic stage too
   spec.nx_min = 6;
   spec.nx_max = 9;  // stage-varying dims
   spec.nu = 3;
@@ -103,12 +107,13 @@ TEST(QpNoMalloc, SolveAllocatesNothing) {
   OcpQp indefinite = qp;
   for (auto& s : indefinite.stage) s.R *= -1.0;
 
-  QpRiccatiIpm solver(qp.dims);
+  Solver solver(qp.dims);
   OcpQpSolution sol(qp.dims);
   QpStatus cold, primal, dual, invalid, failed;
   {
     NoMalloc guard;
     cold = solver.solve(qp, sol);
+    solver.prepare(qp);
     primal = solver.solve(qp, sol, QpWarmStart::primal);
     dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
     invalid = solver.solve(bad, sol);
@@ -120,6 +125,12 @@ TEST(QpNoMalloc, SolveAllocatesNothing) {
   EXPECT_EQ(dual, QpStatus::success);
   EXPECT_EQ(invalid, QpStatus::invalid_data);
   EXPECT_EQ(failed, QpStatus::factorization_failed);
+}
+
+TEST(QpNoMalloc, SolveAllocatesNothing) { expect_solves_allocate_nothing<QpRiccatiIpm>(); }
+
+TEST(QpNoMalloc, PairsPrepareAndSolveAllocateNothing) {
+  expect_solves_allocate_nothing<QpRiccatiIpmPairs>();
 }
 
 TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {

@@ -8,6 +8,8 @@
 // x_1 plus a 2 % disturbance) warm-started (primal-dual) from the shifted solution, as in RTI.
 // <problem>_dense: the same with QpCondensedDense (condensing + dense IPM, short horizons); its
 // Hessian condensing is part of every timed solve (in RTI it runs in prepare()).
+// <problem>_pairs: the same with QpRiccatiIpmPairs (stage pairs condensed, then the Riccati IPM on
+// N/2 stages); the condensing and the expansion of the solution are part of every timed solve.
 // Counter "iterations": IPM iterations per solve.
 //
 // MIXPILOT_DUMP_QP=<file> appends each QP solved here (once per benchmark) to <file> as one JSON
@@ -22,6 +24,7 @@
 #include "core/ocp_qp_io.hpp"
 #include "core/qp_condensed_dense.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "core/qp_riccati_ipm_pairs.hpp"
 #include "tests/qp_problems.hpp"
 
 namespace mixpilot {
@@ -92,6 +95,13 @@ const OcpQp& pendubot() {
 
 void mi_cold(benchmark::State& s) { run(s, "BM_QpSolve/mi", mi(), false); }
 void mi_warm(benchmark::State& s) { run(s, "BM_QpSolve/mi_warm", mi(), true); }
+void mi_pairs(benchmark::State& s) { run<QpRiccatiIpmPairs>(s, "BM_QpSolve/mi_pairs", mi(), false); }
+void mi_pairs_warm(benchmark::State& s) {
+  run<QpRiccatiIpmPairs>(s, "BM_QpSolve/mi_pairs_warm", mi(), true);
+}
+void cf_pairs(benchmark::State& s) {
+  run<QpRiccatiIpmPairs>(s, "BM_QpSolve/crazyflie_pairs", crazyflie(), false);
+}
 void cf_cold(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie", crazyflie(), false); }
 void cf_warm(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie_warm", crazyflie(), true); }
 void pb_cold(benchmark::State& s) { run(s, "BM_QpSolve/pendubot", pendubot(), false); }
@@ -103,6 +113,9 @@ void pb_dense_warm(benchmark::State& s) {
 void cf_dense(benchmark::State& s) { run<QpCondensedDense>(s, "BM_QpSolve/crazyflie_dense", crazyflie(), false); }
 BENCHMARK(mi_cold)->Name("BM_QpSolve/mi")->Unit(benchmark::kMicrosecond);
 BENCHMARK(mi_warm)->Name("BM_QpSolve/mi_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(mi_pairs)->Name("BM_QpSolve/mi_pairs")->Unit(benchmark::kMicrosecond);
+BENCHMARK(mi_pairs_warm)->Name("BM_QpSolve/mi_pairs_warm")->Unit(benchmark::kMicrosecond);
+BENCHMARK(cf_pairs)->Name("BM_QpSolve/crazyflie_pairs")->Unit(benchmark::kMicrosecond);
 BENCHMARK(cf_cold)->Name("BM_QpSolve/crazyflie")->Unit(benchmark::kMicrosecond);
 BENCHMARK(cf_warm)->Name("BM_QpSolve/crazyflie_warm")->Unit(benchmark::kMicrosecond);
 BENCHMARK(pb_cold)->Name("BM_QpSolve/pendubot")->Unit(benchmark::kMicrosecond);
