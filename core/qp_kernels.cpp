@@ -494,6 +494,132 @@ void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y) 
 #endif
 }
 
+#if defined(__AVX2__) && defined(__FMA__)
+namespace {
+// Rows r..r+3 (mask m0) and, with TWO, r+4..r+7 (mask m1) of C += A B; columns in blocks of 4.
+// FULL: both masks are all lanes, so plain loads and stores (masked ones cost more on Zen).
+template <bool TWO, bool FULL>
+inline void gemm_nn_rows(int n, int k, const double* A, int lda, const double* B, int ldb,
+                         double* C, int ldc, __m256i m0, __m256i m1, bool overwrite) {
+  const __m256d zero = _mm256_setzero_pd();
+  const auto ldc0 = [&](const double* p) {  // C's old values, or zero
+    if (overwrite) return zero;
+    if constexpr (FULL) return _mm256_loadu_pd(p);
+    else return _mm256_maskload_pd(p, m0);
+  };
+  const auto ldc1 = [&](const double* p) {
+    if (overwrite) return zero;
+    if constexpr (FULL) return _mm256_loadu_pd(p);
+    else return _mm256_maskload_pd(p, m1);
+  };
+  const auto ld0 = [m0](const double* p) {
+    if constexpr (FULL) return _mm256_loadu_pd(p);
+    else return _mm256_maskload_pd(p, m0);
+  };
+  const auto ld1 = [m1](const double* p) {
+    if constexpr (FULL) return _mm256_loadu_pd(p);
+    else return _mm256_maskload_pd(p, m1);
+  };
+  const auto st0 = [m0](double* p, __m256d v) {
+    if constexpr (FULL) _mm256_storeu_pd(p, v);
+    else _mm256_maskstore_pd(p, m0, v);
+  };
+  const auto st1 = [m1](double* p, __m256d v) {
+    if constexpr (FULL) _mm256_storeu_pd(p, v);
+    else _mm256_maskstore_pd(p, m1, v);
+  };
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    double* c = C + static_cast<ptrdiff_t>(j) * ldc;
+    __m256d c00 = ldc0(c), c01 = ldc0(c + ldc), c02 = ldc0(c + 2 * ldc), c03 = ldc0(c + 3 * ldc);
+    __m256d c10 = _mm256_setzero_pd(), c11 = c10, c12 = c10, c13 = c10;
+    if constexpr (TWO) {
+      c10 = ldc1(c + 4), c11 = ldc1(c + ldc + 4);
+      c12 = ldc1(c + 2 * ldc + 4), c13 = ldc1(c + 3 * ldc + 4);
+    }
+    const double* b = B + static_cast<ptrdiff_t>(j) * ldb;
+    for (int p = 0; p < k; ++p) {
+      const double* a = A + static_cast<ptrdiff_t>(p) * lda;
+      const __m256d a0 = ld0(a);
+      const __m256d b0 = _mm256_broadcast_sd(b + p), b1 = _mm256_broadcast_sd(b + ldb + p),
+                    b2 = _mm256_broadcast_sd(b + 2 * ldb + p),
+                    b3 = _mm256_broadcast_sd(b + 3 * ldb + p);
+      c00 = _mm256_fmadd_pd(a0, b0, c00);
+      c01 = _mm256_fmadd_pd(a0, b1, c01);
+      c02 = _mm256_fmadd_pd(a0, b2, c02);
+      c03 = _mm256_fmadd_pd(a0, b3, c03);
+      if constexpr (TWO) {
+        const __m256d a1 = ld1(a + 4);
+        c10 = _mm256_fmadd_pd(a1, b0, c10);
+        c11 = _mm256_fmadd_pd(a1, b1, c11);
+        c12 = _mm256_fmadd_pd(a1, b2, c12);
+        c13 = _mm256_fmadd_pd(a1, b3, c13);
+      }
+    }
+    st0(c, c00);
+    st0(c + ldc, c01);
+    st0(c + 2 * ldc, c02);
+    st0(c + 3 * ldc, c03);
+    if constexpr (TWO) {
+      st1(c + 4, c10);
+      st1(c + ldc + 4, c11);
+      st1(c + 2 * ldc + 4, c12);
+      st1(c + 3 * ldc + 4, c13);
+    }
+  }
+  for (; j < n; ++j) {
+    double* c = C + static_cast<ptrdiff_t>(j) * ldc;
+    const double* b = B + static_cast<ptrdiff_t>(j) * ldb;
+    __m256d c0 = ldc0(c), c1 = _mm256_setzero_pd();
+    if constexpr (TWO) c1 = ldc1(c + 4);
+    for (int p = 0; p < k; ++p) {
+      const double* a = A + static_cast<ptrdiff_t>(p) * lda;
+      const __m256d bp = _mm256_broadcast_sd(b + p);
+      c0 = _mm256_fmadd_pd(ld0(a), bp, c0);
+      if constexpr (TWO) c1 = _mm256_fmadd_pd(ld1(a + 4), bp, c1);
+    }
+    st0(c, c0);
+    if constexpr (TWO) st1(c + 4, c1);
+  }
+}
+}  // namespace
+#endif
+
+void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
+             int ldc, bool overwrite) {
+  if (m <= 0 || n <= 0) return;
+  if (k <= 0) {
+    if (overwrite)
+      for (int j = 0; j < n; ++j)
+        for (int r = 0; r < m; ++r) C[r + static_cast<ptrdiff_t>(j) * ldc] = 0.0;
+    return;
+  }
+#if defined(__AVX2__) && defined(__FMA__)
+  for (int r = 0; r < m; r += 8) {
+    const int rows = m - r < 8 ? m - r : 8;
+    const int r0 = rows < 4 ? rows : 4, r1 = rows - r0;
+    const __m256i m0 = tail_mask(r0), m1 = tail_mask(r1 > 0 ? r1 : 4);
+    if (rows == 8)
+      gemm_nn_rows<true, true>(n, k, A + r, lda, B, ldb, C + r, ldc, m0, m1, overwrite);
+    else if (r1 > 0)
+      gemm_nn_rows<true, false>(n, k, A + r, lda, B, ldb, C + r, ldc, m0, m1, overwrite);
+    else if (rows == 4)
+      gemm_nn_rows<false, true>(n, k, A + r, lda, B, ldb, C + r, ldc, m0, m1, overwrite);
+    else
+      gemm_nn_rows<false, false>(n, k, A + r, lda, B, ldb, C + r, ldc, m0, m1, overwrite);
+  }
+#else
+  if (overwrite)
+    for (int j = 0; j < n; ++j)
+      for (int r = 0; r < m; ++r) C[r + static_cast<ptrdiff_t>(j) * ldc] = 0.0;
+  for (int j = 0; j < n; ++j)
+    for (int p = 0; p < k; ++p)
+      for (int r = 0; r < m; ++r)
+        C[r + static_cast<ptrdiff_t>(j) * ldc] +=
+            A[r + static_cast<ptrdiff_t>(p) * lda] * B[p + static_cast<ptrdiff_t>(j) * ldb];
+#endif
+}
+
 void trsv_lt_small(int n, const double* dinv, int lddinv, double* x) {
 #if defined(__AVX2__) && defined(__FMA__)
   // z_j = Σ_r M_rj x_r: four independent dot products of length 4 (M is zero outside n x n).

@@ -45,6 +45,12 @@ bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int
                           double* inv_diag, double psd_tol, double* dinv, int lddinv);
 // y (m) += A x (A m x n);  y (n) += Aᵀ x (A m x n). Exact row counts, no padding needed.
 void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
+// C += A B with A m x k, B k x n, C m x n (column-major, any leading dimensions): 8 x 4 register
+// tiles, B broadcast (the small products of partial condensing, where Eigen's GEMM spends more
+// on packing than on the products).
+// With overwrite, C = A B (C's old values are not read).
+void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
+             int ldc, bool overwrite = false);
 void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y);
 
 }  // namespace mixpilot::kernels

@@ -8,20 +8,17 @@ namespace mixpilot {
 
 namespace {
 
-// C += A B and C += Aᵀ B, column by column with the register-blocked gemv kernels (Eigen's
-// general GEMM packs its operands first: 3x slower at these 4..24 sizes). Column-major operands
-// (Eigen matrices or their blocks).
+// C += A B and C = A B with the register-blocked kernel (Eigen's general GEMM packs its
+// operands first: 3x slower at these 4..24 sizes). Column-major operands (matrices or blocks).
 template <class MA, class MB, class MC>
 void add_ab(const MA& A, const MB& B, MC&& C) {
-  for (Eigen::Index j = 0; j < B.cols(); ++j)
-    kernels::gemv_n(int(A.rows()), int(A.cols()), A.data(), int(A.outerStride()),
-                    B.data() + j * B.outerStride(), C.data() + j * C.outerStride());
+  kernels::gemm_nn(int(A.rows()), int(B.cols()), int(A.cols()), A.data(), int(A.outerStride()),
+                   B.data(), int(B.outerStride()), C.data(), int(C.outerStride()));
 }
 template <class MA, class MB, class MC>
-void add_atb(const MA& A, const MB& B, MC&& C) {
-  for (Eigen::Index j = 0; j < B.cols(); ++j)
-    kernels::gemv_t(int(A.rows()), int(A.cols()), A.data(), int(A.outerStride()),
-                    B.data() + j * B.outerStride(), C.data() + j * C.outerStride());
+void set_ab(const MA& A, const MB& B, MC&& C) {
+  kernels::gemm_nn(int(A.rows()), int(B.cols()), int(A.cols()), A.data(), int(A.outerStride()),
+                   B.data(), int(B.outerStride()), C.data(), int(C.outerStride()), true);
 }
 // y += A x and y += Aᵀ x.
 template <class MA, class VX, class VY>
@@ -93,6 +90,8 @@ bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
   }
   Q1A0_.resize(nx, nx);
   Q1B0_.resize(nx, nu);
+  A0t_.resize(nx, nx);
+  B0t_.resize(nu, nx);
   g1_.resize(nx);
   x1_.resize(nx);
   constant_.assign(first_.size(), 0.0);
@@ -114,10 +113,8 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   auto Q1A0 = Q1A0_.topLeftCorner(nx1, nx0);
   auto Q1B0 = Q1B0_.topLeftCorner(nx1, nu0);
   auto g1 = g1_.head(nx1);
-  Q1A0.setZero();
-  add_ab(s1.Q, A0, Q1A0);
-  Q1B0.setZero();
-  add_ab(s1.Q, B0, Q1B0);
+  set_ab(s1.Q, A0, Q1A0);
+  set_ab(s1.Q, B0, Q1B0);
   auto Q1b0 = x1_.head(nx1);
   Q1b0.setZero();
   add_ax(s1.Q, s0.b, Q1b0);
@@ -125,24 +122,24 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   constant_[j] = s0.b.dot(g1) - 0.5 * s0.b.dot(Q1b0);  // ½b0ᵀQ1b0 + q1ᵀb0
 
   // Dynamics to x_{k+2}.
-  t.A.setZero();
-  add_ab(s1.A, A0, t.A);
-  t.B.leftCols(nu0).setZero();
-  add_ab(s1.A, B0, t.B.leftCols(nu0));
+  set_ab(s1.A, A0, t.A);
+  set_ab(s1.A, B0, t.B.leftCols(nu0));
   t.B.rightCols(nu1) = s1.B;
   t.b = s1.b;
   add_ax(s1.A, s0.b, t.b);
   // Cost.
   t.Q = s0.Q;
-  add_atb(A0, Q1A0, t.Q);
+  auto A0t = A0t_.topLeftCorner(nx0, nx1);
+  auto B0t = B0t_.topLeftCorner(nu0, nx1);
+  A0t = A0.transpose();
+  B0t = B0.transpose();
+  add_ab(A0t, Q1A0, t.Q);
   t.S.topRows(nu0) = s0.S;
-  add_atb(B0, Q1A0, t.S.topRows(nu0));
-  t.S.bottomRows(nu1).setZero();
-  add_ab(s1.S, A0, t.S.bottomRows(nu1));
+  add_ab(B0t, Q1A0, t.S.topRows(nu0));
+  set_ab(s1.S, A0, t.S.bottomRows(nu1));
   t.R.topLeftCorner(nu0, nu0) = s0.R;
-  add_atb(B0, Q1B0, t.R.topLeftCorner(nu0, nu0));
-  t.R.bottomLeftCorner(nu1, nu0).setZero();
-  add_ab(s1.S, B0, t.R.bottomLeftCorner(nu1, nu0));
+  add_ab(B0t, Q1B0, t.R.topLeftCorner(nu0, nu0));
+  set_ab(s1.S, B0, t.R.bottomLeftCorner(nu1, nu0));
   t.R.topRightCorner(nu0, nu1) = t.R.bottomLeftCorner(nu1, nu0).transpose();
   t.R.bottomRightCorner(nu1, nu1) = s1.R;
   t.q = s0.q;
@@ -177,10 +174,8 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   {  // C1 x_{k+1} + D1 u1 = C1A0 x + C1B0 u0 + D1 u1 + C1 b0
     auto C = t.C.middleRows(ng0 + nbx1, ng1);
     auto D = t.D.middleRows(ng0 + nbx1, ng1);
-    C.setZero();
-    add_ab(s1.C, A0, C);
-    D.leftCols(nu0).setZero();
-    add_ab(s1.C, B0, D.leftCols(nu0));
+    set_ab(s1.C, A0, C);
+    set_ab(s1.C, B0, D.leftCols(nu0));
     D.rightCols(nu1) = s1.D;
     for (int r = 0; r < ng1; ++r) {
       const double c = s1.C.row(r).dot(s0.b);

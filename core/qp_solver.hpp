@@ -4,8 +4,8 @@
 // (core/qp_condensed_dense.hpp, for short horizons, where the Riccati recursion's per-stage
 // overhead dominates), and the Riccati IPM behind partial condensing of stage pairs
 // (core/qp_riccati_ipm_pairs.hpp, half the recursion's sequential steps). All solve the OcpQp of
-// core/ocp_qp.hpp to the same tolerances and
-// return the same OcpQpSolution layout, so RtiSolver can use either (RtiSettings::qp_solver).
+// core/ocp_qp.hpp to the same tolerances and return the same OcpQpSolution layout, so RtiSolver
+// can use any of them (RtiSettings::qp_solver).
 //
 // Contract of every implementation: setup() sizes every buffer (may allocate); prepare() and
 // solve() never allocate, throw or print; solve() returns a QpStatus and, on any status other

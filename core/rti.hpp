@@ -28,6 +28,7 @@
 #include "core/ocp_qp.hpp"
 #include "core/qp_condensed_dense.hpp"
 #include "core/qp_riccati_ipm.hpp"
+#include "core/qp_riccati_ipm_pairs.hpp"
 #include "core/qp_solver.hpp"
 #include "core/types.hpp"
 
@@ -125,11 +126,14 @@ class RtiSolver {
   OcpQp qp_;
   OcpQpSolution qp_sol_;
   QpSolver& qp_solver() {
-    return settings_.qp_solver != QpSolverKind::riccati_ipm
-               ? static_cast<QpSolver&>(qp_dense_)
-               : static_cast<QpSolver&>(qp_riccati_);
+    switch (settings_.qp_solver) {
+      case QpSolverKind::riccati_ipm: return qp_riccati_;
+      case QpSolverKind::riccati_ipm_pairs: return qp_pairs_;
+      default: return qp_dense_;
+    }
   }
   QpRiccatiIpm qp_riccati_;    // set up when settings.qp_solver == riccati_ipm
+  QpRiccatiIpmPairs qp_pairs_;  // set up when settings.qp_solver == riccati_ipm_pairs
   QpCondensedDense qp_dense_;  // set up when settings.qp_solver is condensed_*
   RtiWorkspace ws_;
   const SelectionOutput* selection_output_ = nullptr;    // fast Gauss-Newton path, or null

@@ -80,6 +80,8 @@ inline constexpr bool kQpWarmStart = true;
 // OCP-QP solver variant of the RTI engine (core/qp_solver.hpp, SPEC §4).
 enum class QpSolverKind {
   riccati_ipm,      // structure-exploiting Riccati IPM: O(N) per iteration, any horizon
+  riccati_ipm_pairs,  // the same behind partial condensing of stage pairs (condensing in
+                      // prepare()): long horizons, cold or many-iteration solves
   condensed_dense,  // condensing + dense IPM: short horizons (≲ 10–20 stages, few inputs)
   condensed_active_set,  // condensing + warm-started dense active set (IPM fallback): short
                          // horizons in closed loop, where the active set rarely changes

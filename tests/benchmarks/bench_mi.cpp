@@ -2,6 +2,8 @@
 // flown by the emulated novice (whose λ moves the most). Only MiController::step is timed
 // (manual timing); the pilot's own NMPC and the plant run untimed between steps. The flight is
 // restarted every 400 steps, after 100 untimed warm-up steps, so it never leaves the helix.
+// BM_Rti/mi_pairs: the same with the QP solved by QpRiccatiIpmPairs (pairs condensed in
+// prepare()).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -14,7 +16,7 @@
 namespace mixpilot {
 namespace {
 
-void BM_RtiMi(benchmark::State& state) {
+void BM_RtiMi(benchmark::State& state, QpSolverKind qp_solver) {
   std::string error;
   const auto sc = load_scenario(MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml", error);
   if (!sc) {
@@ -40,7 +42,9 @@ void BM_RtiMi(benchmark::State& state) {
   const auto restart = [&] {
     controller = std::make_unique<MiController>();
     pilot = std::make_unique<EmulatedPilot>();
-    controller->setup(model, sc->controller, sc->arena, sc->reference);
+    RtiSettings rti;
+    rti.qp_solver = qp_solver;
+    controller->setup(model, sc->controller, sc->arena, sc->reference, rti);
     PilotProfile profile = sc->pilots.at("novice");
     pilot->setup(model, profile, sc->reference, dt);
     x = model.hover_state(sc->reference.position(0.0));
@@ -74,7 +78,14 @@ void BM_RtiMi(benchmark::State& state) {
   state.counters["qp_us"] = qp / n;
   state.counters["qp_iterations"] = iterations / n;
 }
-BENCHMARK(BM_RtiMi)->Name("BM_Rti/mi")->UseManualTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_RtiMi, riccati, QpSolverKind::riccati_ipm)
+    ->Name("BM_Rti/mi")
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_RtiMi, pairs, QpSolverKind::riccati_ipm_pairs)
+    ->Name("BM_Rti/mi_pairs")
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace mixpilot
