@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "core/qp_condensed_dense.hpp"
 #include "core/qp_dense_active_set.hpp"
 #include "core/qp_dense_ipm.hpp"
+#include "core/qp_kernels.hpp"
 #include "core/qp_riccati_ipm.hpp"
 #include "core/qp_riccati_ipm_pairs.hpp"
 #include "qp_dense_reference.hpp"
@@ -909,6 +911,29 @@ TEST_P(ControllerQp, PairsMatchThePlainSolverColdAndWarm) {
   EXPECT_LE(max_diff(a, w), 1e-7);
   EXPECT_LE(kkt_residuals(qp2, w).max(), 1e-8);
   EXPECT_LT(w.iterations, b.iterations);
+}
+
+// The condensing's gemm kernel against Eigen on every tile shape: rows 1..13 (one and two
+// vectors, full and masked), columns 1..9 (4-column blocks and tails), k = 0..16, leading
+// dimensions larger than the operands, accumulating and overwriting; rows below m untouched.
+TEST(QpKernels, GemmNnMatchesEigen) {
+  std::srand(11);
+  for (int m = 1; m <= 13; ++m)
+    for (int n = 1; n <= 9; ++n)
+      for (int k : {0, 1, 5, 16})
+        for (bool overwrite : {false, true}) {
+          const Eigen::MatrixXd A = Eigen::MatrixXd::Random(m + 3, k);
+          const Eigen::MatrixXd B = Eigen::MatrixXd::Random(k + 2, n);
+          Eigen::MatrixXd C = Eigen::MatrixXd::Random(m + 1, n);
+          const Eigen::MatrixXd C0 = C;
+          Eigen::MatrixXd expected = A.topRows(m) * B.topRows(k);
+          if (!overwrite) expected += C0.topRows(m);
+          kernels::gemm_nn(m, n, k, A.data(), int(A.rows()), B.data(), int(B.rows()), C.data(),
+                           int(C.rows()), overwrite);
+          EXPECT_LE((C.topRows(m) - expected).cwiseAbs().maxCoeff(), 1e-14 * (k + 1))
+              << m << "x" << n << "x" << k;
+          EXPECT_EQ(C.row(m), C0.row(m));
+        }
 }
 
 TEST(QpRiccatiIpmPairs, FailureStatusesWithoutNan) {

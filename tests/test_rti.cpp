@@ -130,6 +130,37 @@ TEST(RtiFailurePolicy, WarmStartFarFromTheNewQpDoesNotFallBack) {
   EXPECT_EQ(rti.stats().fallbacks, 0);
 }
 
+// RtiSettings::qp_solver = riccati_ipm_pairs (partial condensing in prepare()) flies the smooth
+// step like the plain Riccati IPM: eliminating x_{k+1} commutes with the Newton step, so both
+// take the same IPM iterates in exact arithmetic and the inputs differ by rounding only.
+TEST(RtiQpSolvers, PairCondensingFliesTheSameLoop) {
+  CrazyflieTracking problem(kN, kDt);
+  RtiSolver plain, pairs;
+  RtiSettings s;
+  ASSERT_TRUE(plain.setup(problem.ocp(), s));
+  s.qp_solver = QpSolverKind::riccati_ipm_pairs;
+  ASSERT_TRUE(pairs.setup(problem.ocp(), s));
+  const Eigen::Vector3d start(0, 0, 0.4);
+  problem.hover_guess(plain.trajectory(), start);
+  problem.hover_guess(pairs.trajectory(), start);
+  Eigen::VectorXd x = problem.model().hover_state(start);
+  double worst = 0;
+  for (int k = 0; k < 120; ++k) {
+    for (RtiSolver* r : {&plain, &pairs}) {
+      problem.set_reference(r->data(), smooth_step().trajectory, k);
+      r->prepare();
+      r->feedback(x);
+      EXPECT_EQ(r->stats().status, RtiStatus::success) << k;
+    }
+    worst = std::max(worst, (plain.control() - pairs.control()).lpNorm<Eigen::Infinity>());
+    x = plant_step(problem.integrator(), x, plain.control());
+    plain.shift();
+    pairs.shift();
+  }
+  EXPECT_LE(worst, 1e-9);  // krpm, inputs ~16
+  std::printf("max |u_plain - u_pairs| over 120 steps: %.2e krpm\n", worst);
+}
+
 // A converged SQP iterate is only as stationary as its QPs: with weights as small as 1e-5 (SPEC
 // §5.2), the RTI default (1e-6) leaves primal errors ~1e-5, so fully converged runs tighten it.
 RtiSettings converged_settings() {
