@@ -137,6 +137,7 @@ TEST(RtiQpSolvers, PairCondensingFliesTheSameLoop) {
   CrazyflieTracking problem(kN, kDt);
   RtiSolver plain, pairs;
   RtiSettings s;
+  s.qp_solver = QpSolverKind::riccati_ipm;
   ASSERT_TRUE(plain.setup(problem.ocp(), s));
   s.qp_solver = QpSolverKind::riccati_ipm_pairs;
   ASSERT_TRUE(pairs.setup(problem.ocp(), s));

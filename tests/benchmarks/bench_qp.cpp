@@ -1,5 +1,7 @@
-// BM_QpSolve/<problem>: one OCP-QP solve by QpRiccatiIpm (issue 3, SPEC §4) on the QPs of
+// BM_QpSolve/<problem>: one OCP-QP solve by the RTI's default solver, the Riccati IPM behind
+// partial condensing of stage pairs (QpRiccatiIpmPairs; issue 3, SPEC §4), on the QPs of
 // tests/qp_problems.hpp, at the issue's tolerances (complementarity 1e-8, stationarity 1e-6).
+// The condensing and the expansion of the solution are part of every timed solve.
 //   mi         MikroKopter mixed-initiative (SPEC §5.4): nx 16, nu 4, N 50, 4 τ bounds per stage,
 //              4 Ω bounds on stages 1..N
 //   crazyflie  nx 13, nu 4, N 50, 4 input bounds (SPEC §5.2)
@@ -8,8 +10,7 @@
 // x_1 plus a 2 % disturbance) warm-started (primal-dual) from the shifted solution, as in RTI.
 // <problem>_dense: the same with QpCondensedDense (condensing + dense IPM, short horizons); its
 // Hessian condensing is part of every timed solve (in RTI it runs in prepare()).
-// <problem>_pairs: the same with QpRiccatiIpmPairs (stage pairs condensed, then the Riccati IPM on
-// N/2 stages); the condensing and the expansion of the solution are part of every timed solve.
+// <problem>_stagewise: the same with QpRiccatiIpm (the Riccati recursion over all N stages).
 // Counter "iterations": IPM iterations per solve.
 //
 // MIXPILOT_DUMP_QP=<file> appends each QP solved here (once per benchmark) to <file> as one JSON
@@ -93,36 +94,34 @@ const OcpQp& pendubot() {
   return qp;
 }
 
-void mi_cold(benchmark::State& s) { run(s, "BM_QpSolve/mi", mi(), false); }
-void mi_warm(benchmark::State& s) { run(s, "BM_QpSolve/mi_warm", mi(), true); }
-void mi_pairs(benchmark::State& s) { run<QpRiccatiIpmPairs>(s, "BM_QpSolve/mi_pairs", mi(), false); }
-void mi_pairs_warm(benchmark::State& s) {
-  run<QpRiccatiIpmPairs>(s, "BM_QpSolve/mi_pairs_warm", mi(), true);
+template <class Solver>
+void add(const std::string& name, const OcpQp& (*problem)(), bool warm) {
+  benchmark::RegisterBenchmark(name.c_str(), [name, problem, warm](benchmark::State& state) {
+    run<Solver>(state, name, problem(), warm);
+  })->Unit(benchmark::kMicrosecond);
 }
-void cf_pairs(benchmark::State& s) {
-  run<QpRiccatiIpmPairs>(s, "BM_QpSolve/crazyflie_pairs", crazyflie(), false);
-}
-void cf_cold(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie", crazyflie(), false); }
-void cf_warm(benchmark::State& s) { run(s, "BM_QpSolve/crazyflie_warm", crazyflie(), true); }
-void pb_cold(benchmark::State& s) { run(s, "BM_QpSolve/pendubot", pendubot(), false); }
-void pb_warm(benchmark::State& s) { run(s, "BM_QpSolve/pendubot_warm", pendubot(), true); }
-void pb_dense(benchmark::State& s) { run<QpCondensedDense>(s, "BM_QpSolve/pendubot_dense", pendubot(), false); }
-void pb_dense_warm(benchmark::State& s) {
-  run<QpCondensedDense>(s, "BM_QpSolve/pendubot_dense_warm", pendubot(), true);
-}
-void cf_dense(benchmark::State& s) { run<QpCondensedDense>(s, "BM_QpSolve/crazyflie_dense", crazyflie(), false); }
-BENCHMARK(mi_cold)->Name("BM_QpSolve/mi")->Unit(benchmark::kMicrosecond);
-BENCHMARK(mi_warm)->Name("BM_QpSolve/mi_warm")->Unit(benchmark::kMicrosecond);
-BENCHMARK(mi_pairs)->Name("BM_QpSolve/mi_pairs")->Unit(benchmark::kMicrosecond);
-BENCHMARK(mi_pairs_warm)->Name("BM_QpSolve/mi_pairs_warm")->Unit(benchmark::kMicrosecond);
-BENCHMARK(cf_pairs)->Name("BM_QpSolve/crazyflie_pairs")->Unit(benchmark::kMicrosecond);
-BENCHMARK(cf_cold)->Name("BM_QpSolve/crazyflie")->Unit(benchmark::kMicrosecond);
-BENCHMARK(cf_warm)->Name("BM_QpSolve/crazyflie_warm")->Unit(benchmark::kMicrosecond);
-BENCHMARK(pb_cold)->Name("BM_QpSolve/pendubot")->Unit(benchmark::kMicrosecond);
-BENCHMARK(pb_warm)->Name("BM_QpSolve/pendubot_warm")->Unit(benchmark::kMicrosecond);
-BENCHMARK(pb_dense)->Name("BM_QpSolve/pendubot_dense")->Unit(benchmark::kMicrosecond);
-BENCHMARK(pb_dense_warm)->Name("BM_QpSolve/pendubot_dense_warm")->Unit(benchmark::kMicrosecond);
-BENCHMARK(cf_dense)->Name("BM_QpSolve/crazyflie_dense")->Unit(benchmark::kMicrosecond);
+
+// Per problem: the default solver (QpRiccatiIpmPairs, as RTI uses it), then the stage-wise
+// Riccati IPM; full condensing where the horizon suits it.
+const bool registered = [] {
+  struct Problem {
+    const char* name;
+    const OcpQp& (*qp)();
+  };
+  for (const Problem p : {Problem{"mi", mi}, Problem{"crazyflie", crazyflie},
+                          Problem{"pendubot", pendubot}}) {
+    const std::string base = std::string("BM_QpSolve/") + p.name;
+    for (const bool warm : {false, true}) {
+      const std::string suffix = warm ? "_warm" : "";
+      add<QpRiccatiIpmPairs>(base + suffix, p.qp, warm);
+      add<QpRiccatiIpm>(base + "_stagewise" + suffix, p.qp, warm);
+    }
+  }
+  add<QpCondensedDense>("BM_QpSolve/pendubot_dense", pendubot, false);
+  add<QpCondensedDense>("BM_QpSolve/pendubot_dense_warm", pendubot, true);
+  add<QpCondensedDense>("BM_QpSolve/crazyflie_dense", crazyflie, false);
+  return true;
+}();
 
 }  // namespace
 }  // namespace mixpilot
