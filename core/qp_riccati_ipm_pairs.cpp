@@ -1,6 +1,7 @@
 #include "core/qp_riccati_ipm_pairs.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "core/qp_kernels.hpp"
 
@@ -44,6 +45,34 @@ void blocks_of(const OcpQpDims& d, std::vector<int>& first, std::vector<int>& co
     first.push_back(k);
     count.push_back(1);
   }
+}
+
+// Stage i of `from` into stage j of `to` (a lone stage: the same sizes in both).
+void copy_stage(const OcpQpSolution& from, int i, OcpQpSolution& to, int j, bool dynamics) {
+  to.x[j] = from.x[i];
+  to.u[j] = from.u[i];
+  if (dynamics) to.pi[j] = from.pi[i];
+  to.lam_l[j] = from.lam_l[i];
+  to.lam_u[j] = from.lam_u[i];
+  to.sl[j] = from.sl[i];
+  to.su[j] = from.su[i];
+  to.lam_sl[j] = from.lam_sl[i];
+  to.lam_su[j] = from.lam_su[i];
+}
+
+// Where the constraints of stages k (stage 0) and k+1 (stage 1) sit in their pair's block.
+struct Segment {
+  int block, stage, offset, size;  // block offset; stage 0/1 and offset there; length
+};
+std::array<Segment, 6> pair_segments(const OcpQpDims& d, int k) {
+  const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx0 = d.nbx[k], nbx1 = d.nbx[k + 1];
+  const int ng0 = d.ng[k], ng1 = d.ng[k + 1], nbu = nbu0 + nbu1;
+  return {Segment{0, 0, 0, nbu0},                                  // bu_k
+          Segment{nbu0, 1, 0, nbu1},                               // bu_{k+1}
+          Segment{nbu, 0, nbu0, nbx0},                             // bx_k
+          Segment{nbu + nbx0, 0, nbu0 + nbx0, ng0},                // g_k
+          Segment{nbu + nbx0 + ng0, 1, nbu1, nbx1},                // bx_{k+1} as rows
+          Segment{nbu + nbx0 + ng0 + nbx1, 1, nbu1 + nbx1, ng1}};  // g_{k+1}
 }
 
 }  // namespace
@@ -222,32 +251,18 @@ void QpRiccatiIpmPairs::restrict_warm_start(const OcpQpSolution& sol) {
   const OcpQpDims& d = dims_;
   for (std::size_t jj = 0; jj < first_.size(); ++jj) {
     const int j = static_cast<int>(jj), k = first_[jj];
-    solc_.x[j] = sol.x[k];
     if (count_[jj] == 1) {
-      solc_.u[j] = sol.u[k];
-      if (k < d.N) solc_.pi[j] = sol.pi[k];
-      solc_.lam_l[j] = sol.lam_l[k];
-      solc_.lam_u[j] = sol.lam_u[k];
-      solc_.sl[j] = sol.sl[k];
-      solc_.su[j] = sol.su[k];
-      solc_.lam_sl[j] = sol.lam_sl[k];
-      solc_.lam_su[j] = sol.lam_su[k];
+      copy_stage(sol, k, solc_, j, k < d.N);
       continue;
     }
-    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1];
-    const int nbx0 = d.nbx[k], nbx1 = d.nbx[k + 1], ng0 = d.ng[k], ng1 = d.ng[k + 1];
-    const int ns0 = d.ns[k], ns1 = d.ns[k + 1], nbu = nbu0 + nbu1;
+    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+    solc_.x[j] = sol.x[k];
     solc_.u[j].head(nu0) = sol.u[k];
     solc_.u[j].tail(nu1) = sol.u[k + 1];
     solc_.pi[j] = sol.pi[k + 1];
-    for (auto [dst, src] : {std::pair{&solc_.lam_l[j], &sol.lam_l}, std::pair{&solc_.lam_u[j], &sol.lam_u}}) {
-      const Eigen::VectorXd &l0 = (*src)[k], &l1 = (*src)[k + 1];
-      dst->segment(0, nbu0) = l0.segment(0, nbu0);
-      dst->segment(nbu0, nbu1) = l1.segment(0, nbu1);
-      dst->segment(nbu, nbx0) = l0.segment(nbu0, nbx0);
-      dst->segment(nbu + nbx0, ng0) = l0.segment(nbu0 + nbx0, ng0);
-      dst->segment(nbu + nbx0 + ng0, nbx1) = l1.segment(nbu1, nbx1);
-      dst->segment(nbu + nbx0 + ng0 + nbx1, ng1) = l1.segment(nbu1 + nbx1, ng1);
+    for (const Segment& g : pair_segments(d, k)) {
+      solc_.lam_l[j].segment(g.block, g.size) = sol.lam_l[k + g.stage].segment(g.offset, g.size);
+      solc_.lam_u[j].segment(g.block, g.size) = sol.lam_u[k + g.stage].segment(g.offset, g.size);
     }
     for (auto [dst, src] : {std::pair{&solc_.sl, &sol.sl}, std::pair{&solc_.su, &sol.su},
                             std::pair{&solc_.lam_sl, &sol.lam_sl},
@@ -264,36 +279,23 @@ void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
   for (std::size_t jj = 0; jj < first_.size(); ++jj) {
     const int j = static_cast<int>(jj), k = first_[jj];
     constant += constant_[jj];
-    sol.x[k] = solc_.x[j];
     if (count_[jj] == 1) {
-      sol.u[k] = solc_.u[j];
-      if (k < d.N) sol.pi[k] = solc_.pi[j];
-      sol.lam_l[k] = solc_.lam_l[j];
-      sol.lam_u[k] = solc_.lam_u[j];
-      sol.sl[k] = solc_.sl[j];
-      sol.su[k] = solc_.su[j];
-      sol.lam_sl[k] = solc_.lam_sl[j];
-      sol.lam_su[k] = solc_.lam_su[j];
+      copy_stage(solc_, j, sol, k, k < d.N);
       continue;
     }
     const OcpQpStage &s0 = qp.stage[k], &s1 = qp.stage[k + 1];
-    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1];
-    const int nbx0 = d.nbx[k], nbx1 = d.nbx[k + 1], ng0 = d.ng[k], ng1 = d.ng[k + 1];
-    const int ns0 = d.ns[k], ns1 = d.ns[k + 1], nbu = nbu0 + nbu1;
+    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], nbu1 = d.nbu[k + 1], nbx1 = d.nbx[k + 1];
+    const int ng1 = d.ng[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+    sol.x[k] = solc_.x[j];
     sol.u[k] = solc_.u[j].head(nu0);
     sol.u[k + 1] = solc_.u[j].tail(nu1);
     Eigen::VectorXd& x1 = sol.x[k + 1];
     x1 = s0.b;
     add_ax(s0.A, sol.x[k], x1);
     add_ax(s0.B, sol.u[k], x1);
-    for (auto [dst, src] : {std::pair{&sol.lam_l, &solc_.lam_l[j]}, std::pair{&sol.lam_u, &solc_.lam_u[j]}}) {
-      Eigen::VectorXd &l0 = (*dst)[k], &l1 = (*dst)[k + 1];
-      l0.segment(0, nbu0) = src->segment(0, nbu0);
-      l1.segment(0, nbu1) = src->segment(nbu0, nbu1);
-      l0.segment(nbu0, nbx0) = src->segment(nbu, nbx0);
-      l0.segment(nbu0 + nbx0, ng0) = src->segment(nbu + nbx0, ng0);
-      l1.segment(nbu1, nbx1) = src->segment(nbu + nbx0 + ng0, nbx1);
-      l1.segment(nbu1 + nbx1, ng1) = src->segment(nbu + nbx0 + ng0 + nbx1, ng1);
+    for (const Segment& g : pair_segments(d, k)) {
+      sol.lam_l[k + g.stage].segment(g.offset, g.size) = solc_.lam_l[j].segment(g.block, g.size);
+      sol.lam_u[k + g.stage].segment(g.offset, g.size) = solc_.lam_u[j].segment(g.block, g.size);
     }
     for (auto [dst, src] : {std::pair{&sol.sl, &solc_.sl[j]}, std::pair{&sol.su, &solc_.su[j]},
                             std::pair{&sol.lam_sl, &solc_.lam_sl[j]},
