@@ -109,9 +109,13 @@ bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
   const OcpQpDims dc = ocp_qp_pair_dims(dims);
   qpc_.resize(dc);
   solc_.resize(dc);
+  if (levels_ > 1)
+    inner_ = std::make_unique<QpRiccatiIpmPairs>(levels_ - 1);
+  else
+    inner_ = std::make_unique<QpRiccatiIpm>();
   Settings inner = settings;
   inner.check_data = false;  // solve() checks the original data
-  if (!inner_.setup(dc, inner)) return false;
+  if (!inner_->setup(dc, inner)) return false;
   int nx = 0, nu = 0;
   for (int i = 0; i <= dims.N; ++i) {
     nx = std::max(nx, dims.nx[i]);
@@ -244,7 +248,15 @@ void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
       constant_[j] = 0.0;
     }
   }
+  set_inner_settings();
+  inner_->prepare(qpc_);  // a nested level condenses its pairs (x0 plays no part)
   prepared_ = true;
+}
+
+void QpRiccatiIpmPairs::set_inner_settings() {
+  Settings& inner = inner_->settings();
+  inner = settings_;
+  inner.check_data = false;
 }
 
 void QpRiccatiIpmPairs::restrict_warm_start(const OcpQpSolution& sol) {
@@ -330,12 +342,9 @@ QpStatus QpRiccatiIpmPairs::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmSta
   if (!prepared_) prepare(qp);
   if (!prepared_) return sol.set_invalid_data();
   prepared_ = false;
-  Settings inner = settings_;
-  inner.check_data = false;
-  inner_.settings() = inner;
   qpc_.x0 = qp.x0;
   if (warm != QpWarmStart::cold) restrict_warm_start(sol);
-  inner_.solve(qpc_, solc_, warm);
+  inner_->solve(qpc_, solc_, warm);
   expand(qp, sol);
   return sol.status;
 }

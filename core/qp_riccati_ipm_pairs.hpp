@@ -18,7 +18,11 @@
 // multipliers split, and π_k from the stationarity in x_{k+1}:
 //   π_k = Q1 x_{k+1} + S1ᵀu_{k+1} + q1 + A1ᵀπ_{k+1} − ∇_x d_{k+1}ᵀ(λ_l − λ_u)_{k+1}.
 //
+// `levels` > 1 condenses the condensed QP again (pairs of pairs: blocks of 2^levels stages),
+// by a nested QpRiccatiIpmPairs.
+//
 // setup() sizes everything; prepare(), solve() allocate nothing, never throw or print.
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -32,15 +36,19 @@ namespace mixpilot {
 // The condensed dims of `dims`: one stage per pair (k, k+1) with k + 1 < N, then the lone stages.
 OcpQpDims ocp_qp_pair_dims(const OcpQpDims& dims);
 
-class QpRiccatiIpmPairs final : public QpSolver {
+class QpRiccatiIpmPairs : public QpSolver {
  public:
   using Settings = QpRiccatiIpmSettings;
 
-  QpRiccatiIpmPairs() = default;
-  explicit QpRiccatiIpmPairs(const OcpQpDims& dims, const Settings& settings = {}) {
+  explicit QpRiccatiIpmPairs(int levels = qp_defaults::kPairLevels) { set_levels(levels); }
+  explicit QpRiccatiIpmPairs(const OcpQpDims& dims, const Settings& settings = {},
+                             int levels = qp_defaults::kPairLevels) {
+    set_levels(levels);
     setup(dims, settings);
   }
 
+  // How many times pairs are condensed (≥ 1); takes effect at the next setup().
+  void set_levels(int levels) { levels_ = levels < 1 ? 1 : levels; }
   bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
   // Condenses qp (everything but x0); the next solve() of the same qp reuses it.
   void prepare(const OcpQp& qp) override;
@@ -57,7 +65,9 @@ class QpRiccatiIpmPairs final : public QpSolver {
   void condense_pair(const OcpQp& qp, int j);
   void expand(const OcpQp& qp, OcpQpSolution& sol) const;
   void restrict_warm_start(const OcpQpSolution& sol);
+  void set_inner_settings();  // settings_ without the data check (done on the original QP)
 
+  int levels_ = qp_defaults::kPairLevels;  // ≥ 1
   Settings settings_{};
   OcpQpDims dims_;
   bool ready_ = false;
@@ -66,7 +76,7 @@ class QpRiccatiIpmPairs final : public QpSolver {
   std::vector<int> count_;  // per block: 1 or 2 stages
   OcpQp qpc_;               // the condensed QP (x0 copied at each solve)
   OcpQpSolution solc_;      // its solution (and warm start)
-  QpRiccatiIpm inner_;
+  std::unique_ptr<QpSolver> inner_;  // QpRiccatiIpm, or QpRiccatiIpmPairs(levels − 1)
   // Condensing workspace, sized for the largest stage.
   Eigen::MatrixXd Q1A0_;  // nx1 x nx0
   Eigen::MatrixXd Q1B0_;  // nx1 x nu0

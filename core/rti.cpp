@@ -57,6 +57,7 @@ bool RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   qp_dense_.set_method(settings.qp_solver == QpSolverKind::condensed_active_set
                            ? CondensedQpMethod::active_set
                            : CondensedQpMethod::ipm);
+  qp_pairs_.set_levels(settings.qp_pair_levels);
   if (!qp_solver().setup(dims, settings.qp)) return false;
 
   // Constant parts of the QP: index lists and slack weights.

@@ -40,6 +40,8 @@ struct RtiSettings {
   bool qp_warm_start = rti_defaults::kQpWarmStart;
   // QP solver variant; condensed_* condense the Hessian in prepare() (no x̄_0 needed).
   QpSolverKind qp_solver = rti_defaults::kQpSolver;
+  // riccati_ipm_pairs: how many times stage pairs are condensed (blocks of 2^levels stages).
+  int qp_pair_levels = rti_defaults::kQpPairLevels;
 };
 
 enum class RtiStatus {

@@ -47,6 +47,10 @@ inline constexpr double kRefineRatio = 0.1;
 // ... and only while μ < kRefineMuRatio · tol_comp: W = λ/t ≈ λ²/μ is only then large enough for
 // the rounding it amplifies to matter.
 inline constexpr double kRefineMuRatio = 1e3;
+// QpRiccatiIpmPairs: pair condensing applied this many times (blocks of 2^levels stages).
+// Cold solves, condensing included, levels 1/2/3/4: MI QP (nx 16, nu 4, N 50) 326/309/350/503 µs,
+// Crazyflie (nx 13, N 50) 413/357/359/438 µs, Pendubot (nx 4, nu 1, N 10) 45/37/35/33 µs.
+inline constexpr int kPairLevels = 2;
 // ... and only while ε‖W‖∞‖Δv‖∞ · kRefineBoundSafety (an a-priori bound on the error, measured
 // 1–3 orders of magnitude above the actual one on the test and controller QPs) exceeds the
 // target; otherwise the error is not even measured.
@@ -91,6 +95,9 @@ namespace rti_defaults {
 // obstacles 228 vs 276 µs, mi 343 vs 351 µs, the QP feedback phase of mi 214 vs 266 µs (the
 // condensing moves into prepare()).
 inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm_pairs;
+// One level of pairs in RTI: its warm-started QPs take ~2 iterations, too few to repay a second
+// condensing level (BM_Rti/mi 379 µs with two levels, 343 µs with one).
+inline constexpr int kQpPairLevels = 1;
 }  // namespace rti_defaults
 
 // PH index of SPEC §5.4 (Table 7.1).

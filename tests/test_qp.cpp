@@ -234,11 +234,21 @@ INSTANTIATE_TEST_SUITE_P(Sizes, RandomQp, ::testing::ValuesIn(kRandomCases), cas
 // The same cases through partial condensing (core/qp_riccati_ipm_pairs): odd and even N, N = 1
 // and 2 (nothing or one pair to condense), stage-varying nx, soft and general constraints on the
 // eliminated stages; the expanded solution, multipliers included, is checked as above.
+// Pairs condensed `Levels` times (blocks of 2^Levels stages).
+template <int Levels>
+struct PairsSolver : QpRiccatiIpmPairs {
+  PairsSolver(const OcpQpDims& dims, const QpSettings& settings)
+      : QpRiccatiIpmPairs(dims, settings, Levels) {}
+};
+
 class PairsRandomQp : public ::testing::TestWithParam<Case> {};
 
 TEST_P(PairsRandomQp, MatchesCertifiedDenseReference) {
   const Case& c = GetParam();
-  expect_matches_reference<QpRiccatiIpmPairs>(testing_qp::random_qp(c.spec, c.seed));
+  const OcpQp qp = testing_qp::random_qp(c.spec, c.seed);
+  expect_matches_reference<PairsSolver<1>>(qp);
+  expect_matches_reference<PairsSolver<2>>(qp);
+  expect_matches_reference<PairsSolver<3>>(qp);
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, PairsRandomQp, ::testing::ValuesIn(kRandomCases), case_name);

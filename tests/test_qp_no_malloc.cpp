@@ -129,8 +129,13 @@ void expect_solves_allocate_nothing() {
 
 TEST(QpNoMalloc, SolveAllocatesNothing) { expect_solves_allocate_nothing<QpRiccatiIpm>(); }
 
+struct PairsOnce : QpRiccatiIpmPairs {  // one level: the plain Riccati IPM inside
+  explicit PairsOnce(const OcpQpDims& dims) : QpRiccatiIpmPairs(dims, {}, 1) {}
+};
+
 TEST(QpNoMalloc, PairsPrepareAndSolveAllocateNothing) {
-  expect_solves_allocate_nothing<QpRiccatiIpmPairs>();
+  expect_solves_allocate_nothing<QpRiccatiIpmPairs>();  // nested: pairs of pairs
+  expect_solves_allocate_nothing<PairsOnce>();
 }
 
 TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {

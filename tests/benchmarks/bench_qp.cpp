@@ -1,5 +1,5 @@
-// BM_QpSolve/<problem>: one OCP-QP solve by the RTI's default solver, the Riccati IPM behind
-// partial condensing of stage pairs (QpRiccatiIpmPairs; issue 3, SPEC §4), on the QPs of
+// BM_QpSolve/<problem>: one OCP-QP solve by the Riccati IPM behind partial condensing of stage
+// pairs, twice (QpRiccatiIpmPairs' default: blocks of 4 stages; issue 3, SPEC §4), on the QPs of
 // tests/qp_problems.hpp, at the issue's tolerances (complementarity 1e-8, stationarity 1e-6).
 // The condensing and the expansion of the solution are part of every timed solve.
 //   mi         MikroKopter mixed-initiative (SPEC §5.4): nx 16, nu 4, N 50, 4 τ bounds per stage,
@@ -101,8 +101,8 @@ void add(const std::string& name, const OcpQp& (*problem)(), bool warm) {
   })->Unit(benchmark::kMicrosecond);
 }
 
-// Per problem: the default solver (QpRiccatiIpmPairs, as RTI uses it), then the stage-wise
-// Riccati IPM; full condensing where the horizon suits it.
+// Per problem: QpRiccatiIpmPairs (default levels), then the stage-wise Riccati IPM; full
+// condensing where the horizon suits it.
 const bool registered = [] {
   struct Problem {
     const char* name;
