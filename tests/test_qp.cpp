@@ -118,6 +118,19 @@ bool all_finite(const OcpQpSolution& s) {
          ok(s.lam_sl) && ok(s.lam_su) && s.lam_x0.allFinite() && std::isfinite(s.objective);
 }
 
+// Inconsistent hard bounds on input 0 of `stage` (lb = 1 > ub = −1): the solve stops with
+// min_step or max_iterations and a finite iterate.
+void expect_inconsistent_bounds_fail_cleanly(QpSolver& solver, const OcpQp& qp, int stage) {
+  OcpQp infeasible = qp;
+  infeasible.stage[stage].lbu[0] = 1.0;
+  infeasible.stage[stage].ubu[0] = -1.0;
+  OcpQpSolution sol(qp.dims);
+  const QpStatus st = solver.solve(infeasible, sol);
+  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
+  EXPECT_EQ(sol.status, st);
+  EXPECT_TRUE(all_finite(sol));
+}
+
 QpRiccatiIpmSettings tight() {
   QpRiccatiIpmSettings s;
   // An order of magnitude below the 1e-8 required of the KKT residuals.
@@ -659,13 +672,7 @@ TEST(QpDenseIpm, FailureStatusesWithoutNan) {
   bad = qp;
   bad.stage[0].idxbu[0] = qp.dims.nu[0];
   EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
-  // Inconsistent hard bounds on an input: infeasible, stops with a finite iterate.
-  OcpQp infeasible = qp;
-  infeasible.stage[0].lbu[0] = 1.0;
-  infeasible.stage[0].ubu[0] = -1.0;
-  const QpStatus st = solver.solve(infeasible, sol);
-  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
-  EXPECT_TRUE(all_finite(sol));
+  expect_inconsistent_bounds_fail_cleanly(solver, qp, 0);
   QpSettings few;
   few.max_iterations = 1;
   QpDenseIpm limited(qp.dims, few);
@@ -849,12 +856,7 @@ TEST(QpDenseActiveSet, FailureStatusesWithoutNan) {
   EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
   EXPECT_TRUE(all_finite(sol));
   // Inconsistent hard bounds on an input: both sides end in hold on one variable.
-  OcpQp infeasible = qp;
-  infeasible.stage[0].lbu[0] = 1.0;
-  infeasible.stage[0].ubu[0] = -1.0;
-  const QpStatus st = solver.solve(infeasible, sol);
-  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
-  EXPECT_TRUE(all_finite(sol));
+  expect_inconsistent_bounds_fail_cleanly(solver, qp, 0);
   QpSettings few;
   few.max_iterations = 1;
   QpDenseActiveSet limited(qp.dims, few);
@@ -958,12 +960,7 @@ TEST(QpRiccatiIpmPairs, FailureStatusesWithoutNan) {
   for (auto& s : indefinite.stage) s.R *= -1.0;
   EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
   EXPECT_TRUE(all_finite(sol));
-  OcpQp infeasible = qp;  // inconsistent bounds on an eliminated (odd) stage's input
-  infeasible.stage[3].lbu.setConstant(1.0);
-  infeasible.stage[3].ubu.setConstant(-1.0);
-  const QpStatus st = solver.solve(infeasible, sol);
-  EXPECT_TRUE(st == QpStatus::min_step || st == QpStatus::max_iterations) << to_string(st);
-  EXPECT_TRUE(all_finite(sol));
+  expect_inconsistent_bounds_fail_cleanly(solver, qp, 3);  // an eliminated (odd) stage's input
   EXPECT_EQ(solver.solve(qp, sol), QpStatus::success);
   QpRiccatiIpmPairs other(OcpQpDims::uniform(4, 3, 2));
   EXPECT_EQ(other.solve(qp, sol), QpStatus::invalid_data);

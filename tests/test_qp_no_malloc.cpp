@@ -90,34 +90,40 @@ TEST(QpNoMalloc, GuardsAreLive) {
 #endif
 }
 
-// Cold, primal and primal-dual warm starts (after a prepare() where the solver has one), invalid
-// data and a failed factorization: none allocates.
-template <class Solver>
-void expect_solves_allocate_nothing() {
+// A QP and two variants that must fail: NaN in the data, an indefinite Hessian.
+struct QpCases {
+  OcpQp qp, bad, indefinite;
+};
+
+QpCases random_cases(int N, int nx_min, int nx_max, int nu, unsigned seed) {
   testing_qp::RandomQpSpec spec;
-  spec.N = 21;      // odd: QpRiccatiIpmPairs then has a lone last dynamic stage too
-  spec.nx_min = 6;
-  spec.nx_max = 9;  // stage-varying dims
-  spec.nu = 3;
+  spec.N = N;
+  spec.nx_min = nx_min;
+  spec.nx_max = nx_max;
+  spec.nu = nu;
   spec.ng_max = 2;
   spec.soft_fraction = 0.4;
-  const OcpQp qp = testing_qp::random_qp(spec, 77);
-  OcpQp bad = qp;
-  bad.stage[3].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  OcpQp indefinite = qp;
-  for (auto& s : indefinite.stage) s.R *= -1.0;
+  QpCases c{testing_qp::random_qp(spec, seed), {}, {}};
+  c.bad = c.qp;
+  c.bad.stage[3].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  c.indefinite = c.qp;
+  for (auto& st : c.indefinite.stage) st.R *= -1.0;
+  return c;
+}
 
-  Solver solver(qp.dims);
-  OcpQpSolution sol(qp.dims);
+// Cold, primal and primal-dual warm starts (after a prepare(), where the solver has one),
+// invalid data and a failed factorization: none allocates.
+void expect_solves_allocate_nothing(QpSolver& solver, const QpCases& c) {
+  OcpQpSolution sol(c.qp.dims);
   QpStatus cold, primal, dual, invalid, failed;
   {
     NoMalloc guard;
-    cold = solver.solve(qp, sol);
-    solver.prepare(qp);
-    primal = solver.solve(qp, sol, QpWarmStart::primal);
-    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
-    invalid = solver.solve(bad, sol);
-    failed = solver.solve(indefinite, sol);
+    cold = solver.solve(c.qp, sol);
+    solver.prepare(c.qp);
+    primal = solver.solve(c.qp, sol, QpWarmStart::primal);
+    dual = solver.solve(c.qp, sol, QpWarmStart::primal_dual);
+    invalid = solver.solve(c.bad, sol);
+    failed = solver.solve(c.indefinite, sol);
     EXPECT_EQ(NoMalloc::count(), 0);
   }
   EXPECT_EQ(cold, QpStatus::success);
@@ -127,49 +133,28 @@ void expect_solves_allocate_nothing() {
   EXPECT_EQ(failed, QpStatus::factorization_failed);
 }
 
-TEST(QpNoMalloc, SolveAllocatesNothing) { expect_solves_allocate_nothing<QpRiccatiIpm>(); }
+// N = 21 (odd: QpRiccatiIpmPairs then has a lone last dynamic stage too), stage-varying nx.
+const QpCases& riccati_cases() {
+  static const QpCases c = random_cases(21, 6, 9, 3, 77);
+  return c;
+}
 
-struct PairsOnce : QpRiccatiIpmPairs {  // one level: the plain Riccati IPM inside
-  explicit PairsOnce(const OcpQpDims& dims) : QpRiccatiIpmPairs(dims, {}, 1) {}
-};
+TEST(QpNoMalloc, SolveAllocatesNothing) {
+  QpRiccatiIpm solver(riccati_cases().qp.dims);
+  expect_solves_allocate_nothing(solver, riccati_cases());
+}
 
 TEST(QpNoMalloc, PairsPrepareAndSolveAllocateNothing) {
-  expect_solves_allocate_nothing<QpRiccatiIpmPairs>();  // nested: pairs of pairs
-  expect_solves_allocate_nothing<PairsOnce>();
+  for (const int levels : {1, 2}) {  // 2: nested, pairs of pairs
+    QpRiccatiIpmPairs solver(riccati_cases().qp.dims, {}, levels);
+    expect_solves_allocate_nothing(solver, riccati_cases());
+  }
 }
 
 TEST(QpNoMalloc, CondensedDensePrepareAndSolveAllocateNothing) {
-  testing_qp::RandomQpSpec spec;
-  spec.N = 12;
-  spec.nx_min = 3;
-  spec.nx_max = 6;  // stage-varying dims
-  spec.nu = 2;
-  spec.ng_max = 2;
-  spec.soft_fraction = 0.4;
-  const OcpQp qp = testing_qp::random_qp(spec, 78);
-  OcpQp bad = qp;
-  bad.stage[3].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  OcpQp indefinite = qp;
-  for (auto& s : indefinite.stage) s.R *= -1.0;
-
-  QpCondensedDense solver(qp.dims);
-  OcpQpSolution sol(qp.dims);
-  QpStatus cold, prepared, dual, invalid, failed;
-  {
-    NoMalloc guard;
-    cold = solver.solve(qp, sol);
-    solver.prepare(qp);
-    prepared = solver.solve(qp, sol, QpWarmStart::primal);
-    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
-    invalid = solver.solve(bad, sol);
-    failed = solver.solve(indefinite, sol);
-    EXPECT_EQ(NoMalloc::count(), 0);
-  }
-  EXPECT_EQ(cold, QpStatus::success);
-  EXPECT_EQ(prepared, QpStatus::success);
-  EXPECT_EQ(dual, QpStatus::success);
-  EXPECT_EQ(invalid, QpStatus::invalid_data);
-  EXPECT_EQ(failed, QpStatus::factorization_failed);
+  const QpCases c = random_cases(12, 3, 6, 2, 78);  // stage-varying dims
+  QpCondensedDense solver(c.qp.dims);
+  expect_solves_allocate_nothing(solver, c);
 }
 
 TEST(QpNoMalloc, CondensedActiveSetPrepareAndSolveAllocateNothing) {
@@ -219,29 +204,13 @@ TEST(QpNoMalloc, DenseIpmSolveAllocatesNothing) {
   QpCondensedDense condenser(ocp.dims);
   OcpQpSolution osol(ocp.dims);
   ASSERT_EQ(condenser.solve(ocp, osol), QpStatus::success);
-  const OcpQp qp = condenser.condensed_qp();
-  OcpQp bad = qp;
-  bad.stage[0].R(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  OcpQp indefinite = qp;
-  indefinite.stage[0].R *= -1.0;
-
-  QpDenseIpm solver(qp.dims);
-  OcpQpSolution sol(qp.dims);
-  QpStatus cold, primal, dual, invalid, failed;
-  {
-    NoMalloc guard;
-    cold = solver.solve(qp, sol);
-    primal = solver.solve(qp, sol, QpWarmStart::primal);
-    dual = solver.solve(qp, sol, QpWarmStart::primal_dual);
-    invalid = solver.solve(bad, sol);
-    failed = solver.solve(indefinite, sol);
-    EXPECT_EQ(NoMalloc::count(), 0);
-  }
-  EXPECT_EQ(cold, QpStatus::success);
-  EXPECT_EQ(primal, QpStatus::success);
-  EXPECT_EQ(dual, QpStatus::success);
-  EXPECT_EQ(invalid, QpStatus::invalid_data);
-  EXPECT_EQ(failed, QpStatus::factorization_failed);
+  QpCases c{condenser.condensed_qp(), {}, {}};  // one stage, no states
+  c.bad = c.qp;
+  c.bad.stage[0].R(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  c.indefinite = c.qp;
+  c.indefinite.stage[0].R *= -1.0;
+  QpDenseIpm solver(c.qp.dims);
+  expect_solves_allocate_nothing(solver, c);
 }
 
 }  // namespace
