@@ -139,9 +139,8 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   const OcpQpStage& s1 = qp.stage[k + 1];
   OcpQpStage& t = qpc_.stage[j];
   const int nx0 = d.nx[k], nu0 = d.nu[k], nx1 = d.nx[k + 1], nu1 = d.nu[k + 1];
-  const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx0 = d.nbx[k], nbx1 = d.nbx[k + 1];
+  const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx1 = d.nbx[k + 1];
   const int ng0 = d.ng[k], ng1 = d.ng[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
-  const int nbu = nbu0 + nbu1;
   const Eigen::MatrixXd &A0 = s0.A, &B0 = s0.B;
   auto Q1A0 = Q1A0_.topLeftCorner(nx1, nx0);
   auto Q1B0 = Q1B0_.topLeftCorner(nx1, nu0);
@@ -217,16 +216,14 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
     }
   }
   // Soft constraints: stage k's, then stage k+1's, re-indexed into the block's d.
-  for (int r = 0; r < ns0; ++r) {
-    const int c = s0.idxs[r];
-    t.idxs[r] = c < nbu0 ? c : c < nbu0 + nbx0 ? nbu + (c - nbu0) : nbu + nbx0 + (c - nbu0 - nbx0);
-  }
-  for (int r = 0; r < ns1; ++r) {
-    const int c = s1.idxs[r];
-    t.idxs[ns0 + r] = c < nbu1          ? nbu0 + c
-                      : c < nbu1 + nbx1 ? nbu + nbx0 + ng0 + (c - nbu1)
-                                        : nbu + nbx0 + ng0 + nbx1 + (c - nbu1 - nbx1);
-  }
+  const std::array<Segment, 6> segments = pair_segments(d, k);
+  const auto block_index = [&](int stage, int c) {
+    for (const Segment& g : segments)
+      if (g.stage == stage && c >= g.offset && c < g.offset + g.size) return g.block + c - g.offset;
+    return -1;  // unreachable: the indices were validated
+  };
+  for (int r = 0; r < ns0; ++r) t.idxs[r] = block_index(0, s0.idxs[r]);
+  for (int r = 0; r < ns1; ++r) t.idxs[ns0 + r] = block_index(1, s1.idxs[r]);
   t.Zl.head(ns0) = s0.Zl;
   t.Zl.tail(ns1) = s1.Zl;
   t.Zu.head(ns0) = s0.Zu;
