@@ -54,28 +54,14 @@ TEST(NoMalloc, Erk4MikroKopter) {
   expect_erk4_allocation_free(mk, mk.hover_state({0, 0, 1}), mk.hover_input());
 }
 
+// Every QP solver of the RTI: the Riccati IPMs on N = 50, condensing on a short horizon (N = 10)
+// where it pays.
 TEST(NoMalloc, RtiPrepareFeedbackShift) {
-  CrazyflieTracking problem(50, 0.015);
-  RtiSolver rti;
-  ASSERT_TRUE(rti.setup(problem.ocp()));
-  problem.set_hover_target(rti.data(), {0.1, -0.1, 0.5});
-  problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
-  Eigen::VectorXd x = problem.model().hover_state({0, 0, 0.4});
-  Eigen::VectorXd u(4);
-  for (int k = 0; k < 5; ++k) {
-    NoMalloc guard;
-    ASSERT_EQ(rti.prepare(), RtiStatus::success);
-    ASSERT_EQ(rti.feedback(x), RtiStatus::success);
-    u = rti.control();
-    rti.shift();
-    x(2) += 0.01;  // a new measurement
-  }
-  EXPECT_TRUE(u.allFinite());
-}
-
-TEST(NoMalloc, RtiPrepareFeedbackShiftCondensedDense) {
-  for (QpSolverKind kind : {QpSolverKind::condensed_dense, QpSolverKind::condensed_active_set}) {
-    CrazyflieTracking problem(10, 0.015);  // a short horizon, where condensing pays
+  for (QpSolverKind kind : {QpSolverKind::riccati_ipm, QpSolverKind::riccati_ipm_pairs,
+                            QpSolverKind::condensed_dense, QpSolverKind::condensed_active_set}) {
+    const bool riccati =
+        kind == QpSolverKind::riccati_ipm || kind == QpSolverKind::riccati_ipm_pairs;
+    CrazyflieTracking problem(riccati ? 50 : 10, 0.015);
     RtiSolver rti;
     RtiSettings settings;
     settings.qp_solver = kind;

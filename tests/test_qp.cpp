@@ -118,6 +118,19 @@ bool all_finite(const OcpQpSolution& s) {
          ok(s.lam_sl) && ok(s.lam_su) && s.lam_x0.allFinite() && std::isfinite(s.objective);
 }
 
+// NaN in the data and an index out of range: invalid_data, and no NaN in the output.
+void expect_invalid_data_rejected(QpSolver& solver, const OcpQp& qp) {
+  OcpQpSolution sol(qp.dims);
+  OcpQp bad = qp;
+  bad.stage[0].D(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+  bad = qp;
+  bad.stage[0].idxbu[0] = qp.dims.nu[0];
+  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  EXPECT_TRUE(all_finite(sol));
+}
+
 // Inconsistent hard bounds on input 0 of `stage` (lb = 1 > ub = −1): the solve stops with
 // min_step or max_iterations and a finite iterate.
 void expect_inconsistent_bounds_fail_cleanly(QpSolver& solver, const OcpQp& qp, int stage) {
@@ -665,13 +678,7 @@ TEST(QpDenseIpm, FailureStatusesWithoutNan) {
   indefinite.stage[0].R = -1e4 * Eigen::MatrixXd::Identity(qp.dims.nu[0], qp.dims.nu[0]);
   EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
   EXPECT_TRUE(all_finite(sol));
-  OcpQp bad = qp;
-  bad.stage[0].D(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
-  EXPECT_TRUE(all_finite(sol));
-  bad = qp;
-  bad.stage[0].idxbu[0] = qp.dims.nu[0];
-  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
+  expect_invalid_data_rejected(solver, qp);
   expect_inconsistent_bounds_fail_cleanly(solver, qp, 0);
   QpSettings few;
   few.max_iterations = 1;
@@ -847,14 +854,7 @@ TEST(QpDenseActiveSet, FailureStatusesWithoutNan) {
   indefinite.stage[0].R = -Eigen::MatrixXd::Identity(qp.dims.nu[0], qp.dims.nu[0]);
   EXPECT_EQ(solver.solve(indefinite, sol), QpStatus::factorization_failed);
   EXPECT_TRUE(all_finite(sol));
-  OcpQp bad = qp;
-  bad.stage[0].D(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
-  EXPECT_TRUE(all_finite(sol));
-  bad = qp;
-  bad.stage[0].idxbu[0] = qp.dims.nu[0];
-  EXPECT_EQ(solver.solve(bad, sol), QpStatus::invalid_data);
-  EXPECT_TRUE(all_finite(sol));
+  expect_invalid_data_rejected(solver, qp);
   // Inconsistent hard bounds on an input: both sides end in hold on one variable.
   expect_inconsistent_bounds_fail_cleanly(solver, qp, 0);
   QpSettings few;
