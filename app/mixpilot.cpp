@@ -14,15 +14,15 @@
 #include <thread>
 #include <vector>
 
-#include "core/integrator_erk4.hpp"
-#include "core/mode.hpp"
-#include "core/pilot_emulated.hpp"
-#include "core/recording.hpp"
-#include "core/scenario_toml.hpp"
-#include "core/score.hpp"
-#include "core/session.hpp"
-#include "core/session_recording.hpp"
-#include "core/version.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/modes/mode.hpp"
+#include "core/control/pilot_emulated.hpp"
+#include "core/recording/recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
+#include "core/modes/score.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/numerics/version.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"
@@ -157,7 +157,7 @@ void print_summary(const Scenario& sc, const std::string& pilot, const Score& s,
   if (lost) std::printf("  the vehicle was lost: the plant state stopped being finite\n");
 }
 
-// Modes other than mixed_initiative fly on their own (core/mode.hpp).
+// Modes other than mixed_initiative fly on their own (core/modes/mode.hpp).
 int run_mode(const std::string& mode, const FlyOptions& o) {
   const ModeRunner runner = find_mode_runner(mode);
   if (!runner) {

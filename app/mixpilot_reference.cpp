@@ -1,15 +1,15 @@
-// mixpilot-reference: offline reference trajectories computed with Ipopt (core/nlp_ipopt.hpp).
+// mixpilot-reference: offline reference trajectories computed with Ipopt (core/nlp/nlp_ipopt.hpp).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <string_view>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/nlp_ipopt.hpp"
-#include "core/pendubot_swingup.hpp"
-#include "core/obstacles.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/nlp/nlp_ipopt.hpp"
+#include "core/modes/pendubot_swingup.hpp"
+#include "core/modes/obstacles.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 namespace {
 
@@ -29,7 +29,7 @@ constexpr const char* kUsage =
     "  obstacles-p2  the same to p2 = (0.5,-0.5,1) (scenarios/references/obstacles_to_0.5_-0.5_1.csv)\n"
     "\n"
     "options:\n"
-    "  --out FILE          write the trajectory as CSV (docs: core/trajectory_io.hpp)\n"
+    "  --out FILE          write the trajectory as CSV (docs: core/nlp/trajectory_io.hpp)\n"
     "  --hessian NAME      fd-curvature (default), gauss-newton or limited-memory\n"
     "  --tol X             Ipopt tolerance (default 1e-10)\n"
     "  --max-iter N        iteration limit (default 1000)\n"
@@ -134,7 +134,7 @@ int run_obstacle_reference(const Eigen::Vector3d& target, const std::string& out
   return 0;
 }
 
-// SPEC 5.1: the Pendubot swing-up reference the NMPC tracks (core/pendubot_swingup.hpp).
+// SPEC 5.1: the Pendubot swing-up reference the NMPC tracks (core/modes/pendubot_swingup.hpp).
 int run_pendubot_swingup(const std::string& out, const IpoptOcpSettings& settings, int N) {
   PendubotReferenceSettings s;
   s.ipopt = settings;

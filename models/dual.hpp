@@ -4,7 +4,7 @@
 //
 // Why not Eigen's AutoDiffScalar: its expression templates leave nested temporaries that g++
 // does not flatten; a whole ERK4 step with it ran 3-6x slower than with this type
-// (core/integrator_erk4.hpp). Here every operation is eager: one pass over the derivatives,
+// (core/numerics/integrator_erk4.hpp). Here every operation is eager: one pass over the derivatives,
 // stored as g++ vector-extension blocks of 4 doubles (one AVX2 register each, padded with
 // zero lanes, which every operation keeps zero), so the optimizer keeps the temporaries of
 // an inlined expression in registers and emits one FMA-width instruction per block.

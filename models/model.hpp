@@ -5,7 +5,7 @@
 // with a fixed-size derivative array) rather than hand-written formulas: they are exact to
 // rounding, cannot drift from the model when it changes, and the fixed size lets the compiler
 // unroll and vectorize the derivative arithmetic, which exploits the sparsity of f for free
-// (each elementary operation costs one short vector update). See core/integrator_erk4.hpp for
+// (each elementary operation costs one short vector update). See core/numerics/integrator_erk4.hpp for
 // the same technique applied to a whole ERK4 step, which is what the NMPC uses.
 #include <concepts>
 

@@ -12,7 +12,7 @@
 
 #include <Eigen/Dense>
 
-#include "core/ocp_qp.hpp"
+#include "core/qp/ocp_qp.hpp"
 
 namespace mixpilot::testing_qp {
 

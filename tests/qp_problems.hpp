@@ -7,8 +7,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/integrator_erk4.hpp"
-#include "core/ocp_qp.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/qp/ocp_qp.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"

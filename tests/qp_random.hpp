@@ -9,7 +9,7 @@
 #include <numeric>
 #include <random>
 
-#include "core/ocp_qp.hpp"
+#include "core/qp/ocp_qp.hpp"
 
 namespace mixpilot::testing_qp {
 

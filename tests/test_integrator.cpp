@@ -1,11 +1,11 @@
-// ERK4 (core/integrator_erk4.hpp): convergence order, sensitivities vs finite differences,
+// ERK4 (core/numerics/integrator_erk4.hpp): convergence order, sensitivities vs finite differences,
 // quaternion norm, and agreement of the fixed-size and the virtual interfaces.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "core/integrator_erk4.hpp"
+#include "core/numerics/integrator_erk4.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"

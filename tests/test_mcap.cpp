@@ -1,4 +1,4 @@
-// MCAP container (core/mcap.hpp), CRC-32 and CDR (core/cdr.hpp): known vectors, exact byte
+// MCAP container (core/recording/mcap.hpp), CRC-32 and CDR (core/recording/cdr.hpp): known vectors, exact byte
 // layouts, round trips, crash behaviour, and malformed input (every truncation, random
 // corruption) giving clean errors that name a byte offset.
 #include <gtest/gtest.h>
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "core/cdr.hpp"
-#include "core/mcap.hpp"
+#include "core/recording/cdr.hpp"
+#include "core/recording/mcap.hpp"
 
 namespace mixpilot {
 namespace {

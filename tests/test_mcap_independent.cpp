@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "core/recording.hpp"
-#include "core/version.hpp"
+#include "core/recording/recording.hpp"
+#include "core/numerics/version.hpp"
 
 #ifndef MIXPILOT_NODE
 #define MIXPILOT_NODE ""

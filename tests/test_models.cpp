@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
-#include "core/integrator_erk4.hpp"
+#include "core/numerics/integrator_erk4.hpp"
 #include "models/crazyflie.hpp"
 #include "models/dual.hpp"
 #include "models/mikrokopter.hpp"

@@ -1,4 +1,4 @@
-// The Ipopt adapter (core/nlp_ipopt.hpp) and trajectory files (core/trajectory_io.hpp):
+// The Ipopt adapter (core/nlp/nlp_ipopt.hpp) and trajectory files (core/nlp/trajectory_io.hpp):
 // - a linear-quadratic OCP against a dense KKT solve;
 // - hard and soft (ℓ1, ℓ2²) path constraints and state bounds against the dense KKT solve of
 //   the active set the adapter found (which verifies that set: multiplier signs, feasibility);
@@ -13,9 +13,9 @@
 
 #include <Eigen/Dense>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/nlp_ipopt.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/nlp/nlp_ipopt.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 #ifndef MIXPILOT_SOURCE_DIR
 #error "MIXPILOT_SOURCE_DIR must point to the repository root"

@@ -2,21 +2,16 @@
 // allocation check armed (EIGEN_RUNTIME_NO_MALLOC), which aborts on any Eigen heap allocation.
 #include <gtest/gtest.h>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/integrator_erk4.hpp"
-#include "core/rti.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/nlp/rti.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"
+#include "no_malloc.hpp"
 
 namespace mixpilot {
 namespace {
-
-// RAII guard: Eigen heap allocation is forbidden while it lives.
-struct NoMalloc {
-  NoMalloc() { Eigen::internal::set_is_malloc_allowed(false); }
-  ~NoMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
-};
 
 TEST(NoMallocGuard, CatchesAnAllocation) {
   // The check is live in this build: an allocation under the guard aborts.

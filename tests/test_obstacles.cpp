@@ -1,4 +1,4 @@
-// Obstacle avoidance with the LCL constraint (SPEC §5.3, core/obstacles.hpp): Proposition 1,
+// Obstacle avoidance with the LCL constraint (SPEC §5.3, core/modes/obstacles.hpp): Proposition 1,
 // the shipped scenarios in closed loop with both constraint forms, converged SQP equivalence,
 // the mode runner and scenario diagnostics.
 #include <gtest/gtest.h>
@@ -9,9 +9,9 @@
 #include <random>
 #include <string>
 
-#include "core/mode.hpp"
-#include "core/obstacle_constraint.hpp"
-#include "core/obstacles.hpp"
+#include "core/modes/mode.hpp"
+#include "core/control/obstacle_constraint.hpp"
+#include "core/modes/obstacles.hpp"
 
 namespace mixpilot {
 namespace {

@@ -1,4 +1,4 @@
-// Pendubot swing-up (core/pendubot_swingup.hpp, SPEC §5.1, issue 6): the shipped scenarios reach
+// Pendubot swing-up (core/modes/pendubot_swingup.hpp, SPEC §5.1, issue 6): the shipped scenarios reach
 // and hold up-up with |u| ≤ 0.4 (exact state and encoders), velocity-bound violations are
 // reported, the LQR stabilizes the linearization, the committed Ipopt reference satisfies the
 // dynamics and bounds, and scenario errors name file:line:col: key.
@@ -9,9 +9,9 @@
 
 #include <Eigen/Dense>
 
-#include "core/mode.hpp"
-#include "core/pendubot_swingup.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/modes/mode.hpp"
+#include "core/modes/pendubot_swingup.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 #ifndef MIXPILOT_SOURCE_DIR
 #error "MIXPILOT_SOURCE_DIR must point to the repository root"

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "core/ph_index.hpp"
+#include "core/control/ph_index.hpp"
 
 namespace mixpilot {
 namespace {

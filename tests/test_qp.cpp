@@ -9,13 +9,13 @@
 
 #include <sstream>
 
-#include "core/ocp_qp_io.hpp"
-#include "core/qp_condensed_dense.hpp"
-#include "core/qp_dense_active_set.hpp"
-#include "core/qp_dense_ipm.hpp"
-#include "core/qp_kernels.hpp"
-#include "core/qp_riccati_ipm.hpp"
-#include "core/qp_riccati_ipm_pairs.hpp"
+#include "core/qp/ocp_qp_io.hpp"
+#include "core/qp/qp_condensed_dense.hpp"
+#include "core/qp/qp_dense_active_set.hpp"
+#include "core/qp/qp_dense_ipm.hpp"
+#include "core/qp/qp_kernels.hpp"
+#include "core/qp/qp_riccati_ipm.hpp"
+#include "core/qp/qp_riccati_ipm_pairs.hpp"
 #include "qp_dense_reference.hpp"
 #include "qp_problems.hpp"
 #include "qp_random.hpp"
@@ -26,7 +26,7 @@ namespace {
 using testing_qp::RandomQpSpec;
 
 // KKT residuals of (x, u, s, π, λ) for the OCP-QP, from the problem data alone
-// (conventions of core/ocp_qp.hpp).
+// (conventions of core/qp/ocp_qp.hpp).
 struct Kkt {
   double stat = 0, dyn = 0, primal = 0, dual = 0, comp = 0, x0 = 0;
   double max() const { return std::max({stat, dyn, primal, dual, comp, x0}); }

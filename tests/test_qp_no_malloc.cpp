@@ -4,71 +4,17 @@
 // growth, operator new, ...) is counted while solve() runs and must stay at zero.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-
-#include "core/qp_condensed_dense.hpp"
-#include "core/qp_dense_active_set.hpp"
-#include "core/qp_dense_ipm.hpp"
-#include "core/qp_riccati_ipm.hpp"
-#include "core/qp_riccati_ipm_pairs.hpp"
+#include "core/qp/qp_condensed_dense.hpp"
+#include "core/qp/qp_dense_active_set.hpp"
+#include "core/qp/qp_dense_ipm.hpp"
+#include "core/qp/qp_riccati_ipm.hpp"
+#include "core/qp/qp_riccati_ipm_pairs.hpp"
+#include "no_malloc.hpp"
 #include "qp_problems.hpp"
 #include "qp_random.hpp"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define MIXPILOT_COUNT_MALLOC 0
-#else
-#define MIXPILOT_COUNT_MALLOC 1
-#endif
-
-#if MIXPILOT_COUNT_MALLOC
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-extern "C" void* malloc(std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t m) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  return __libc_realloc(p, n);
-}
-#endif
-
 namespace mixpilot {
 namespace {
-
-// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
-struct NoMalloc {
-  NoMalloc() {
-#if MIXPILOT_COUNT_MALLOC
-    g_allocations = 0;
-    g_counting = true;
-#endif
-    Eigen::internal::set_is_malloc_allowed(false);
-  }
-  ~NoMalloc() {
-    Eigen::internal::set_is_malloc_allowed(true);
-#if MIXPILOT_COUNT_MALLOC
-    g_counting = false;
-#endif
-  }
-  static long count() {
-#if MIXPILOT_COUNT_MALLOC
-    return g_allocations.load();
-#else
-    return 0;
-#endif
-  }
-};
 
 TEST(QpNoMalloc, GuardsAreLive) {
   EXPECT_DEATH(

@@ -1,4 +1,4 @@
-// Session recordings (core/recording.hpp): every message type round-trips bit-exactly, a
+// Session recordings (core/recording/recording.hpp): every message type round-trips bit-exactly, a
 // recorded session reads back in order with its metadata, a failed session keeps its .tmp,
 // and corrupt or truncated recordings give errors naming a byte offset.
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <limits>
 #include <random>
 
-#include "core/recording.hpp"
-#include "core/version.hpp"
+#include "core/recording/recording.hpp"
+#include "core/numerics/version.hpp"
 
 namespace mixpilot {
 namespace {

@@ -1,15 +1,15 @@
-// RTI engine (core/rti.hpp) on the Crazyflie tracking OCP of SPEC §5.2.
+// RTI engine (core/nlp/rti.hpp) on the Crazyflie tracking OCP of SPEC §5.2.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/nlp_ipopt.hpp"
-#include "core/obstacle_constraint.hpp"
-#include "core/rti.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/nlp/nlp_ipopt.hpp"
+#include "core/control/obstacle_constraint.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 namespace mixpilot {
 namespace {

@@ -1,4 +1,4 @@
-// Scenario files (core/scenario_toml.hpp): the shipped mi_helix.toml and its geometry, the
+// Scenario files (core/scenario/scenario_toml.hpp): the shipped mi_helix.toml and its geometry, the
 // defaults, and that each kind of error names file, line, column and key.
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "core/scenario_toml.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot {
 namespace {

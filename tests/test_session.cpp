@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <memory>
 
-#include "core/pilot_emulated.hpp"
-#include "core/scenario_toml.hpp"
-#include "core/score.hpp"
-#include "core/session.hpp"
-#include "core/session_recording.hpp"
+#include "core/control/pilot_emulated.hpp"
+#include "core/scenario/scenario_toml.hpp"
+#include "core/modes/score.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/session_recording.hpp"
 
 namespace mixpilot {
 namespace {

@@ -1,4 +1,4 @@
-// Crazyflie tracking under delay (core/tracking.hpp, SPEC §5.2, thesis Fig. 5.6, issue 6): the
+// Crazyflie tracking under delay (core/modes/tracking.hpp, SPEC §5.2, thesis Fig. 5.6, issue 6): the
 // RTT study, the predictor's exactness, the 12-state LQR, the shipped scenarios and their errors.
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <string>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/integrator_erk4.hpp"
-#include "core/mode.hpp"
-#include "core/tracking.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/modes/mode.hpp"
+#include "core/modes/tracking.hpp"
 
 namespace mixpilot {
 namespace {
@@ -73,7 +73,7 @@ TEST(TrackingDelay, RttStudy) {
   EXPECT_EQ(nmpc[0][0].overshoot_m, nmpc[0][1].overshoot_m);
   EXPECT_EQ(lqr[0][0].tracking_rms_m, lqr[0][1].tracking_rms_m);
   // With a matched model the predictor restores the delay-free loop on the controller's clock
-  // (core/tracking.hpp): the compensated error does not depend on the RTT.
+  // (core/modes/tracking.hpp): the compensated error does not depend on the RTT.
   for (int i = 1; i < 4; ++i) {
     EXPECT_NEAR(nmpc[i][1].tracking_rms_m, nmpc[0][1].tracking_rms_m, 1e-6) << rtts[i];
     EXPECT_NEAR(nmpc[i][1].overshoot_m, nmpc[0][1].overshoot_m, 1e-6) << rtts[i];

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "core/integrator_erk4.hpp"
+#include "core/numerics/integrator_erk4.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"

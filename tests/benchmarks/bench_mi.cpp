@@ -7,11 +7,12 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <memory>
 
-#include "core/mi_controller.hpp"
-#include "core/pilot_emulated.hpp"
-#include "core/scenario_toml.hpp"
+#include "core/control/mi_controller.hpp"
+#include "core/control/pilot_emulated.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot {
 namespace {
@@ -44,9 +45,9 @@ void BM_RtiMi(benchmark::State& state, QpSolverKind qp_solver) {
     pilot = std::make_unique<EmulatedPilot>();
     RtiSettings rti;
     rti.qp_solver = qp_solver;
-    controller->setup(model, sc->controller, sc->arena, sc->reference, rti);
-    PilotProfile profile = sc->pilots.at("novice");
-    pilot->setup(model, profile, sc->reference, dt);
+    if (!controller->setup(model, sc->controller, sc->arena, sc->reference, rti) ||
+        !pilot->setup(model, sc->pilots.at("novice"), sc->reference, dt))
+      std::abort();  // the shipped scenario's settings form valid OCPs
     x = model.hover_state(sc->reference.position(0.0));
     controller->reset(x);
     for (k = 0; k < 100; ++k) {

@@ -9,7 +9,7 @@
 #include <chrono>
 #include <string>
 
-#include "core/obstacles.hpp"
+#include "core/modes/obstacles.hpp"
 
 namespace mixpilot {
 namespace {
@@ -24,7 +24,10 @@ void BM_RtiObstacles(benchmark::State& state) {
   }
   ObstacleAvoidanceOcp problem(sc->world.size(), sc->controller);
   RtiSolver rti;
-  rti.setup(problem.ocp());
+  if (const SetupResult r = rti.setup(problem.ocp()); !r) {
+    state.SkipWithError(r.reason().c_str());
+    return;
+  }
   const auto& erk4 = problem.integrator();
   const OcpTrajectory& ref = sc->reference.trajectory;
   const double dt = sc->controller.dt;

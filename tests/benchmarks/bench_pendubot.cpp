@@ -9,9 +9,9 @@
 
 #include <chrono>
 
-#include "core/pendubot_swingup.hpp"
-#include "core/rti.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/modes/pendubot_swingup.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 namespace mixpilot {
 namespace {
@@ -29,7 +29,10 @@ void BM_RtiPendubot(benchmark::State& state, QpSolverKind qp_solver) {
   RtiSolver rti;
   RtiSettings settings;
   settings.qp_solver = qp_solver;
-  rti.setup(problem.ocp(), settings);
+  if (const SetupResult r = rti.setup(problem.ocp(), settings); !r) {
+    state.SkipWithError(r.reason().c_str());
+    return;
+  }
   const auto& erk4 = problem.integrator();
   constexpr double dt = 0.002;
   constexpr int kSubsteps = 8;

@@ -22,10 +22,10 @@
 #include <set>
 #include <string>
 
-#include "core/ocp_qp_io.hpp"
-#include "core/qp_condensed_dense.hpp"
-#include "core/qp_riccati_ipm.hpp"
-#include "core/qp_riccati_ipm_pairs.hpp"
+#include "core/qp/ocp_qp_io.hpp"
+#include "core/qp/qp_condensed_dense.hpp"
+#include "core/qp/qp_riccati_ipm.hpp"
+#include "core/qp/qp_riccati_ipm_pairs.hpp"
 #include "tests/qp_problems.hpp"
 
 namespace mixpilot {

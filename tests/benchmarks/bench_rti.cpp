@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "core/crazyflie_tracking.hpp"
-#include "core/rti.hpp"
-#include "core/trajectory_io.hpp"
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/nlp/trajectory_io.hpp"
 
 namespace mixpilot {
 namespace {
@@ -25,7 +25,10 @@ void BM_RtiCrazyflieTracking(benchmark::State& state) {
   }
   CrazyflieTracking problem(50, 0.015);
   RtiSolver rti;
-  rti.setup(problem.ocp());
+  if (const SetupResult r = rti.setup(problem.ocp()); !r) {
+    state.SkipWithError(r.reason().c_str());
+    return;
+  }
   const auto& erk4 = problem.integrator();
 
   constexpr int kStart = 10, kSpan = 20;

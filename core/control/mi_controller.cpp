@@ -1,0 +1,172 @@
+#include "core/control/mi_controller.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace mixpilot {
+
+namespace {
+
+// y = (η, ν, e, u) as a selection of x = (p, γ, v_b, ω, Ω) and u = τ.
+Eigen::VectorXi output_state_index() {
+  Eigen::VectorXi idx(16);
+  idx << 0, 1, 2,      // η = p
+      3, 4,            // ν: φ, θ
+      12, 13, 14, 15,  // ν: Ω1..4
+      5,               // e: ψ
+      6, 7, 8,         // e: v_b
+      9, 10, 11;       // e: ω
+  return idx;
+}
+
+}  // namespace
+
+SetupResult MiController::setup(const models::MikroKopter& model, const MiControllerSettings& settings,
+                         const Arena& arena, const HelixReference& reference,
+                         const RtiSettings& rti_settings) {
+  model_ = model;
+  integrator_ = IntegratorErk4<models::MikroKopter>(model);
+  settings_ = settings;
+  arena_ = arena;
+  helix_ = reference;
+  output_ = SelectionOutput(output_state_index(), Eigen::VectorXi::LinSpaced(nu, 0, nu - 1));
+  terminal_output_ = SelectionOutput(output_state_index(), Eigen::VectorXi());
+
+  const int N = settings.N;
+  ocp_ = Ocp{};
+  ocp_.integrator = &integrator_;
+  ocp_.N = N;
+  ocp_.dt = settings.dt;
+  ocp_.output = &output_;
+  ocp_.terminal_output = &terminal_output_;
+  ocp_.idxbu = Eigen::VectorXi::LinSpaced(nu, 0, nu - 1);
+  ocp_.lbu = Eigen::VectorXd::Constant(nu, model.p.tau_min);
+  ocp_.ubu = Eigen::VectorXd::Constant(nu, model.p.tau_max);
+
+  const bool safety = settings.safety_constraints;
+  ocp_.idxbx.resize(safety ? 7 : 4);
+  ocp_.lbx.resize(ocp_.idxbx.size());
+  ocp_.ubx.resize(ocp_.idxbx.size());
+  ocp_.idxbx.head<4>() << 12, 13, 14, 15;
+  ocp_.lbx.head<4>().setConstant(model.p.omega_min + settings.rotor_speed_backoff);
+  ocp_.ubx.head<4>().setConstant(model.p.omega_max - settings.rotor_speed_backoff);
+  const double rv = settings.vehicle_radius;
+  const SoftConstraint soft{0, settings.slack_l2, settings.slack_l2, settings.slack_l1,
+                            settings.slack_l1};
+  if (safety) {
+    ocp_.idxbx.tail<3>() << 0, 1, 2;
+    ocp_.lbx.tail<3>() = arena.min.array() + rv;
+    ocp_.ubx.tail<3>() = arena.max.array() - rv;
+    for (int k = 4; k < 7; ++k) {
+      ocp_.soft_state_bounds.push_back(soft);
+      ocp_.soft_state_bounds.back().index = k;
+    }
+  }
+
+  num_obstacles_ = safety ? std::min<int>(settings.max_constrained_obstacles,
+                                          int(arena.obstacles.size()))
+                          : 0;
+  if (num_obstacles_ > 0) {
+    obstacles_ = ObstacleConstraint(num_obstacles_, settings.obstacle_form);
+    ocp_.constraint = &obstacles_;
+    ocp_.np = ObstacleConstraint::kParamsPerObstacle * num_obstacles_;
+    ocp_.lg = Eigen::VectorXd::Zero(num_obstacles_);
+    ocp_.ug = Eigen::VectorXd::Constant(num_obstacles_, 1e20);
+    for (int j = 0; j < num_obstacles_; ++j) {
+      ocp_.soft_constraints.push_back(soft);
+      ocp_.soft_constraints.back().index = j;
+    }
+  }
+  if (SetupResult r = rti_.setup(ocp_, rti_settings); !r) return r;
+
+  const MiWeights& w = settings.weights;
+  weights_.resize(ny);
+  weights_ << w.q_eta, Eigen::VectorXd::Constant(6, w.q_nu), w.q_e, Eigen::VectorXd::Constant(4, w.r);
+  control_ = model.hover_input();
+  applied_ = model.hover_state(Eigen::Vector3d::Zero());
+  predicted_.setZero(3, N + 1);
+  reference_.setZero(3, N + 1);
+  nearest_.resize(int(arena.obstacles.size()));
+  distance_.resize(int(arena.obstacles.size()));
+  lambda_next_ = lambda_used_ = settings.ph.initial_lambda;
+  return {};
+}
+
+void MiController::reset(const Eigen::VectorXd& x) {
+  const Eigen::VectorXd hover = model_.hover_state(x.head<3>());
+  for (auto& xi : rti_.trajectory().x) xi = hover;
+  for (auto& ui : rti_.trajectory().u) ui = model_.hover_input();
+  control_ = model_.hover_input();
+  lambda_next_ = lambda_used_ = settings_.ph.initial_lambda;
+}
+
+void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x) {
+  const int N = settings_.N;
+  const double l = lambda_used_;
+  OcpStageData& data = rti_.data();
+  for (int i = 0; i <= N; ++i) {
+    Eigen::VectorXd& y = data.yref[i];
+    y.setZero();
+    y.head<3>() = helix_.position(t + i * settings_.dt);
+    y(3) = pilot.roll;
+    y(4) = pilot.pitch;
+    y.segment<4>(5) = pilot.rotor_speed;
+    auto d = data.W[i].diagonal();
+    const int n = int(d.size());  // 20, or 16 at the terminal stage
+    d.head<3>() = (1.0 - l) * weights_.head<3>();
+    d.segment<6>(3) = l * weights_.segment<6>(3);
+    d.segment(9, n - 9) = (1.0 - l) * weights_.segment(9, n - 9);
+  }
+
+  if (num_obstacles_ > 0) {
+    // The nearest obstacles (by surface distance) to the current position, for all stages.
+    const auto& obs = arena_.obstacles;
+    for (int j = 0; j < int(obs.size()); ++j) {
+      distance_(j) = (x.head<3>() - obs[j].center).norm() - obs[j].radius;
+      nearest_(j) = j;
+    }
+    std::partial_sort(nearest_.data(), nearest_.data() + num_obstacles_,
+                      nearest_.data() + nearest_.size(),
+                      [&](int a, int b) { return distance_(a) < distance_(b); });
+    for (int i = 0; i <= N; ++i) {
+      for (int j = 0; j < num_obstacles_; ++j) {
+        const Obstacle& o = obs[nearest_(j)];
+        auto p = data.p[i].segment<ObstacleConstraint::kParamsPerObstacle>(
+            ObstacleConstraint::kParamsPerObstacle * j);
+        p.head<3>() = o.center;
+        p(3) = o.radius + settings_.vehicle_radius;
+      }
+    }
+  }
+}
+
+RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
+  lambda_used_ = lambda_next_;
+  set_stage_data(t, pilot, x);
+  rti_.prepare();
+  const RtiStatus status = rti_.feedback(x);
+  control_ = rti_.control();
+
+  // The prediction and reference of this step, and from them λ for the next (SPEC §5.4).
+  const OcpTrajectory& traj = rti_.trajectory();
+  double d_res = 0.0;
+  for (int i = 0; i <= settings_.N; ++i) {
+    predicted_.col(i) = traj.x[i].head<3>();
+    reference_.col(i) = rti_.data().yref[i].head<3>();
+    if (i <= settings_.ph.N_b) d_res = std::max(d_res, (predicted_.col(i) - reference_.col(i)).norm());
+  }
+  lambda_next_ = ph_lambda(d_res, settings_.ph);
+  applied_ = traj.x[1];
+  rti_.shift();
+  return status;
+}
+
+PilotCommand MiController::applied_command() const {
+  PilotCommand c;
+  c.roll = applied_(3);
+  c.pitch = applied_(4);
+  c.rotor_speed = applied_.segment<4>(12);
+  return c;
+}
+
+}  // namespace mixpilot

@@ -1,0 +1,88 @@
+#pragma once
+// Mixed-initiative NMPC of SPEC §5.4 (thesis ch. 7) on the MikroKopter. The pilot's reference
+// ν^r and the planner's η^r are blended inside the cost by the PH index λ ∈ (0, 1):
+//   L = ½[(1−λ) Δηᵀ Q_η Δη + λ Δνᵀ Q_ν Δν + (1−λ) Δeᵀ Q_e Δe + (1−λ) uᵀ R u],
+// η = p, ν = (φ, θ, Ω1..4), e = (ψ, v_b, ω) with reference 0; terminal cost without u.
+// λ comes from the previous step's prediction (ph_index.hpp) and is held over the horizon;
+// ν^r is held constant over the horizon (ZOH); η^r is the planner's trajectory sampled at the
+// shooting nodes. Ω and τ are bounded (SPEC §3.3).
+//
+// Safety beyond the thesis (on by default): the ball B is only a soft working condition, so the
+// nearest obstacles enter as lcl clearance constraints ‖p − o‖ ≥ r_o + r_vehicle and the arena
+// walls and floor as bounds on p, all soft with an exact ℓ1 penalty.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/control/obstacle_constraint.hpp"
+#include "core/nlp/ocp.hpp"
+#include "core/control/pilot.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/control/mi_settings.hpp"
+#include "models/mikrokopter.hpp"
+
+namespace mixpilot {
+
+class MiController {
+ public:
+  static constexpr int nx = models::MikroKopter::nx;  // 16
+  static constexpr int nu = models::MikroKopter::nu;  // 4
+  static constexpr int ny = 20;                        // η (3), ν (6), e (7), u (4)
+
+  MiController() = default;
+  MiController(const MiController&) = delete;  // the Ocp points into this object
+  MiController& operator=(const MiController&) = delete;
+
+  // Sizes everything. Fails with the reason if the settings do not describe a valid OCP.
+  SetupResult setup(const models::MikroKopter& model, const MiControllerSettings& settings,
+             const Arena& arena, const HelixReference& reference,
+             const RtiSettings& rti_settings = {});
+
+  // Initializes the trajectory at x (hover guess at its position); λ restarts at its initial
+  // value until a prediction exists.
+  void reset(const Eigen::VectorXd& x);
+
+  // One control step at time t from the measured state x with the pilot's reference.
+  // Allocates nothing. control() then holds τ to apply (never NaN).
+  RtiStatus step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot);
+
+  const Eigen::VectorXd& control() const { return control_; }  // τ (nu)
+  double lambda() const { return lambda_used_; }               // λ used in the last step
+  // The MPC's own (φ, θ, Ω) at stage 1: what the pilot's command became.
+  PilotCommand applied_command() const;
+  // Predicted positions and planner reference at the nodes of the last step (3 x (N+1)).
+  const Eigen::Matrix3Xd& predicted_positions() const { return predicted_; }
+  const Eigen::Matrix3Xd& reference_positions() const { return reference_; }
+  const RtiSolver& rti() const { return rti_; }
+  const models::MikroKopter& model() const { return model_; }
+  const MiControllerSettings& settings() const { return settings_; }
+  int constrained_obstacles() const { return num_obstacles_; }
+
+ private:
+  void set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x);
+
+  models::MikroKopter model_{};
+  IntegratorErk4<models::MikroKopter> integrator_{};
+  MiControllerSettings settings_{};
+  Arena arena_{};
+  HelixReference helix_{};
+  SelectionOutput output_;
+  SelectionOutput terminal_output_;
+  ObstacleConstraint obstacles_{0, ObstacleForm::lcl};
+  Ocp ocp_;
+  RtiSolver rti_;
+  int num_obstacles_ = 0;
+
+  Eigen::VectorXd weights_;           // ny: unscaled diagonal of W
+  Eigen::VectorXd control_;           // nu
+  Eigen::VectorXd applied_;           // nx: predicted state at stage 1
+  Eigen::Matrix3Xd predicted_;        // 3 x (N+1)
+  Eigen::Matrix3Xd reference_;        // 3 x (N+1)
+  Eigen::VectorXi nearest_;           // obstacle indices, by distance (scratch)
+  Eigen::VectorXd distance_;          // per obstacle (scratch)
+  double lambda_next_ = 0.5;
+  double lambda_used_ = 0.5;
+};
+
+}  // namespace mixpilot

@@ -1,0 +1,44 @@
+#pragma once
+// Pilot input: whatever flies the vehicle (emulated pilot, recording, gamepad, network peer)
+// yields the same command stream, one command per control step (SPEC §6).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace mixpilot {
+
+// The human reference ν^r = (φ_h, θ_h, Ω_h) of SPEC §5.4.
+struct PilotCommand {
+  double roll = 0.0;                                // φ_h [rad]
+  double pitch = 0.0;                               // θ_h [rad]
+  Eigen::Vector4d rotor_speed = Eigen::Vector4d::Zero();  // Ω_h (scaled units, SPEC §3.3)
+};
+
+// Raw device input that produced a command (sensor_msgs/Joy in recordings). Fixed capacity,
+// so telemetry holding it is copied without allocating.
+struct JoyInput {
+  static constexpr int kMaxAxes = 8;
+  static constexpr int kMaxButtons = 32;
+  std::array<float, kMaxAxes> axes{};             // [-1, 1], the first num_axes are used
+  std::array<std::int32_t, kMaxButtons> buttons{};  // 0 / 1, the first num_buttons are used
+  int num_axes = 0;
+  int num_buttons = 0;
+};
+
+class PilotSource {
+ public:
+  virtual ~PilotSource() = default;
+  // "novice", "gamepad", "replay:<file>", ...
+  virtual std::string name() const = 0;
+  // The command for control step `step` at time t, given the true state x. Returns false when
+  // the source has nothing more to give (end of a recording).
+  virtual bool command(std::int64_t step, double t, const Eigen::VectorXd& x,
+                       PilotCommand& out) = 0;
+  // The raw device input behind the last command, if the source is a device.
+  virtual const JoyInput* joy() const { return nullptr; }
+};
+
+}  // namespace mixpilot

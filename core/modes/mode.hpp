@@ -1,0 +1,126 @@
+#pragma once
+// One interface for every mode (SPEC §5.1–§5.4): mixed initiative, Pendubot swing-up, tracking
+// under delay, obstacle avoidance. A mode is made from a parsed scenario (core/modes/
+// make_mode.hpp); step() advances one control period, plant substeps included, and allocates
+// nothing. Between steps its telemetry and metrics can be read. The session
+// (core/modes/session.hpp) drives any mode and hands each step's telemetry to its sinks.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/control/pilot.hpp"
+#include "core/nlp/rti.hpp"
+
+namespace mixpilot {
+
+enum class ModeKind { mixed_initiative, pendubot_swingup, crazyflie_tracking, obstacle_avoidance };
+
+const char* to_string(ModeKind kind);
+std::optional<ModeKind> mode_kind_from_string(std::string_view name);
+// "mixed_initiative, pendubot_swingup, ...", for messages.
+std::string mode_kind_names();
+
+// What happened in one control step (bit flags of Telemetry::events).
+enum ModeEvent : std::uint32_t {
+  kEventFallback = 1u << 0,   // the QP failed: the previous solution's next input was applied
+  kEventCollision = 1u << 1,  // contact started: the vehicle touches an obstacle, wall or floor
+  kEventViolation = 1u << 2,  // a constraint of the mode was violated (clearance, velocity bound)
+  kEventSwitch = 1u << 3,     // the active controller changed (Pendubot NMPC ↔ LQR)
+  kEventLost = 1u << 4,       // the vehicle was lost (non-finite or far away): the run ends
+};
+
+// A named scalar of one step, for plots that do not know the mode. Names and units are string
+// literals of the mode, never pointers into its memory.
+struct Channel {
+  const char* name = "";
+  const char* unit = "";
+  double value = 0.0;
+};
+
+// One control step k, [t_k, t_k + Δt). A value: copying it (into a buffer sized by a first
+// copy) allocates nothing, and it points into nothing, so a render or writer thread can keep it.
+struct Telemetry {
+  static constexpr int kMaxChannels = 16;
+
+  ModeKind mode = ModeKind::mixed_initiative;
+  std::int64_t step = 0;
+  double t = 0.0;                   // [s] t_k
+  Eigen::VectorXd x;                // nx: true plant state at t_k
+  Eigen::VectorXd x_measured;       // nx: the state the controller started from
+  Eigen::VectorXd u;                // nu: input applied to the plant over the step
+  // The mode's reference at t_k: the position η^r (3) in the quadrotor modes, the state (4) in
+  // the Pendubot mode.
+  Eigen::VectorXd reference;
+  Eigen::Matrix3Xd predicted;            // 3 x (N+1): predicted positions (quadrotor modes)
+  Eigen::Matrix3Xd predicted_reference;  // 3 x (N+1): reference at the shooting nodes
+  bool solved = false;   // an RTI step ran (false: an LQR step, or the run has not started)
+  RtiStats stats{};      // of that RTI step; stats.total_us = prepare + feedback
+  std::uint32_t events = 0;  // ModeEvent flags
+
+  // Mixed initiative only.
+  PilotCommand pilot;    // the pilot's command ν^r
+  PilotCommand applied;  // the MPC's stage-1 (φ, θ, Ω): what the pilot's command became
+  double lambda = 0.0;   // PH index used in this step
+  bool has_joy = false;  // joy holds the raw device input behind the pilot's command
+  JoyInput joy;
+
+  std::array<Channel, kMaxChannels> channels{};
+  int num_channels = 0;
+
+  // Sets channel i (i < kMaxChannels) and extends num_channels to cover it.
+  void set_channel(int i, const char* name, const char* unit, double value) {
+    channels[std::size_t(i)] = Channel{name, unit, value};
+    if (num_channels <= i) num_channels = i + 1;
+  }
+};
+
+// Name → value in report order (`mixpilot fly --report` writes them as a JSON object).
+using Metrics = std::vector<std::pair<std::string, double>>;
+
+class Mode {
+ public:
+  virtual ~Mode() = default;
+
+  virtual ModeKind kind() const = 0;
+  virtual const std::string& scenario_name() const = 0;
+  virtual double dt() const = 0;  // control period [s]
+  virtual std::int64_t steps_total() const = 0;
+  virtual std::int64_t steps_done() const = 0;
+
+  // One control period: the controller, then the plant over Δt. Allocates nothing. Returns
+  // false, doing nothing, once the run is over; telemetry() then describes the last step.
+  [[nodiscard]] virtual bool step() = 0;
+  virtual bool finished() const = 0;
+  // The run ended because the vehicle was lost (non-finite state, or far outside its world).
+  virtual bool lost() const = 0;
+  virtual double lost_at() const = 0;  // [s] when, or −1
+
+  // The last step's telemetry (before the first step: the initial state, solved = false).
+  virtual const Telemetry& telemetry() const = 0;
+  // The mode's metrics so far (the score in mixed initiative). Allocates: not for the loop.
+  virtual Metrics metrics() const = 0;
+  // A few human-readable lines about the run so far, for the terminal.
+  virtual std::string summary() const = 0;
+};
+
+// ---- legacy whole-run runners, removed once every mode implements Mode ----
+struct ModeOptions {
+  std::optional<double> duration;  // [s] overrides the scenario's duration
+};
+struct ModeResult {
+  bool ok = false;
+  std::string error;
+  std::string summary;
+  std::vector<std::pair<std::string, double>> metrics;
+};
+using ModeRunner = ModeResult (*)(const std::string& scenario_path, const ModeOptions& options);
+ModeRunner find_mode_runner(const std::string& mode);
+std::vector<std::string> mode_runner_names();
+
+}  // namespace mixpilot

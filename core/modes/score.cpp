@@ -1,0 +1,178 @@
+#include "core/modes/score.hpp"
+
+#include "core/numerics/stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace mixpilot {
+
+ScoreAccumulator::ScoreAccumulator(const Scenario& scenario)
+    : scenario_(scenario), dt_(scenario.controller.dt) {
+  const auto steps = std::size_t(std::lround(scenario.duration / dt_)) + 1;
+  position_.reserve(steps);
+  reference_.reserve(steps);
+  lambda_.reserve(steps);
+  rti_us_.reserve(steps);
+}
+
+void ScoreAccumulator::on_sample(const TelemetrySample& s) {
+  const Eigen::Vector3d p = s.x.head<3>();
+  position_.push_back(p);
+  reference_.push_back(s.reference);
+  lambda_.push_back(s.lambda);
+  rti_us_.push_back(s.stats.total_us);
+  if (s.stats.status == RtiStatus::fallback) ++fallbacks_;
+
+  const double dr = s.pilot.roll - s.applied.roll, dp = s.pilot.pitch - s.applied.pitch;
+  sum_override_sq_ += dr * dr + dp * dp;
+  if (!position_.empty() && position_.size() > 1) {
+    const double vr = (s.pilot.roll - prev_roll_) / dt_, vp = (s.pilot.pitch - prev_pitch_) / dt_;
+    sum_stick_sq_ += vr * vr + vp * vp;
+  }
+  prev_roll_ = s.pilot.roll;
+  prev_pitch_ = s.pilot.pitch;
+
+  // Clearance of the vehicle sphere to obstacles, walls and floor.
+  const double rv = scenario_.controller.vehicle_radius;
+  double clearance = 1e9;
+  for (const Obstacle& o : scenario_.arena.obstacles) {
+    const double c = (p - o.center).norm() - o.radius - rv;
+    min_clearance_ = std::min(min_clearance_, c);
+    clearance = std::min(clearance, c);
+  }
+  const Arena& a = scenario_.arena;
+  for (int i = 0; i < 3; ++i) {
+    clearance = std::min({clearance, p(i) - a.min(i) - rv, a.max(i) - p(i) - rv});
+  }
+  const bool contact = clearance < 0.0;
+  if (contact && !in_contact_) ++collisions_;
+  in_contact_ = contact;
+}
+
+Score ScoreAccumulator::finish() const {
+  Score sc;
+  const std::size_t K = position_.size();
+  if (K == 0) return sc;
+  const double r = scenario_.controller.ph.r;
+  sc.duration_s = double(K) * dt_;
+
+  double sum_sq = 0, max_dev = 0;
+  std::size_t in_ball = 0;
+  for (std::size_t k = 0; k < K; ++k) {
+    const double d = (position_[k] - reference_[k]).norm();
+    sum_sq += d * d;
+    max_dev = std::max(max_dev, d);
+    if (d <= r) ++in_ball;
+  }
+  sc.max_deviation_m = max_dev;
+  sc.rms_deviation_m = std::sqrt(sum_sq / double(K));
+  sc.time_in_ball = double(in_ball) / double(K);
+
+  // Waypoint k counts as flown if the vehicle came within r of it within ±1 s; the reference
+  // is the whole scenario's, so a session cut short (end of a recording) makes less progress.
+  const auto window = std::int64_t(std::lround(1.0 / dt_));
+  const auto total = std::int64_t(std::lround(scenario_.duration / dt_));
+  std::int64_t reached = 0;
+  for (std::int64_t k = 0; k < std::int64_t(K); ++k) {
+    const std::int64_t lo = std::max<std::int64_t>(0, k - window);
+    const std::int64_t hi = std::min<std::int64_t>(std::int64_t(K) - 1, k + window);
+    for (std::int64_t j = lo; j <= hi; ++j) {
+      if ((position_[std::size_t(j)] - reference_[std::size_t(k)]).norm() <= r) {
+        ++reached;
+        break;
+      }
+    }
+  }
+  sc.progress = double(reached) / double(std::max<std::int64_t>(total, std::int64_t(K)));
+
+  double sum_l = 0, min_l = 1.0;
+  for (double l : lambda_) {
+    sum_l += l;
+    min_l = std::min(min_l, l);
+  }
+  sc.mean_lambda = sum_l / double(K);
+  sc.min_lambda = min_l;
+  sc.collisions = collisions_;
+  sc.min_clearance_m = scenario_.arena.obstacles.empty() ? 0.0 : min_clearance_;
+  sc.override_rms = std::sqrt(sum_override_sq_ / double(K));
+  sc.stick_smoothness = K > 1 ? std::sqrt(sum_stick_sq_ / double(K - 1)) : 0.0;
+
+  set_timing(sc, rti_us_, dt_);
+  sc.fallbacks = fallbacks_;
+
+  const double quality = 0.4 * sc.time_in_ball + 0.4 * sc.mean_lambda +
+                         0.2 * std::exp(-sc.override_rms / 0.1);
+  sc.skill = 100.0 * sc.progress * quality / (1.0 + sc.collisions);
+  return sc;
+}
+
+void set_timing(Score& sc, std::vector<double> t, double dt) {
+  sc.rti_median_us = sc.rti_p99_us = 0.0;
+  sc.deadline_misses = 0;
+  if (t.empty()) return;
+  for (double v : t) sc.deadline_misses += v > dt * 1e6 ? 1 : 0;
+  sc.rti_median_us = percentile(t, 0.5);
+  sc.rti_p99_us = percentile(t, 0.99);
+}
+
+namespace {
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string to_json(const Score& s, const std::vector<std::pair<std::string, std::string>>& labels,
+                    int indent) {
+  const std::string pad(std::size_t(std::max(indent, 0)), ' ');
+  std::string out = "{\n";
+  for (const auto& [key, value] : labels) {
+    out += pad + "\"" + json_escape(key) + "\": \"" + json_escape(value) + "\",\n";
+  }
+  char buf[128];
+  const auto num = [&](const char* key, double v, bool last = false) {
+    std::snprintf(buf, sizeof buf, "%s\"%s\": %.17g%s\n", pad.c_str(), key, v, last ? "" : ",");
+    out += buf;
+  };
+  const auto integer = [&](const char* key, long long v) {
+    std::snprintf(buf, sizeof buf, "%s\"%s\": %lld,\n", pad.c_str(), key, v);
+    out += buf;
+  };
+  num("duration_s", s.duration_s);
+  num("progress", s.progress);
+  num("time_in_ball", s.time_in_ball);
+  num("max_deviation_m", s.max_deviation_m);
+  num("rms_deviation_m", s.rms_deviation_m);
+  num("mean_lambda", s.mean_lambda);
+  num("min_lambda", s.min_lambda);
+  integer("collisions", s.collisions);
+  num("min_clearance_m", s.min_clearance_m);
+  num("override_rms", s.override_rms);
+  num("stick_smoothness", s.stick_smoothness);
+  num("rti_median_us", s.rti_median_us);
+  num("rti_p99_us", s.rti_p99_us);
+  integer("deadline_misses", s.deadline_misses);
+  integer("fallbacks", s.fallbacks);
+  num("skill", s.skill, true);
+  out += "}";
+  return out;
+}
+
+}  // namespace mixpilot

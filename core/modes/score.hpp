@@ -1,0 +1,84 @@
+#pragma once
+// Scoring of a session from its telemetry (issue 5). With K control steps of Δt, p_k the true
+// position, η^r_k the planner reference, r the ball radius, r_v the vehicle radius:
+//   duration_s        K Δt
+//   progress          fraction of the reference waypoints η^r_k that the vehicle came within r
+//                     of at some step j with |j − k| Δt ≤ 1 s (how much of the path was flown)
+//   time_in_ball      fraction of steps with ‖p_k − η^r_k‖ ≤ r
+//   max_deviation_m   max_k ‖p_k − η^r_k‖;   rms_deviation_m  √(mean_k ‖p_k − η^r_k‖²)
+//   mean_lambda, min_lambda   of the PH index λ_k
+//   collisions        number of times the vehicle sphere (radius r_v) starts touching an
+//                     obstacle, a wall or the floor
+//   min_clearance_m   min_k min_o (‖p_k − o‖ − r_o − r_v): negative means contact
+//   override_rms      √(mean_k ((φ_h − φ*_1)² + (θ_h − θ*_1)²)) [rad]: how far the MPC's
+//                     attitude (its stage-1 prediction) departs from the pilot's command
+//   stick_smoothness  √(mean_k ‖(Δφ_h, Δθ_h)/Δt‖²) [rad/s]: RMS rate of the pilot's attitude
+//                     command (lower is smoother)
+//   rti_median_us, rti_p99_us  of the controller's prepare + feedback time per step
+//   deadline_misses   steps whose controller time exceeded Δt;   fallbacks  RTI fallbacks
+//   skill             100 · progress · (0.4 time_in_ball + 0.4 mean_lambda
+//                     + 0.2 exp(−override_rms / 0.1 rad)) / (1 + collisions) ∈ [0, 100]
+// The three timing fields measure this run on this machine; every other field is a pure
+// function of the telemetry, so a replay of a recording reproduces it bit for bit.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/scenario/scenario.hpp"
+#include "core/modes/session.hpp"
+
+namespace mixpilot {
+
+struct Score {
+  double duration_s = 0;
+  double progress = 0;
+  double time_in_ball = 0;
+  double max_deviation_m = 0;
+  double rms_deviation_m = 0;
+  double mean_lambda = 0;
+  double min_lambda = 0;
+  int collisions = 0;
+  double min_clearance_m = 0;
+  double override_rms = 0;
+  double stick_smoothness = 0;
+  double rti_median_us = 0;
+  double rti_p99_us = 0;
+  int deadline_misses = 0;
+  std::int64_t fallbacks = 0;
+  double skill = 0;
+};
+
+// JSON object with the fields above (17 significant digits: exact round trip), preceded by
+// the given string-valued labels (e.g. scenario, pilot).
+std::string to_json(const Score& score,
+                    const std::vector<std::pair<std::string, std::string>>& labels = {},
+                    int indent = 2);
+
+// Timing fields from per-step controller times [µs] (median, p99, misses of dt).
+void set_timing(Score& score, std::vector<double> total_us, double dt);
+
+class ScoreAccumulator final : public TelemetrySink {
+ public:
+  explicit ScoreAccumulator(const Scenario& scenario);
+  void on_sample(const TelemetrySample& sample) override;
+  Score finish() const;
+
+ private:
+  const Scenario& scenario_;
+  double dt_;
+  std::vector<Eigen::Vector3d> position_;
+  std::vector<Eigen::Vector3d> reference_;
+  std::vector<double> lambda_;
+  std::vector<double> rti_us_;
+  double sum_override_sq_ = 0;
+  double sum_stick_sq_ = 0;
+  double prev_roll_ = 0, prev_pitch_ = 0;
+  double min_clearance_ = 1e9;
+  int collisions_ = 0;
+  bool in_contact_ = false;
+  std::int64_t fallbacks_ = 0;
+};
+
+}  // namespace mixpilot

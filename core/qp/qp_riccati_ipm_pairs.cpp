@@ -1,0 +1,349 @@
+#include "core/qp/qp_riccati_ipm_pairs.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include "core/qp/qp_kernels.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+// C += A B and C = A B with the register-blocked kernel (Eigen's general GEMM packs its
+// operands first: 3x slower at these 4..24 sizes). Column-major operands (matrices or blocks).
+template <class MA, class MB, class MC>
+void add_ab(const MA& A, const MB& B, MC&& C) {
+  kernels::gemm_nn(int(A.rows()), int(B.cols()), int(A.cols()), A.data(), int(A.outerStride()),
+                   B.data(), int(B.outerStride()), C.data(), int(C.outerStride()));
+}
+template <class MA, class MB, class MC>
+void set_ab(const MA& A, const MB& B, MC&& C) {
+  kernels::gemm_nn(int(A.rows()), int(B.cols()), int(A.cols()), A.data(), int(A.outerStride()),
+                   B.data(), int(B.outerStride()), C.data(), int(C.outerStride()), true);
+}
+// y += A x and y += Aᵀ x.
+template <class MA, class VX, class VY>
+void add_ax(const MA& A, const VX& x, VY&& y) {
+  kernels::gemv_n(int(A.rows()), int(A.cols()), A.data(), int(A.outerStride()), x.data(), y.data());
+}
+template <class MA, class VX, class VY>
+void add_atx(const MA& A, const VX& x, VY&& y) {
+  kernels::gemv_t(int(A.rows()), int(A.cols()), A.data(), int(A.outerStride()), x.data(), y.data());
+}
+
+// Blocks: pairs (k, k+1) while k + 1 < N, then a lone last dynamic stage (odd N) and the
+// terminal stage N, each alone.
+void blocks_of(const OcpQpDims& d, std::vector<int>& first, std::vector<int>& count) {
+  first.clear();
+  count.clear();
+  int k = 0;
+  for (; k + 1 < d.N; k += 2) {
+    first.push_back(k);
+    count.push_back(2);
+  }
+  for (; k <= d.N; ++k) {
+    first.push_back(k);
+    count.push_back(1);
+  }
+}
+
+// Stage i of `from` into stage j of `to` (a lone stage: the same sizes in both).
+void copy_stage(const OcpQpSolution& from, int i, OcpQpSolution& to, int j, bool dynamics) {
+  to.x[j] = from.x[i];
+  to.u[j] = from.u[i];
+  if (dynamics) to.pi[j] = from.pi[i];
+  to.lam_l[j] = from.lam_l[i];
+  to.lam_u[j] = from.lam_u[i];
+  to.sl[j] = from.sl[i];
+  to.su[j] = from.su[i];
+  to.lam_sl[j] = from.lam_sl[i];
+  to.lam_su[j] = from.lam_su[i];
+}
+
+// Where the constraints of stages k (stage 0) and k+1 (stage 1) sit in their pair's block.
+struct Segment {
+  int block, stage, offset, size;  // block offset; stage 0/1 and offset there; length
+};
+std::array<Segment, 6> pair_segments(const OcpQpDims& d, int k) {
+  const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx0 = d.nbx[k], nbx1 = d.nbx[k + 1];
+  const int ng0 = d.ng[k], ng1 = d.ng[k + 1], nbu = nbu0 + nbu1;
+  return {Segment{0, 0, 0, nbu0},                                  // bu_k
+          Segment{nbu0, 1, 0, nbu1},                               // bu_{k+1}
+          Segment{nbu, 0, nbu0, nbx0},                             // bx_k
+          Segment{nbu + nbx0, 0, nbu0 + nbx0, ng0},                // g_k
+          Segment{nbu + nbx0 + ng0, 1, nbu1, nbx1},                // bx_{k+1} as rows
+          Segment{nbu + nbx0 + ng0 + nbx1, 1, nbu1 + nbx1, ng1}};  // g_{k+1}
+}
+
+}  // namespace
+
+OcpQpDims ocp_qp_pair_dims(const OcpQpDims& d) {
+  std::vector<int> first, count;
+  blocks_of(d, first, count);
+  OcpQpDims c(static_cast<int>(first.size()) - 1);
+  for (std::size_t j = 0; j < first.size(); ++j) {
+    const int k = first[j];
+    c.nx[j] = d.nx[k];
+    c.nu[j] = d.nu[k];
+    c.nbu[j] = d.nbu[k];
+    c.nbx[j] = d.nbx[k];
+    c.ng[j] = d.ng[k];
+    c.ns[j] = d.ns[k];
+    if (count[j] == 2) {
+      c.nu[j] += d.nu[k + 1];
+      c.nbu[j] += d.nbu[k + 1];
+      c.ng[j] += d.nbx[k + 1] + d.ng[k + 1];
+      c.ns[j] += d.ns[k + 1];
+    }
+  }
+  return c;
+}
+
+bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
+  ready_ = false;
+  prepared_ = false;
+  settings_ = settings;
+  if (!dims.valid()) return false;
+  dims_ = dims;
+  blocks_of(dims, first_, count_);
+  const OcpQpDims dc = ocp_qp_pair_dims(dims);
+  qpc_.resize(dc);
+  solc_.resize(dc);
+  if (levels_ > 1)
+    inner_ = std::make_unique<QpRiccatiIpmPairs>(levels_ - 1);
+  else
+    inner_ = std::make_unique<QpRiccatiIpm>();
+  Settings inner = settings;
+  inner.check_data = false;  // solve() checks the original data
+  if (!inner_->setup(dc, inner)) return false;
+  int nx = 0, nu = 0;
+  for (int i = 0; i <= dims.N; ++i) {
+    nx = std::max(nx, dims.nx[i]);
+    nu = std::max(nu, dims.nu[i]);
+  }
+  Q1A0_.resize(nx, nx);
+  Q1B0_.resize(nx, nu);
+  A0t_.resize(nx, nx);
+  B0t_.resize(nu, nx);
+  g1_.resize(nx);
+  x1_.resize(nx);
+  constant_.assign(first_.size(), 0.0);
+  ready_ = true;
+  return true;
+}
+
+void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
+  const int k = first_[j];
+  const OcpQpDims& d = dims_;
+  const OcpQpStage& s0 = qp.stage[k];
+  const OcpQpStage& s1 = qp.stage[k + 1];
+  OcpQpStage& t = qpc_.stage[j];
+  const int nx0 = d.nx[k], nu0 = d.nu[k], nx1 = d.nx[k + 1], nu1 = d.nu[k + 1];
+  const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx1 = d.nbx[k + 1];
+  const int ng0 = d.ng[k], ng1 = d.ng[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+  const Eigen::MatrixXd &A0 = s0.A, &B0 = s0.B;
+  auto Q1A0 = Q1A0_.topLeftCorner(nx1, nx0);
+  auto Q1B0 = Q1B0_.topLeftCorner(nx1, nu0);
+  auto g1 = g1_.head(nx1);
+  set_ab(s1.Q, A0, Q1A0);
+  set_ab(s1.Q, B0, Q1B0);
+  auto Q1b0 = x1_.head(nx1);
+  Q1b0.setZero();
+  add_ax(s1.Q, s0.b, Q1b0);
+  g1 = Q1b0 + s1.q;
+  constant_[j] = s0.b.dot(g1) - 0.5 * s0.b.dot(Q1b0);  // ½b0ᵀQ1b0 + q1ᵀb0
+
+  // Dynamics to x_{k+2}.
+  set_ab(s1.A, A0, t.A);
+  set_ab(s1.A, B0, t.B.leftCols(nu0));
+  t.B.rightCols(nu1) = s1.B;
+  t.b = s1.b;
+  add_ax(s1.A, s0.b, t.b);
+  // Cost.
+  t.Q = s0.Q;
+  auto A0t = A0t_.topLeftCorner(nx0, nx1);
+  auto B0t = B0t_.topLeftCorner(nu0, nx1);
+  A0t = A0.transpose();
+  B0t = B0.transpose();
+  add_ab(A0t, Q1A0, t.Q);
+  t.S.topRows(nu0) = s0.S;
+  add_ab(B0t, Q1A0, t.S.topRows(nu0));
+  set_ab(s1.S, A0, t.S.bottomRows(nu1));
+  t.R.topLeftCorner(nu0, nu0) = s0.R;
+  add_ab(B0t, Q1B0, t.R.topLeftCorner(nu0, nu0));
+  set_ab(s1.S, B0, t.R.bottomLeftCorner(nu1, nu0));
+  t.R.topRightCorner(nu0, nu1) = t.R.bottomLeftCorner(nu1, nu0).transpose();
+  t.R.bottomRightCorner(nu1, nu1) = s1.R;
+  t.q = s0.q;
+  add_atx(A0, g1, t.q);
+  t.r.head(nu0) = s0.r;
+  add_atx(B0, g1, t.r.head(nu0));
+  t.r.tail(nu1) = s1.r;
+  add_ax(s1.S, s0.b, t.r.tail(nu1));
+  // Constraints: [bu0; bu1], bx0, [g0; bx1 rows; g1 rows].
+  t.idxbu.head(nbu0) = s0.idxbu;
+  t.idxbu.tail(nbu1) = (s1.idxbu.array() + nu0).matrix();
+  t.lbu.head(nbu0) = s0.lbu;
+  t.lbu.tail(nbu1) = s1.lbu;
+  t.ubu.head(nbu0) = s0.ubu;
+  t.ubu.tail(nbu1) = s1.ubu;
+  t.idxbx = s0.idxbx;
+  t.lbx = s0.lbx;
+  t.ubx = s0.ubx;
+  t.C.topRows(ng0) = s0.C;
+  t.D.topLeftCorner(ng0, nu0) = s0.D;
+  t.D.topRightCorner(ng0, nu1).setZero();
+  t.lg.head(ng0) = s0.lg;
+  t.ug.head(ng0) = s0.ug;
+  for (int r = 0; r < nbx1; ++r) {  // x_{k+1}[idx] = A0[idx,:] x + B0[idx,:] u0 + b0[idx]
+    const int idx = s1.idxbx[r], row = ng0 + r;
+    t.C.row(row) = A0.row(idx);
+    t.D.row(row).head(nu0) = B0.row(idx);
+    t.D.row(row).tail(nu1).setZero();
+    t.lg[row] = s1.lbx[r] - s0.b[idx];
+    t.ug[row] = s1.ubx[r] - s0.b[idx];
+  }
+  {  // C1 x_{k+1} + D1 u1 = C1A0 x + C1B0 u0 + D1 u1 + C1 b0
+    auto C = t.C.middleRows(ng0 + nbx1, ng1);
+    auto D = t.D.middleRows(ng0 + nbx1, ng1);
+    set_ab(s1.C, A0, C);
+    set_ab(s1.C, B0, D.leftCols(nu0));
+    D.rightCols(nu1) = s1.D;
+    for (int r = 0; r < ng1; ++r) {
+      const double c = s1.C.row(r).dot(s0.b);
+      t.lg[ng0 + nbx1 + r] = s1.lg[r] - c;
+      t.ug[ng0 + nbx1 + r] = s1.ug[r] - c;
+    }
+  }
+  // Soft constraints: stage k's, then stage k+1's, re-indexed into the block's d.
+  const std::array<Segment, 6> segments = pair_segments(d, k);
+  const auto block_index = [&](int stage, int c) {
+    for (const Segment& g : segments)
+      if (g.stage == stage && c >= g.offset && c < g.offset + g.size) return g.block + c - g.offset;
+    return -1;  // unreachable: the indices were validated
+  };
+  for (int r = 0; r < ns0; ++r) t.idxs[r] = block_index(0, s0.idxs[r]);
+  for (int r = 0; r < ns1; ++r) t.idxs[ns0 + r] = block_index(1, s1.idxs[r]);
+  t.Zl.head(ns0) = s0.Zl;
+  t.Zl.tail(ns1) = s1.Zl;
+  t.Zu.head(ns0) = s0.Zu;
+  t.Zu.tail(ns1) = s1.Zu;
+  t.zl.head(ns0) = s0.zl;
+  t.zl.tail(ns1) = s1.zl;
+  t.zu.head(ns0) = s0.zu;
+  t.zu.tail(ns1) = s1.zu;
+}
+
+void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
+  prepared_ = false;
+  if (!ready_ || !ocp_qp_valid_for(qp, dims_, settings_.check_data)) return;
+  for (std::size_t j = 0; j < first_.size(); ++j) {
+    if (count_[j] == 2) {
+      condense_pair(qp, static_cast<int>(j));
+    } else {
+      qpc_.stage[j] = qp.stage[first_[j]];  // same sizes: no allocation
+      constant_[j] = 0.0;
+    }
+  }
+  set_inner_settings();
+  inner_->prepare(qpc_);  // a nested level condenses its pairs (x0 plays no part)
+  prepared_ = true;
+}
+
+void QpRiccatiIpmPairs::set_inner_settings() {
+  Settings& inner = inner_->settings();
+  inner = settings_;
+  inner.check_data = false;
+}
+
+void QpRiccatiIpmPairs::restrict_warm_start(const OcpQpSolution& sol) {
+  const OcpQpDims& d = dims_;
+  for (std::size_t jj = 0; jj < first_.size(); ++jj) {
+    const int j = static_cast<int>(jj), k = first_[jj];
+    if (count_[jj] == 1) {
+      copy_stage(sol, k, solc_, j, k < d.N);
+      continue;
+    }
+    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+    solc_.x[j] = sol.x[k];
+    solc_.u[j].head(nu0) = sol.u[k];
+    solc_.u[j].tail(nu1) = sol.u[k + 1];
+    solc_.pi[j] = sol.pi[k + 1];
+    for (const Segment& g : pair_segments(d, k)) {
+      solc_.lam_l[j].segment(g.block, g.size) = sol.lam_l[k + g.stage].segment(g.offset, g.size);
+      solc_.lam_u[j].segment(g.block, g.size) = sol.lam_u[k + g.stage].segment(g.offset, g.size);
+    }
+    for (auto [dst, src] : {std::pair{&solc_.sl, &sol.sl}, std::pair{&solc_.su, &sol.su},
+                            std::pair{&solc_.lam_sl, &sol.lam_sl},
+                            std::pair{&solc_.lam_su, &sol.lam_su}}) {
+      (*dst)[j].head(ns0) = (*src)[k];
+      (*dst)[j].tail(ns1) = (*src)[k + 1];
+    }
+  }
+}
+
+void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
+  const OcpQpDims& d = dims_;
+  double constant = 0.0;
+  for (std::size_t jj = 0; jj < first_.size(); ++jj) {
+    const int j = static_cast<int>(jj), k = first_[jj];
+    constant += constant_[jj];
+    if (count_[jj] == 1) {
+      copy_stage(solc_, j, sol, k, k < d.N);
+      continue;
+    }
+    const OcpQpStage &s0 = qp.stage[k], &s1 = qp.stage[k + 1];
+    const int nu0 = d.nu[k], nu1 = d.nu[k + 1], nbu1 = d.nbu[k + 1], nbx1 = d.nbx[k + 1];
+    const int ng1 = d.ng[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+    sol.x[k] = solc_.x[j];
+    sol.u[k] = solc_.u[j].head(nu0);
+    sol.u[k + 1] = solc_.u[j].tail(nu1);
+    Eigen::VectorXd& x1 = sol.x[k + 1];
+    x1 = s0.b;
+    add_ax(s0.A, sol.x[k], x1);
+    add_ax(s0.B, sol.u[k], x1);
+    for (const Segment& g : pair_segments(d, k)) {
+      sol.lam_l[k + g.stage].segment(g.offset, g.size) = solc_.lam_l[j].segment(g.block, g.size);
+      sol.lam_u[k + g.stage].segment(g.offset, g.size) = solc_.lam_u[j].segment(g.block, g.size);
+    }
+    for (auto [dst, src] : {std::pair{&sol.sl, &solc_.sl[j]}, std::pair{&sol.su, &solc_.su[j]},
+                            std::pair{&sol.lam_sl, &solc_.lam_sl[j]},
+                            std::pair{&sol.lam_su, &solc_.lam_su[j]}}) {
+      (*dst)[k] = src->head(ns0);
+      (*dst)[k + 1] = src->tail(ns1);
+    }
+    // π_k from the stationarity in x_{k+1}.
+    sol.pi[k + 1] = solc_.pi[j];
+    Eigen::VectorXd& pk = sol.pi[k];
+    pk = s1.q;
+    add_ax(s1.Q, x1, pk);
+    add_atx(s1.S, sol.u[k + 1], pk);
+    add_atx(s1.A, sol.pi[k + 1], pk);
+    for (int r = 0; r < nbx1; ++r)
+      pk[s1.idxbx[r]] -= sol.lam_l[k + 1][nbu1 + r] - sol.lam_u[k + 1][nbu1 + r];
+    for (int r = 0; r < ng1; ++r)
+      pk -= (sol.lam_l[k + 1][nbu1 + nbx1 + r] - sol.lam_u[k + 1][nbu1 + nbx1 + r]) *
+            s1.C.row(r).transpose();
+  }
+  sol.lam_x0 = solc_.lam_x0;
+  sol.status = solc_.status;
+  sol.iterations = solc_.iterations;
+  sol.objective = solc_.objective + constant;
+  sol.res_stat = solc_.res_stat;
+  sol.res_eq = solc_.res_eq;
+  sol.res_ineq = solc_.res_ineq;
+  sol.res_comp = solc_.res_comp;
+}
+
+QpStatus QpRiccatiIpmPairs::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
+  if (!prepared_) prepare(qp);
+  if (!prepared_) return sol.set_invalid_data();
+  prepared_ = false;
+  qpc_.x0 = qp.x0;
+  if (warm != QpWarmStart::cold) restrict_warm_start(sol);
+  inner_->solve(qpc_, solc_, warm);
+  expand(qp, sol);
+  return sol.status;
+}
+
+}  // namespace mixpilot

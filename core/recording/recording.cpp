@@ -1,0 +1,416 @@
+#include "core/recording/recording.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <iterator>
+#include <limits>
+#include <utility>
+
+#include "core/numerics/version.hpp"
+
+namespace mixpilot {
+
+RosTime ros_time_from_ns(uint64_t ns) {
+  const uint64_t sec = ns / 1'000'000'000u;
+  return {static_cast<int32_t>(std::min<uint64_t>(sec, std::numeric_limits<int32_t>::max())),
+          static_cast<uint32_t>(ns % 1'000'000'000u)};
+}
+
+uint64_t ros_time_to_ns(const RosTime& t) {
+  if (t.sec < 0) return 0;
+  return static_cast<uint64_t>(t.sec) * 1'000'000'000u + t.nanosec;
+}
+
+// ---- schemas ----------------------------------------------------------------------------
+// ros2msg text as rosbag2 stores it: the top-level definition, then each dependency after a
+// line of 80 '=' and "MSG: pkg/Type" (MCAP well-known schema encoding "ros2msg").
+
+namespace {
+#define MIXPILOT_SEP "================================================================================\n"
+#define MIXPILOT_TIME_DEP                                                          \
+  MIXPILOT_SEP                                                                     \
+  "MSG: builtin_interfaces/Time\n"                                                 \
+  "# Time since an epoch; here the session clock (step * control period).\n"       \
+  "int32 sec\n"                                                                    \
+  "uint32 nanosec\n"
+
+constexpr const char kJoySchema[] =
+    "# Raw gamepad state, as read before any mapping to pilot commands.\n"
+    "std_msgs/Header header\n"
+    "float32[] axes\n"
+    "int32[] buttons\n"
+    "\n" MIXPILOT_SEP
+    "MSG: std_msgs/Header\n"
+    "builtin_interfaces/Time stamp\n"
+    "string frame_id\n"
+    "\n" MIXPILOT_TIME_DEP;
+
+constexpr const char kPilotCommandSchema[] =
+    "# The human reference nu^r = (phi_h, theta_h, Omega_h) of one control step.\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "float64 roll            # phi_h [rad]\n"
+    "float64 pitch           # theta_h [rad]\n"
+    "float64[4] rotor_speed  # Omega_h [kHz, scaled unit]\n"
+    "string source           # novice, experienced, reckless, gamepad, replay:<file>, ...\n"
+    "\n" MIXPILOT_TIME_DEP;
+
+constexpr const char kVehicleStateSchema[] =
+    "# MikroKopter state x = (p, phi theta psi, v_b, omega, Omega), 16 values.\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "float64[] x\n"
+    "\n" MIXPILOT_TIME_DEP;
+
+constexpr const char kFloat64Schema[] = "float64 data\n";
+
+constexpr const char kAppliedCommandSchema[] =
+    "# What the pilot's command became: applied torques and the MPC's stage-1 inputs.\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "float64[] u             # rotor torques tau [N m]\n"
+    "float64 roll            # stage-1 phi [rad]\n"
+    "float64 pitch           # stage-1 theta [rad]\n"
+    "float64[4] rotor_speed  # stage-1 Omega\n"
+    "\n" MIXPILOT_TIME_DEP;
+
+constexpr const char kSolverStatsSchema[] =
+    "# One real-time iteration of the NMPC.\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "uint8 status\n"
+    "uint32 qp_iterations\n"
+    "float64 integration_us\n"
+    "float64 linearization_us\n"
+    "float64 qp_us\n"
+    "float64 total_us\n"
+    "bool fallback\n"
+    "\n" MIXPILOT_TIME_DEP;
+
+constexpr const char kPredictionSchema[] =
+    "# Predicted and reference positions over the horizon, 3*(N+1) values each (x y z per stage).\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "float64[] position\n"
+    "float64[] reference\n"
+    "\n" MIXPILOT_TIME_DEP;
+#undef MIXPILOT_TIME_DEP
+#undef MIXPILOT_SEP
+
+// Order = SessionRecorder::Topic.
+constexpr RecordedType kTypes[] = {
+    {"/joy", "sensor_msgs/msg/Joy", kJoySchema},
+    {"/pilot/command", "mixpilot_msgs/msg/PilotCommand", kPilotCommandSchema},
+    {"/vehicle/state", "mixpilot_msgs/msg/VehicleState", kVehicleStateSchema},
+    {"/controller/lambda", "std_msgs/msg/Float64", kFloat64Schema},
+    {"/controller/applied", "mixpilot_msgs/msg/AppliedCommand", kAppliedCommandSchema},
+    {"/controller/solver", "mixpilot_msgs/msg/SolverStats", kSolverStatsSchema},
+    {"/controller/prediction", "mixpilot_msgs/msg/Prediction", kPredictionSchema},
+};
+
+// rosbag2's serialization of one QoS profile (reliable, volatile, default durations): the ros2
+// MCAP profile requires the offered_qos_profiles channel metadata key, and `ros2 bag play`
+// parses it as YAML.
+constexpr const char kQosProfiles[] =
+    "- history: 3\n"
+    "  depth: 0\n"
+    "  reliability: 1\n"
+    "  durability: 2\n"
+    "  deadline:\n"
+    "    sec: 2147483647\n"
+    "    nsec: 4294967295\n"
+    "  lifespan:\n"
+    "    sec: 2147483647\n"
+    "    nsec: 4294967295\n"
+    "  liveliness: 1\n"
+    "  liveliness_lease_duration:\n"
+    "    sec: 2147483647\n"
+    "    nsec: 4294967295\n"
+    "  avoid_ros_namespace_conventions: false";
+}  // namespace
+
+std::span<const RecordedType> recorded_types() { return kTypes; }
+
+// ---- CDR encode/decode --------------------------------------------------------------------
+
+// The encoders with the stamp given separately: the recorder stamps messages without copying
+// them (no allocation per recorded message once the buffers have grown).
+void encode_body(const JoyMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const PilotCommandMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const VehicleStateMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w);
+
+namespace {
+void put_time(const RosTime& t, CdrWriter& w) {
+  w.write(t.sec);
+  w.write(t.nanosec);
+}
+bool get_time(CdrReader& r, RosTime& t) { return r.read(t.sec) && r.read(t.nanosec); }
+
+template <class T, std::size_t N>
+void put_array(const std::array<T, N>& a, CdrWriter& w) {
+  w.write_array(std::span<const T>(a));
+}
+template <class T, std::size_t N>
+bool get_array(CdrReader& r, std::array<T, N>& a) {
+  return r.read_array(std::span<T>(a));
+}
+
+// Ends a decode: the reader must have succeeded and consumed everything except possibly
+// zero padding to an 8-byte boundary, which some CDR writers append.
+bool finish(CdrReader& r, std::string& error) {
+  if (r.ok() && r.remaining() > 0) {
+    // Reading zero padding through the reader keeps the error wording in one place.
+    const std::size_t at = r.position();
+    bool zero = r.remaining() < 8;
+    std::vector<uint8_t> rest(r.remaining());
+    if (!r.read_array(std::span<uint8_t>(rest))) zero = false;
+    for (uint8_t b : rest) zero = zero && b == 0;
+    if (!zero) {
+      error = "CDR: " + std::to_string(rest.size()) + " unexpected bytes after the message at byte " +
+              std::to_string(at) + " of the message";
+      return false;
+    }
+  }
+  if (!r.ok()) {
+    error = r.error();
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+void encode(const JoyMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const JoyMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write_string(m.frame_id);
+  w.write_sequence(std::span<const float>(m.axes));
+  w.write_sequence(std::span<const int32_t>(m.buttons));
+}
+bool decode(std::span<const uint8_t> d, JoyMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read_string(m.frame_id) && r.read_sequence(m.axes) &&
+      r.read_sequence(m.buttons));
+  return finish(r, error);
+}
+
+void encode(const PilotCommandMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const PilotCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write(m.roll);
+  w.write(m.pitch);
+  put_array(m.rotor_speed, w);
+  w.write_string(m.source);
+}
+bool decode(std::span<const uint8_t> d, PilotCommandMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.roll) && r.read(m.pitch) &&
+      get_array(r, m.rotor_speed) && r.read_string(m.source));
+  return finish(r, error);
+}
+
+void encode(const VehicleStateMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const VehicleStateMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write_sequence(std::span<const double>(m.x));
+}
+bool decode(std::span<const uint8_t> d, VehicleStateMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read_sequence(m.x));
+  return finish(r, error);
+}
+
+void encode(const AppliedCommandMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write_sequence(std::span<const double>(m.u));
+  w.write(m.roll);
+  w.write(m.pitch);
+  put_array(m.rotor_speed, w);
+}
+bool decode(std::span<const uint8_t> d, AppliedCommandMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read_sequence(m.u) && r.read(m.roll) &&
+      r.read(m.pitch) && get_array(r, m.rotor_speed));
+  return finish(r, error);
+}
+
+void encode(const SolverStatsMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write(m.status);
+  w.write(m.qp_iterations);
+  w.write(m.integration_us);
+  w.write(m.linearization_us);
+  w.write(m.qp_us);
+  w.write(m.total_us);
+  w.write(m.fallback);
+}
+bool decode(std::span<const uint8_t> d, SolverStatsMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.status) && r.read(m.qp_iterations) &&
+      r.read(m.integration_us) && r.read(m.linearization_us) && r.read(m.qp_us) &&
+      r.read(m.total_us) && r.read(m.fallback));
+  return finish(r, error);
+}
+
+void encode(const PredictionMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write_sequence(std::span<const double>(m.position));
+  w.write_sequence(std::span<const double>(m.reference));
+}
+bool decode(std::span<const uint8_t> d, PredictionMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read_sequence(m.position) &&
+      r.read_sequence(m.reference));
+  return finish(r, error);
+}
+
+void encode_float64(double v, CdrWriter& w) { w.write(v); }
+bool decode_float64(std::span<const uint8_t> d, double& v, std::string& error) {
+  CdrReader r(d);
+  r.read(v);
+  return finish(r, error);
+}
+
+// ---- SessionRecorder ----------------------------------------------------------------------
+
+bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
+                           const SessionInfo& info, std::string& error) {
+  if (control_period_ns == 0) {
+    error = path + ": control period must be positive";
+    return false;
+  }
+  period_ns_ = control_period_ns;
+  sequence_.fill(0);
+  if (!writer_.open(path, error)) return false;
+  for (std::size_t t = 0; t < kTopicCount; ++t) {
+    const auto schema = writer_.add_schema(kTypes[t].schema_name, "ros2msg", kTypes[t].schema_text);
+    channel_[t] = writer_.add_channel(schema, kTypes[t].topic, "cdr",
+                                      {{"offered_qos_profiles", kQosProfiles}});
+  }
+  // Metadata first, so a crashed session's .tmp still says what it was.
+  writer_.write_metadata("mixpilot", {{"scenario", info.scenario},
+                                      {"scenario_path", info.scenario_path},
+                                      {"version", version()},
+                                      {"seed", std::to_string(info.seed)},
+                                      {"pilot", info.pilot},
+                                      {"control_period_ns", std::to_string(period_ns_)}});
+  if (!writer_.error().empty()) {
+    error = writer_.error();
+    return false;
+  }
+  return true;
+}
+
+bool SessionRecorder::put_encoded(Topic t, uint64_t step) {
+  const uint64_t time = log_time_ns(step);
+  // publish_time = log_time: the session clock is the only clock (spec: "if not available,
+  // must be set to the log time").
+  return writer_.write_message(channel_[t], sequence_[t]++, time, time, cdr_.span());
+}
+
+template <class Msg>
+bool SessionRecorder::put(Topic t, uint64_t step, const Msg& m) {
+  cdr_.reset();
+  encode_body(m, ros_time_from_ns(log_time_ns(step)), cdr_);
+  return put_encoded(t, step);
+}
+
+bool SessionRecorder::record_joy(uint64_t step, const JoyMsg& m) { return put(kJoy, step, m); }
+bool SessionRecorder::record_pilot(const PilotCommandMsg& m) { return put(kPilot, m.step, m); }
+bool SessionRecorder::record_state(const VehicleStateMsg& m) { return put(kState, m.step, m); }
+bool SessionRecorder::record_applied(const AppliedCommandMsg& m) {
+  return put(kApplied, m.step, m);
+}
+bool SessionRecorder::record_solver(const SolverStatsMsg& m) { return put(kSolver, m.step, m); }
+bool SessionRecorder::record_prediction(const PredictionMsg& m) {
+  return put(kPrediction, m.step, m);
+}
+bool SessionRecorder::record_lambda(uint64_t step, double lambda) {
+  cdr_.reset();
+  encode_float64(lambda, cdr_);
+  return put_encoded(kLambda, step);
+}
+
+bool SessionRecorder::close(std::string& error) { return writer_.close(error); }
+
+// ---- reading ------------------------------------------------------------------------------
+
+std::optional<RecordingContents> decode_recording(const McapFile& file, std::string_view name,
+                                                  std::string& error) {
+  RecordingContents out;
+  out.library = file.library;
+  out.complete = file.complete;
+  auto fail = [&](uint64_t at, const std::string& what) {
+    error = std::string(name) + ": " + what + " at byte " + std::to_string(at);
+    return std::nullopt;
+  };
+  if (file.profile != "ros2")
+    return fail(8, "Header profile is '" + file.profile + "', expected 'ros2'");
+
+  // Channel id -> index into kTypes (or -1: a topic this reader does not know).
+  std::map<uint16_t, int> kind;
+  for (const auto& [id, ch] : file.channels) {
+    out.message_counts[ch.topic] += 0;
+    int k = -1;
+    for (std::size_t t = 0; t < std::size(kTypes); ++t)
+      if (ch.topic == kTypes[t].topic) k = static_cast<int>(t);
+    if (k >= 0) {
+      const auto s = file.schemas.find(ch.schema_id);
+      if (s == file.schemas.end() || s->second.name != kTypes[k].schema_name ||
+          s->second.encoding != "ros2msg" || ch.message_encoding != "cdr")
+        return fail(ch.record_offset, "channel " + ch.topic + " is not " +
+                                          kTypes[k].schema_name + " (ros2msg, cdr)");
+    }
+    kind[id] = k;
+  }
+  for (const auto& md : file.metadata)
+    if (md.name == "mixpilot") out.metadata = md.metadata;
+  if (auto it = out.metadata.find("control_period_ns"); it != out.metadata.end())
+    out.control_period_ns = std::strtoull(it->second.c_str(), nullptr, 10);
+
+  std::string why;
+  for (const auto& msg : file.messages) {
+    const auto& ch = file.channels.at(msg.channel_id);
+    ++out.message_counts[ch.topic];
+    const auto data = file.data(msg);
+    bool ok = true;
+    switch (kind.at(msg.channel_id)) {
+      case 0: ok = decode(data, out.joy.emplace_back(), why); break;
+      case 1: ok = decode(data, out.pilot.emplace_back(), why); break;
+      case 2: ok = decode(data, out.states.emplace_back(), why); break;
+      case 3: {
+        LambdaSample s;
+        ok = decode_float64(data, s.lambda, why);
+        s.step = out.control_period_ns ? msg.log_time / out.control_period_ns : 0;
+        out.lambda.push_back(s);
+        break;
+      }
+      case 4: ok = decode(data, out.applied.emplace_back(), why); break;
+      case 5: ok = decode(data, out.solver.emplace_back(), why); break;
+      case 6: ok = decode(data, out.predictions.emplace_back(), why); break;
+      default: break;
+    }
+    if (!ok)
+      return fail(msg.record_offset, "undecodable " + ch.topic + " message (" + why + ")");
+  }
+  return out;
+}
+
+std::optional<RecordingContents> read_recording(const std::string& path, std::string& error,
+                                                const McapReadOptions& options) {
+  const auto file = read_mcap(path, error, options);
+  if (!file) return std::nullopt;
+  return decode_recording(*file, path, error);
+}
+
+}  // namespace mixpilot

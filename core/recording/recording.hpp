@@ -1,0 +1,205 @@
+#pragma once
+// Session recordings: MCAP files (core/recording/mcap.hpp) with the ros2 profile, CDR-encoded messages
+// (core/recording/cdr.hpp) and ros2msg schemas, so ROS 2 tools and Foxglove read them as they are.
+// Topics, types and metadata keys are listed in docs/recording-format.md.
+//
+// Time: every message of control step k is logged at k·Δt (Δt = control period, integer ns),
+// and its stamp (when the type has one) is that same time. A session therefore replays
+// bit-identically from its recording.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/recording/cdr.hpp"
+#include "core/recording/mcap.hpp"
+
+namespace mixpilot {
+
+// builtin_interfaces/Time.
+struct RosTime {
+  int32_t sec = 0;
+  uint32_t nanosec = 0;
+  bool operator==(const RosTime&) const = default;
+};
+RosTime ros_time_from_ns(uint64_t ns);
+uint64_t ros_time_to_ns(const RosTime& t);  // negative sec saturates to 0
+
+// sensor_msgs/msg/Joy on /joy: the raw gamepad (header.stamp, header.frame_id).
+struct JoyMsg {
+  RosTime stamp;
+  std::string frame_id;
+  std::vector<float> axes;      // [-1, 1]
+  std::vector<int32_t> buttons;  // 0 / 1
+  bool operator==(const JoyMsg&) const = default;
+};
+
+// mixpilot_msgs/msg/PilotCommand on /pilot/command: the human reference ν^r = (φ_h, θ_h, Ω_h)
+// of SPEC §5.4 and where it came from.
+struct PilotCommandMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  double roll = 0.0;                     // φ_h [rad]
+  double pitch = 0.0;                    // θ_h [rad]
+  std::array<double, 4> rotor_speed{};   // Ω_h [kHz, the model's scaled unit]
+  std::string source;  // "novice", "experienced", "reckless", "gamepad", "replay:<file>", ...
+  bool operator==(const PilotCommandMsg&) const = default;
+};
+
+// mixpilot_msgs/msg/VehicleState on /vehicle/state: the MikroKopter state of SPEC §3.3,
+// x = (p, φ θ ψ, v_b, ω, Ω) ∈ R¹⁶.
+struct VehicleStateMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  std::vector<double> x;
+  bool operator==(const VehicleStateMsg&) const = default;
+};
+
+// mixpilot_msgs/msg/AppliedCommand on /controller/applied: what the pilot's command became.
+struct AppliedCommandMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  std::vector<double> u;                // rotor torques τ [N·m] applied to the vehicle
+  double roll = 0.0;                    // MPC stage-1 φ [rad]
+  double pitch = 0.0;                   // MPC stage-1 θ [rad]
+  std::array<double, 4> rotor_speed{};  // MPC stage-1 Ω
+  bool operator==(const AppliedCommandMsg&) const = default;
+};
+
+// mixpilot_msgs/msg/SolverStats on /controller/solver.
+struct SolverStatsMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  uint8_t status = 0;
+  uint32_t qp_iterations = 0;
+  double integration_us = 0.0, linearization_us = 0.0, qp_us = 0.0, total_us = 0.0;
+  bool fallback = false;
+  bool operator==(const SolverStatsMsg&) const = default;
+};
+
+// mixpilot_msgs/msg/Prediction on /controller/prediction: 3·(N+1) values each, stage-major
+// (x0 y0 z0 x1 y1 z1 ...).
+struct PredictionMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  std::vector<double> position;   // predicted positions η_{i|k}
+  std::vector<double> reference;  // planner reference η^r_{i|k}
+  bool operator==(const PredictionMsg&) const = default;
+};
+
+// std_msgs/msg/Float64 on /controller/lambda (no stamp in the type: the step is the log time).
+struct LambdaSample {
+  uint64_t step = 0;
+  double lambda = 0.0;
+  bool operator==(const LambdaSample&) const = default;
+};
+
+// ---- encoding ---------------------------------------------------------------------------
+
+// The ros2msg schema (top-level definition followed by its dependencies) and schema name of
+// each type, and the topic it is recorded on.
+struct RecordedType {
+  const char* topic;
+  const char* schema_name;  // e.g. "mixpilot_msgs/msg/PilotCommand"
+  const char* schema_text;  // ros2msg
+};
+std::span<const RecordedType> recorded_types();
+
+// CDR encode (appended to `out`; call out.reset() first for a new message) and decode.
+// Decoders return false and set `error` ("CDR: ... at byte N of the message") on malformed
+// data, including trailing bytes beyond CDR's final alignment padding.
+void encode(const JoyMsg& m, CdrWriter& out);
+void encode(const PilotCommandMsg& m, CdrWriter& out);
+void encode(const VehicleStateMsg& m, CdrWriter& out);
+void encode(const AppliedCommandMsg& m, CdrWriter& out);
+void encode(const SolverStatsMsg& m, CdrWriter& out);
+void encode(const PredictionMsg& m, CdrWriter& out);
+void encode_float64(double v, CdrWriter& out);
+bool decode(std::span<const uint8_t> data, JoyMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, PilotCommandMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, VehicleStateMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, AppliedCommandMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, SolverStatsMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, PredictionMsg& m, std::string& error);
+bool decode_float64(std::span<const uint8_t> data, double& v, std::string& error);
+
+// ---- recording --------------------------------------------------------------------------
+
+// What the "mixpilot" Metadata record holds besides version and control_period_ns.
+struct SessionInfo {
+  std::string scenario;       // full scenario file text
+  std::string scenario_path;
+  uint64_t seed = 0;
+  std::string pilot;          // pilot source, as in PilotCommandMsg::source
+};
+
+// Writes one session. Each record_* call appends one message at log time step·Δt and fills
+// the message's stamp with that time; steps must not decrease across calls (MCAP log-time
+// order). Calls after a failure do nothing; close() reports the first failure.
+class SessionRecorder {
+ public:
+  SessionRecorder() = default;
+  SessionRecorder(const SessionRecorder&) = delete;
+  SessionRecorder& operator=(const SessionRecorder&) = delete;
+
+  // Opens "<path>.tmp", writes the schemas, channels and the "mixpilot" Metadata record.
+  // control_period_ns > 0 is Δt in nanoseconds.
+  bool open(const std::string& path, uint64_t control_period_ns, const SessionInfo& info,
+            std::string& error);
+
+  bool record_joy(uint64_t step, const JoyMsg& m);
+  bool record_pilot(const PilotCommandMsg& m);
+  bool record_state(const VehicleStateMsg& m);
+  bool record_lambda(uint64_t step, double lambda);
+  bool record_applied(const AppliedCommandMsg& m);
+  bool record_solver(const SolverStatsMsg& m);
+  bool record_prediction(const PredictionMsg& m);
+
+  bool flush() { return writer_.flush(); }
+  // Completes the file and renames "<path>.tmp" to <path>.
+  bool close(std::string& error);
+
+  uint64_t log_time_ns(uint64_t step) const { return step * period_ns_; }
+  const McapWriter& writer() const { return writer_; }
+
+ private:
+  enum Topic { kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kTopicCount };
+  template <class Msg>
+  bool put(Topic t, uint64_t step, const Msg& m);
+  bool put_encoded(Topic t, uint64_t step);
+
+  McapWriter writer_;
+  CdrWriter cdr_;
+  uint64_t period_ns_ = 0;
+  std::array<uint16_t, kTopicCount> channel_{};
+  std::array<uint32_t, kTopicCount> sequence_{};
+};
+
+struct RecordingContents {
+  std::string library;                          // the writer ("mixpilot 0.1.0")
+  std::map<std::string, std::string> metadata;  // the "mixpilot" Metadata record
+  uint64_t control_period_ns = 0;               // from metadata (0 if absent)
+  std::map<std::string, uint64_t> message_counts;  // per topic, every channel listed
+  std::vector<JoyMsg> joy;
+  std::vector<PilotCommandMsg> pilot;  // in log-time order
+  std::vector<VehicleStateMsg> states;
+  std::vector<LambdaSample> lambda;
+  std::vector<AppliedCommandMsg> applied;
+  std::vector<SolverStatsMsg> solver;
+  std::vector<PredictionMsg> predictions;
+  bool complete = true;  // false: read from a cut-short .tmp (allow_truncated)
+};
+
+// Reads a recording: validates the MCAP file (core/recording/mcap.hpp), checks that every known topic
+// uses its expected schema name, ros2msg and cdr, and decodes all messages. Topics it does
+// not know are counted, not decoded. Errors: "<path>: <what> at byte <offset> (...)".
+std::optional<RecordingContents> read_recording(const std::string& path, std::string& error,
+                                                const McapReadOptions& options = {});
+std::optional<RecordingContents> decode_recording(const McapFile& file, std::string_view name,
+                                                  std::string& error);
+
+}  // namespace mixpilot

@@ -1,0 +1,272 @@
+#include "core/scenario/scenario_toml.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "core/scenario/toml_read.hpp"
+
+namespace mixpilot {
+namespace {
+
+using namespace toml_read;  // NOLINT: the reading vocabulary of this file
+
+
+void read_controller(Section s, MiControllerSettings& c, Diagnostics& d) {
+  const bool n_ok = s.integer("N", c.N, int_positive) || !s.table() || !s.table()->get("N");
+  s.num("dt", c.dt, positive);
+  s.boolean("safety_constraints", c.safety_constraints);
+  std::string form;
+  if (s.choice("obstacle_form", form, {"lcl", "squared"})) {
+    c.obstacle_form = form == "lcl" ? ObstacleForm::lcl : ObstacleForm::squared;
+  }
+  s.integer("max_constrained_obstacles", c.max_constrained_obstacles, int_non_negative);
+  s.num("vehicle_radius", c.vehicle_radius, non_negative);
+  s.num("slack_l1", c.slack_l1, non_negative);
+  s.num("slack_l2", c.slack_l2, positive);  // keeps the slack Hessian positive definite
+
+  Section w = s.sub("weights");
+  w.vec("q_eta", c.weights.q_eta, non_negative);
+  w.num("q_nu", c.weights.q_nu, non_negative);
+  w.vec("q_e", c.weights.q_e, non_negative);
+  w.num("r", c.weights.r, positive);  // the only input weight: the Riccati input pivots need it
+  w.finish();
+
+  Section ph = s.sub("ph");
+  ph.num("r", c.ph.r, positive);
+  const bool nb_given = ph.integer("N_b", c.ph.N_b, int_positive);
+  ph.num("mu1", c.ph.mu1, unit_open);
+  ph.num("mu2", c.ph.mu2, unit_closed);
+  ph.num("theta2", c.ph.theta2, positive);
+  ph.num("zeta", c.ph.zeta, positive);
+  ph.num("initial_lambda", c.ph.initial_lambda, unit_closed);
+  ph.finish();
+  if (n_ok && c.ph.N_b > c.N && (nb_given || !ph.table() || !ph.table()->get("N_b"))) {
+    d.add(ph.pos("N_b"), ph.path("N_b"),
+          "expected at most controller.N = " + std::to_string(c.N) + ", got " +
+              std::to_string(c.ph.N_b));
+  }
+  s.finish();
+}
+
+PilotProfile read_pilot(Section s, const std::string& name) {
+  PilotProfile p;
+  p.name = name;
+  s.vec("q1", p.q1, non_negative);
+  s.vec("q2", p.q2, non_negative);
+  s.vec("q3", p.q3, non_negative);
+  s.vec("q4", p.q4, non_negative);
+  s.num("q5", p.q5, non_negative);
+  s.num("r1", p.r1, positive);
+  s.integer("N", p.N, int_positive);
+  s.num("reaction_delay", p.reaction_delay, non_negative);
+  s.num("max_tilt", p.max_tilt, tilt);
+  s.finish();
+  return p;
+}
+
+// First time in [0, duration] at which the helix leaves the box, if any. The coordinates are
+// sinusoids and a line: sampling at ≤ 1 mrad of phase misses at most ~R·5e-7 m of excursion.
+std::optional<double> helix_leaves(const HelixReference& h, double duration,
+                                   const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const int n = std::max(1000, int(std::ceil(std::abs(h.angular_rate) * duration / 1e-3)));
+  for (int i = 0; i <= n; ++i) {
+    const double t = duration * i / n;
+    const Eigen::Vector3d p = h.position(t);
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return t;
+  }
+  return std::nullopt;
+}
+
+std::string vec_text(const Eigen::Vector3d& v) {
+  return '[' + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + ']';
+}
+
+// A computed (not user-typed) quantity, to the millimetre / millisecond.
+std::string approx(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+Scenario read_scenario(const toml::table& root, Diagnostics& d) {
+  Scenario sc;
+  Section s(d, &root, "", Pos{1, 1});
+  s.string("name", sc.name, true);
+  const bool mode_ok = s.choice("mode", sc.mode, {"mixed_initiative"}, true);
+  const bool model_ok = s.choice("model", sc.model, {"mikrokopter", "crazyflie", "pendubot"}, true);
+  if (mode_ok && model_ok && sc.mode == "mixed_initiative" && sc.model != "mikrokopter") {
+    d.add(s.pos("model"), "model",
+          "expected \"mikrokopter\" for mode \"mixed_initiative\" (SPEC 5.4), got \"" + sc.model +
+              '"');
+  }
+  const bool duration_ok = s.num("duration", sc.duration, positive) || !root.get("duration");
+  const bool pilot_given = s.string("pilot", sc.default_pilot);
+
+  read_controller(s.sub("controller"), sc.controller, d);
+
+  Section ref = s.sub("reference");
+  Eigen::Vector2d center = sc.reference.center;
+  if (ref.vec("center", center)) sc.reference.center = center;
+  ref.num("radius", sc.reference.radius, non_negative);
+  ref.num("start_height", sc.reference.start_height);
+  ref.num("climb_rate", sc.reference.climb_rate);
+  ref.num("angular_rate", sc.reference.angular_rate);
+  ref.num("phase", sc.reference.phase);
+  ref.finish();
+
+  Section arena = s.sub("arena");
+  bool box_ok = (arena.vec("min", sc.arena.min) || !arena.table() || !arena.table()->get("min")) &
+                (arena.vec("max", sc.arena.max) || !arena.table() || !arena.table()->get("max"));
+  if (box_ok && !(sc.arena.min.array() < sc.arena.max.array()).all()) {
+    d.add(arena.pos("max"), arena.path("max"),
+          "expected every component above arena.min = " + vec_text(sc.arena.min) + ", got " +
+              vec_text(sc.arena.max));
+    box_ok = false;
+  }
+  if (const toml::node* obs = arena.take("obstacles", false, "")) {
+    const toml::array* a = obs->as_array();
+    if (!a || !a->is_array_of_tables()) {
+      d.add(pos_of(obs->source()), arena.path("obstacles"),
+            "expected an array of tables ([[arena.obstacles]]), got " + describe(*obs));
+    } else {
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const toml::node& e = *a->get(i);
+        Section o(d, e.as_table(), arena.path("obstacles") + '[' + std::to_string(i) + ']',
+                  pos_of(e.source()));
+        Obstacle ob;
+        const bool c_ok = o.vec("center", ob.center, finite, true);
+        o.num("radius", ob.radius, positive, true);
+        o.finish();
+        if (c_ok && box_ok &&
+            ((ob.center.array() < sc.arena.min.array()).any() ||
+             (ob.center.array() > sc.arena.max.array()).any())) {
+          d.add(o.pos("center"), o.path("center"),
+                "expected a point inside the arena " + vec_text(sc.arena.min) + " .. " +
+                    vec_text(sc.arena.max) + ", got " + vec_text(ob.center));
+        }
+        sc.arena.obstacles.push_back(ob);
+      }
+    }
+  }
+  arena.finish();
+  // The reference must stay flyable: the controller's soft walls would fight it otherwise.
+  if (box_ok && duration_ok) {
+    if (const auto t = helix_leaves(sc.reference, sc.duration, sc.arena.min, sc.arena.max)) {
+      const Eigen::Vector3d p = sc.reference.position(*t);
+      d.add(ref.pos(), "reference",
+            "expected a helix inside the arena over [0, duration], but it leaves it at t = " +
+                approx(*t) + " s, at (" + approx(p.x()) + ", " + approx(p.y()) + ", " +
+                approx(p.z()) + ")");
+    }
+  }
+
+  // [pilots.<name>]: one table per profile; TOML itself rejects a name given twice.
+  Section pilots = s.sub("pilots");
+  if (pilots.table()) {
+    for (auto&& [k, v] : *pilots.table()) {
+      const std::string name(k.str());
+      if (!v.is_table()) {
+        d.add(pos_of(v.source()), pilots.path(name),
+              "expected a table of pilot weights ([pilots." + name + "]), got " + describe(v));
+        continue;
+      }
+      sc.pilots[name] = read_pilot(Section(d, v.as_table(), pilots.path(name), pos_of(v.source())),
+                                   name);
+    }
+  }
+  // "reckless" (full-tilt inputs, no NMPC) is always available; its max_tilt may be overridden.
+  if (!sc.pilots.count("reckless")) sc.pilots["reckless"] = PilotProfile{.name = "reckless"};
+  if (!sc.pilots.count(sc.default_pilot)) {
+    std::string names;
+    for (const auto& [n, p] : sc.pilots) names += (names.empty() ? "" : ", ") + ('"' + n + '"');
+    d.add(pilot_given ? s.pos("pilot") : Pos{1, 1}, "pilot",
+          "expected the name of a profile in [pilots] (" + names + "), got \"" +
+              sc.default_pilot + '"' + (pilot_given ? "" : " (the default)"));
+  }
+
+  Section plant = s.sub("plant");
+  const bool rate_given = plant.num("rate_hz", sc.plant.rate_hz, at_least_1000);
+  plant.num("input_delay", sc.plant.input_delay, non_negative);
+  plant.num("position_noise", sc.plant.position_noise, non_negative);
+  std::int64_t seed = std::int64_t(sc.plant.seed);
+  if (plant.integer("seed", seed, int_non_negative)) sc.plant.seed = std::uint64_t(seed);
+  plant.finish();
+  // The plant takes a whole number of RK4 substeps per control step.
+  const double substeps = sc.controller.dt * sc.plant.rate_hz;
+  if (sc.plant.rate_hz >= 1000 && sc.controller.dt > 0 &&
+      std::abs(substeps - std::round(substeps)) > 1e-9 * substeps) {
+    d.add(rate_given ? plant.pos("rate_hz") : plant.pos(), plant.path("rate_hz"),
+          "expected a rate giving a whole number of substeps per control step, got controller.dt "
+          "* rate_hz = " + fmt(substeps));
+  }
+
+  s.finish();
+  return sc;
+}
+
+
+}  // namespace
+
+std::optional<Scenario> parse_scenario(std::string_view text, const std::string& source_name,
+                                       std::string& error) {
+  auto sc = parse_document<Scenario>(text, source_name, error,
+                                    [](const toml::table& root, Diagnostics& d) {
+                                      return read_scenario(root, d);
+                                    });
+  if (sc) sc->source_text = std::string(text);
+  return sc;
+}
+
+std::optional<Scenario> load_scenario(const std::string& path, std::string& error) {
+  std::string text;
+  if (!read_text_file(path, text, error)) return std::nullopt;
+  return parse_scenario(text, path, error);
+}
+
+bool read_text_file(const std::string& path, std::string& text, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = path + ": cannot open file (" + std::error_code(errno, std::generic_category()).message() +
+            ')';
+    return false;
+  }
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) {
+    error = path + ": read error";
+    return false;
+  }
+  text = s.str();
+  return true;
+}
+
+std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
+                                         std::string& error) {
+  Diagnostics d(source_name);
+  toml::table root;
+  if (!parse_toml(text, source_name, d, root)) {
+    error = d.str();
+    return std::nullopt;
+  }
+  Section s(d, &root, "", Pos{1, 1});
+  std::string mode;
+  if (!s.string("mode", mode, true)) {
+    error = d.str();
+    return std::nullopt;
+  }
+  return mode;
+}
+
+}  // namespace mixpilot

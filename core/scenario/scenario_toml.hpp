@@ -1,0 +1,33 @@
+#pragma once
+// Scenario files (TOML, docs/scenario-format.md) → Scenario (core/scenario/scenario.hpp).
+// TOML: human-edited, comments allowed, no indentation rules, and every value carries its
+// line/column, so errors can point at the offending key.
+//
+// On failure both functions return nullopt and set `error` to one line per problem, sorted by
+// position, each of the form `<file>:<line>:<col>: <key path>: <what was expected>`, e.g.
+//   scenarios/x.toml:12:9: controller.ph.r: expected a positive number, got -0.1
+// Unknown keys are errors (a typo must not silently fall back to a default). No exceptions
+// escape.
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "core/scenario/scenario.hpp"
+
+namespace mixpilot {
+
+// Reads and validates the file at `path`; source_path = path, source_text = its contents.
+std::optional<Scenario> load_scenario(const std::string& path, std::string& error);
+
+// The same from text; `source_name` names it in messages and becomes source_path.
+std::optional<Scenario> parse_scenario(std::string_view text, const std::string& source_name,
+                                       std::string& error);
+
+// The whole text of a file; false with "<path>: cannot open file (...)" otherwise.
+bool read_text_file(const std::string& path, std::string& text, std::string& error);
+
+// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader.
+std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
+                                         std::string& error);
+
+}  // namespace mixpilot

@@ -1,0 +1,67 @@
+#pragma once
+// "No heap allocation in the control loop", checked two ways: the executable links the engine
+// built with EIGEN_RUNTIME_NO_MALLOC (mixpilot_core_nomalloc), so an Eigen heap allocation
+// inside a NoMalloc scope aborts, and every malloc/calloc/realloc of the process (std::vector
+// growth, operator new, ...) in that scope is counted. Include it in exactly one translation
+// unit of a test executable: it defines the process's malloc.
+#include <atomic>
+#include <cstddef>
+#include <cstdlib>
+
+#include <Eigen/Core>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define MIXPILOT_COUNT_MALLOC 0
+#else
+#define MIXPILOT_COUNT_MALLOC 1
+#endif
+
+#if MIXPILOT_COUNT_MALLOC
+extern "C" void* __libc_malloc(std::size_t);
+extern "C" void* __libc_calloc(std::size_t, std::size_t);
+extern "C" void* __libc_realloc(void*, std::size_t);
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+extern "C" void* malloc(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_malloc(n);
+}
+extern "C" void* calloc(std::size_t n, std::size_t m) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_calloc(n, m);
+}
+extern "C" void* realloc(void* p, std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  return __libc_realloc(p, n);
+}
+#endif
+
+namespace mixpilot {
+
+// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
+struct NoMalloc {
+  NoMalloc() {
+#if MIXPILOT_COUNT_MALLOC
+    g_allocations = 0;
+    g_counting = true;
+#endif
+    Eigen::internal::set_is_malloc_allowed(false);
+  }
+  ~NoMalloc() {
+    Eigen::internal::set_is_malloc_allowed(true);
+#if MIXPILOT_COUNT_MALLOC
+    g_counting = false;
+#endif
+  }
+  static long count() {
+#if MIXPILOT_COUNT_MALLOC
+    return g_allocations.load();
+#else
+    return 0;
+#endif
+  }
+};
+
+}  // namespace mixpilot
