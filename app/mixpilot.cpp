@@ -15,13 +15,15 @@
 #include <vector>
 
 #include "core/numerics/integrator_erk4.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
 #include "core/modes/mode.hpp"
-#include "core/control/pilot_emulated.hpp"
-#include "core/recording/recording.hpp"
-#include "core/scenario/scenario_toml.hpp"
+#include "core/modes/report.hpp"
 #include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
+#include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
 #include "core/numerics/version.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
@@ -61,18 +63,20 @@ constexpr const char* kFlyUsage =
     "                     (mixed_initiative only)\n"
     "  --headless         run without a window (required: this build has no GUI yet)\n"
     "  --duration S       fly S seconds instead of the scenario's duration\n"
-    "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md;\n"
-    "                     mixed_initiative only)\n"
+    "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md):\n"
+    "                     every mode's telemetry, plus the pilot's commands in mixed_initiative\n"
     "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
     "                     mode's metrics as JSON\n";
 
 constexpr const char* kScoreUsage =
     "usage: mixpilot score FILE.mcap... [--jobs N] [--json OUT]\n"
     "\n"
-    "Replays each recording's pilot commands through a fresh session of its embedded scenario\n"
-    "and scores it: progress on stderr, a table on stdout. The timing fields come from the\n"
-    "recorded solver statistics (they describe that flight); every other field is recomputed\n"
-    "and a replay whose states differ from the recorded ones is flagged.\n"
+    "Flies each recording again through a fresh session of its embedded scenario and checks the\n"
+    "replayed states against the recorded ones bit for bit: mixed_initiative recordings replay\n"
+    "their pilot commands and are scored (the timing fields come from the recorded solver\n"
+    "statistics: they describe that flight); other modes are flown for the recorded number of\n"
+    "steps and give their metrics (timing fields from this run). Progress on stderr, a table on\n"
+    "stdout.\n"
     "\n"
     "  --jobs N     replay N recordings in parallel (default: the number of cores)\n"
     "  --json OUT   write a JSON array with one object per recording\n";
@@ -102,36 +106,6 @@ bool write_file(const std::string& path, const std::string& text, std::string& e
   return true;
 }
 
-// A pilot source by name: a profile of the scenario, "reckless", or a recording to replay.
-std::unique_ptr<PilotSource> make_pilot(const Scenario& scenario, const std::string& name,
-                                        const std::optional<RecordingContents>& recording,
-                                        std::string& error) {
-  const models::MikroKopter model;
-  if (recording) {
-    return std::make_unique<ReplayPilot>(recording->pilot, "replay:" + name);
-  }
-  if (name == "reckless") {
-    const auto it = scenario.pilots.find("reckless");
-    const double tilt = it != scenario.pilots.end() ? it->second.max_tilt : PilotProfile{}.max_tilt;
-    return std::make_unique<RecklessPilot>(model, scenario.arena, tilt);
-  }
-  const auto it = scenario.pilots.find(name);
-  if (it == scenario.pilots.end()) {
-    error = "unknown pilot '" + name + "': the scenario defines";
-    for (const auto& [profile, _] : scenario.pilots) error += " " + profile;
-    error += ", plus reckless and RECORDING.mcap";
-    return nullptr;
-  }
-  auto pilot = std::make_unique<EmulatedPilot>();
-  PilotProfile profile = it->second;
-  profile.name = name;
-  if (!pilot->setup(model, profile, scenario.reference, scenario.controller.dt)) {
-    error = "pilot profile '" + name + "' does not form a valid OCP";
-    return nullptr;
-  }
-  return pilot;
-}
-
 struct FlyOptions {
   std::string scenario_path;
   std::string pilot;
@@ -141,115 +115,78 @@ struct FlyOptions {
   std::string report;
 };
 
-void print_summary(const Scenario& sc, const std::string& pilot, const Score& s, double wall,
-                   bool lost) {
-  std::printf("mixpilot fly: %s, pilot %s\n", sc.name.c_str(), pilot.c_str());
-  std::printf("  flew %.1f s in %.2f s (%.0fx real time); RTI median %.0f us, p99 %.0f us, "
-              "%d deadline misses, %lld fallbacks\n",
-              s.duration_s, wall, s.duration_s / std::max(wall, 1e-9), s.rti_median_us,
-              s.rti_p99_us, s.deadline_misses, static_cast<long long>(s.fallbacks));
-  std::printf("  lambda mean %.3f (min %.3f); deviation max %.3f m, rms %.3f m; in ball %.1f%%; "
-              "progress %.1f%%\n",
-              s.mean_lambda, s.min_lambda, s.max_deviation_m, s.rms_deviation_m,
-              100.0 * s.time_in_ball, 100.0 * s.progress);
-  std::printf("  collisions %d; min clearance %.3f m; override %.4f rad rms; skill %.1f / 100\n",
-              s.collisions, s.min_clearance_m, s.override_rms, s.skill);
-  if (lost) std::printf("  the vehicle was lost: the plant state stopped being finite\n");
+// The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
+// --pilot, and the mode it names.
+struct Flight {
+  std::string scenario_text;
+  std::string scenario_source;
+  std::unique_ptr<Mode> mode;
+  std::string pilot;  // mixed initiative: the pilot source's name
+};
+
+std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error) {
+  Flight f;
+  std::optional<RecordingContents> recording;
+  if (ends_with(o.pilot, ".mcap")) {
+    recording = read_recording(o.pilot, error);
+    if (!recording) return std::nullopt;
+  }
+  if (!o.scenario_path.empty()) {
+    if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
+    f.scenario_source = o.scenario_path;
+  } else if (recording) {
+    f.scenario_text = recording->metadata["scenario"];
+    f.scenario_source = o.pilot + " (embedded scenario)";
+  } else {
+    usage_error("fly", "--scenario FILE is required");
+  }
+  const auto kind_name = scenario_mode(f.scenario_text, f.scenario_source, error);
+  if (!kind_name) return std::nullopt;
+  if (*kind_name != "mixed_initiative" && !o.pilot.empty())
+    usage_error("fly", "--pilot is for mixed_initiative scenarios, " + f.scenario_source +
+                           " is " + *kind_name);
+  ModeRequest request;
+  request.duration = o.duration;
+  if (recording) {
+    request.pilot_source = std::make_unique<ReplayPilot>(recording->pilot, "replay:" + o.pilot);
+  } else {
+    request.pilot_name = o.pilot;
+  }
+  f.mode = make_mode(f.scenario_text, f.scenario_source, std::move(request), error);
+  if (!f.mode) return std::nullopt;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get())) f.pilot = mi->pilot().name();
+  return f;
 }
 
-// Modes other than mixed_initiative fly on their own (core/modes/mode.hpp).
-int run_mode(const std::string& mode, const FlyOptions& o) {
-  const ModeRunner runner = find_mode_runner(mode);
-  if (!runner) {
-    std::string known = "mixed_initiative";
-    for (const auto& m : mode_runner_names()) known += ", " + m;
-    std::fprintf(stderr, "mixpilot fly: %s: mode \"%s\" has no runner (known: %s)\n",
-                 o.scenario_path.c_str(), mode.c_str(), known.c_str());
-    return 1;
-  }
-  if (!o.pilot.empty()) usage_error("fly", "--pilot is for mixed_initiative scenarios");
-  if (!o.record.empty()) usage_error("fly", "--record is for mixed_initiative scenarios");
-  ModeOptions options;
-  options.duration = o.duration;
-  const ModeResult r = runner(o.scenario_path, options);
-  if (!r.ok) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", r.error.c_str());
-    return 1;
-  }
-  std::fputs(r.summary.c_str(), stdout);
-  if (!r.summary.empty() && r.summary.back() != '\n') std::fputc('\n', stdout);
-  if (!o.report.empty()) {
-    std::string json = "{\n  \"mode\": \"" + mode + "\"";
-    char buf[160];
-    for (const auto& [name, value] : r.metrics) {
-      std::snprintf(buf, sizeof buf, ",\n  \"%s\": %.17g", name.c_str(), value);
-      json += buf;
-    }
-    json += "\n}\n";
-    std::string error;
-    if (!write_file(o.report, json, error)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-      return 1;
-    }
-    std::printf("  report %s\n", o.report.c_str());
-  }
-  return 0;
+SessionInfo session_info(const Flight& f) {
+  SessionInfo info;
+  info.mode = to_string(f.mode->kind());
+  info.scenario = f.scenario_text;
+  info.scenario_path = f.scenario_source;
+  info.pilot = f.pilot;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
+    info.seed = mi->scenario().plant.seed;
+  return info;
+}
+
+Labels report_labels(const Flight& f) {
+  Labels labels = {{"mode", to_string(f.mode->kind())}, {"scenario", f.mode->scenario_name()}};
+  if (!f.pilot.empty()) labels.emplace_back("pilot", f.pilot);
+  return labels;
 }
 
 int run_fly(const FlyOptions& o) {
   std::string error;
-  if (!o.scenario_path.empty()) {
-    std::string text;
-    if (!read_text_file(o.scenario_path, text, error)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-      return 1;
-    }
-    const auto mode = scenario_mode(text, o.scenario_path, error);
-    if (!mode) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-      return 1;
-    }
-    if (*mode != "mixed_initiative") return run_mode(*mode, o);
-  }
-  std::optional<RecordingContents> recording;
-  if (ends_with(o.pilot, ".mcap")) {
-    recording = read_recording(o.pilot, error);
-    if (!recording) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-      return 1;
-    }
-  }
-  std::optional<Scenario> scenario;
-  if (!o.scenario_path.empty()) {
-    scenario = load_scenario(o.scenario_path, error);
-  } else if (recording) {
-    scenario = parse_scenario(recording->metadata["scenario"],
-                              o.pilot + " (embedded scenario)", error);
-  } else {
-    usage_error("fly", "--scenario FILE is required");
-  }
-  if (!scenario) {
+  std::optional<Flight> flight = prepare_flight(o, error);
+  if (!flight) {
     std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
     return 1;
   }
-  if (o.duration) scenario->duration = *o.duration;
-  const std::string pilot_name = o.pilot.empty() ? scenario->default_pilot : o.pilot;
-  auto pilot = make_pilot(*scenario, pilot_name, recording, error);
-  if (!pilot) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-    return 1;
-  }
-
-  Session session;
-  if (!session.setup(*scenario, *pilot, error)) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
-    return 1;
-  }
-  ScoreAccumulator score(*scenario);
-  session.add_sink(&score);
+  Mode& mode = *flight->mode;
+  Session session(mode);
   RecordingSink recorder;
   if (!o.record.empty()) {
-    if (!recorder.open(o.record, *scenario, pilot->name(), error)) {
+    if (!recorder.open(o.record, mode, session_info(*flight), error)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       return 1;
     }
@@ -259,17 +196,18 @@ int run_fly(const FlyOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   session.run();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const Score s = score.finish();
 
   int status = 0;
   if (!o.record.empty() && !recorder.close(error)) {
     std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
     status = 1;
   }
-  print_summary(*scenario, pilot->name(), s, wall, session.lost());
+  std::fputs(mode.summary().c_str(), stdout);
+  const double flown = double(mode.steps_done()) * mode.dt();
+  std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
+              flown / std::max(wall, 1e-9));
   if (!o.report.empty()) {
-    const std::string json =
-        to_json(s, {{"scenario", scenario->name}, {"pilot", pilot->name()}}) + "\n";
+    const std::string json = to_json(report_labels(*flight), mode.metrics()) + "\n";
     if (!write_file(o.report, json, error)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       status = 1;
@@ -318,13 +256,50 @@ int fly_command(int argc, char** argv) {
 
 struct ScoreRow {
   std::string file;
+  std::string mode;
   std::string pilot;
   std::string scenario;
-  Score score;
+  Metrics metrics;
+  Score score;  // mixed initiative
   bool ok = false;
   bool matches = false;  // replayed states equal the recorded ones bit for bit
   std::string error;
 };
+
+// Compares each replayed state with the recorded one as the session goes.
+struct StateCompare final : TelemetrySink {
+  const std::vector<VehicleStateMsg>* states = nullptr;
+  bool matches = true;
+  void on_sample(const Telemetry& s) override {
+    const auto k = std::size_t(s.step);
+    if (k >= states->size() || (*states)[k].x.size() != std::size_t(s.x.size()) ||
+        !std::equal(s.x.data(), s.x.data() + s.x.size(), (*states)[k].x.begin()))
+      matches = false;
+  }
+};
+
+// A fresh flight of the recording's embedded scenario: mixed initiative replays the recorded
+// pilot commands (and is as long as they are), other modes fly on their own for as many
+// steps as were recorded.
+std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
+                                  const std::string& text, std::string& error) {
+  const std::string source = path + " (embedded scenario)";
+  const auto kind = scenario_mode(text, source, error);
+  if (!kind) return nullptr;
+  ModeRequest request;
+  if (*kind == "mixed_initiative") {
+    const auto scenario = parse_scenario(text, source, error);
+    if (!scenario) return nullptr;
+    request.duration = double(rec.pilot.size()) * scenario->controller.dt;
+    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
+    return make_mode(text, source, std::move(request), error);
+  }
+  auto mode = make_mode(text, source, ModeRequest{}, error);
+  if (mode && std::int64_t(rec.states.size()) < mode->steps_total())  // an interrupted run
+    mode = make_mode(text, source, ModeRequest{double(rec.states.size()) * mode->dt(), {}, {}},
+                     error);
+  return mode;
+}
 
 ScoreRow score_recording(const std::string& path) {
   ScoreRow row;
@@ -340,43 +315,31 @@ ScoreRow score_recording(const std::string& path) {
     row.error = path + ": no embedded scenario in the 'mixpilot' metadata record";
     return row;
   }
-  auto scenario = parse_scenario(meta->second, path + " (embedded scenario)", error);
-  if (!scenario) {
+  std::unique_ptr<Mode> mode = replay_mode(*rec, path, meta->second, error);
+  if (!mode) {
     row.error = error;
     return row;
   }
-  scenario->duration = double(rec->pilot.size()) * scenario->controller.dt;
   const auto pilot_meta = rec->metadata.find("pilot");
-  row.pilot = pilot_meta != rec->metadata.end() ? pilot_meta->second : "?";
-  row.scenario = scenario->name;
-  ReplayPilot pilot(rec->pilot, "replay:" + path);
-  Session session;
-  if (!session.setup(*scenario, pilot, error)) {
-    row.error = path + ": " + error;
-    return row;
-  }
-  ScoreAccumulator acc(*scenario);
-  session.add_sink(&acc);
-  // Compare each replayed state with the recorded one as the session goes.
-  struct Compare final : TelemetrySink {
-    const std::vector<VehicleStateMsg>* states;
-    bool matches = true;
-    void on_sample(const TelemetrySample& s) override {
-      const auto k = std::size_t(s.step);
-      if (k >= states->size() || (*states)[k].x.size() != std::size_t(s.x.size()) ||
-          !std::equal(s.x.data(), s.x.data() + s.x.size(), (*states)[k].x.begin()))
-        matches = false;
-    }
-  } compare;
+  row.pilot = pilot_meta != rec->metadata.end() ? pilot_meta->second : "";
+  row.mode = to_string(mode->kind());
+  row.scenario = mode->scenario_name();
+  Session session(*mode);
+  StateCompare compare;
   compare.states = &rec->states;
   session.add_sink(&compare);
   session.run();
-  row.score = acc.finish();
-  std::vector<double> recorded_us;
-  recorded_us.reserve(rec->solver.size());
-  for (const auto& m : rec->solver) recorded_us.push_back(m.total_us);
-  set_timing(row.score, std::move(recorded_us), scenario->controller.dt);
-  row.matches = compare.matches && rec->states.size() == std::size_t(session.steps_done());
+  row.metrics = mode->metrics();
+  if (const auto* mi = dynamic_cast<const MiMode*>(mode.get())) {
+    // The timing fields describe the recorded flight, not this replay.
+    row.score = mi->score();
+    std::vector<double> recorded_us;
+    recorded_us.reserve(rec->solver.size());
+    for (const auto& m : rec->solver) recorded_us.push_back(m.total_us);
+    set_timing(row.score, std::move(recorded_us), mode->dt());
+    row.metrics = to_metrics(row.score);
+  }
+  row.matches = compare.matches && rec->states.size() == std::size_t(mode->steps_done());
   row.ok = true;
   return row;
 }
@@ -418,9 +381,12 @@ int score_command(int argc, char** argv) {
       rows[i] = score_recording(files[i]);
       const std::size_t d = ++done;
       const std::lock_guard<std::mutex> lock(io);
-      if (rows[i].ok) {
+      if (rows[i].ok && rows[i].mode == "mixed_initiative") {
         std::fprintf(stderr, "[%zu/%zu] %s: skill %.1f\n", d, files.size(), files[i].c_str(),
                      rows[i].score.skill);
+      } else if (rows[i].ok) {
+        std::fprintf(stderr, "[%zu/%zu] %s: %s\n", d, files.size(), files[i].c_str(),
+                     rows[i].mode.c_str());
       } else {
         std::fprintf(stderr, "[%zu/%zu] %s\n", d, files.size(), rows[i].error.c_str());
       }
@@ -442,15 +408,20 @@ int score_command(int argc, char** argv) {
       continue;
     }
     const Score& s = r.score;
-    std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
-                r.pilot.c_str(), s.duration_s, s.mean_lambda, s.min_lambda, s.max_deviation_m,
-                s.collisions, static_cast<long long>(s.fallbacks), s.skill,
-                r.matches ? "exact" : "DIFFERS from recording");
+    const char* replay = r.matches ? "exact" : "DIFFERS from recording";
+    if (r.mode == "mixed_initiative") {
+      std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
+                  r.pilot.c_str(), s.duration_s, s.mean_lambda, s.min_lambda, s.max_deviation_m,
+                  s.collisions, static_cast<long long>(s.fallbacks), s.skill, replay);
+    } else {  // the other modes' metrics are in the JSON
+      std::printf("%-32s %-12.12s %8s %7s %7s %8s %5s %6s %7s %s\n", r.file.c_str(),
+                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay);
+    }
     if (json.size() > 2) json += ",\n";
-    json += to_json(s, {{"file", r.file},
-                        {"scenario", r.scenario},
-                        {"pilot", r.pilot},
-                        {"replay", r.matches ? "exact" : "differs"}});
+    Labels labels = {{"file", r.file}, {"mode", r.mode}, {"scenario", r.scenario}};
+    if (!r.pilot.empty()) labels.emplace_back("pilot", r.pilot);
+    labels.emplace_back("replay", r.matches ? "exact" : "differs");
+    json += to_json(labels, r.metrics);
   }
   json += "\n]\n";
   if (!json_path.empty()) {

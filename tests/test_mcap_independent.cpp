@@ -80,6 +80,11 @@ class Json {
     for (double v : values) num(v);
     return end(']');
   }
+  Json& strs(const std::vector<std::string>& values) {
+    begin('[');
+    for (const auto& v : values) str(v);
+    return end(']');
+  }
   Json& stamp(const RosTime& t) {
     key("stamp").begin('{').key("sec").num(t.sec).key("nanosec").num(t.nanosec);
     return end('}');
@@ -124,7 +129,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   SessionRecorder rec;
   std::string err;
   ASSERT_TRUE(rec.open(file.string(), kPeriodNs,
-                       {"[arena]\nradius = 0.175\n", "scenarios/x.toml", 7, "experienced"}, err))
+                       {"mixed_initiative", "[arena]\nradius = 0.175\n", "scenarios/x.toml", 7,
+                        "experienced"},
+                       err))
       << err;
   JoyMsg joy;
   PilotCommandMsg pilot;
@@ -132,6 +139,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   AppliedCommandMsg applied;
   SolverStatsMsg solver;
   PredictionMsg pred;
+  ModeChannelsMsg channels;
   double lambda = 0;
   for (uint64_t k = 0; k < kSteps; ++k) {
     const double s = static_cast<double>(k);
@@ -152,6 +160,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
     ASSERT_TRUE(rec.record_solver(solver));
     pred = {{}, k, std::vector<double>(33, 0.5 * s), std::vector<double>(30, -0.25)};
     ASSERT_TRUE(rec.record_prediction(pred));
+    channels = {{}, k, static_cast<uint32_t>(k % 32), {"lambda", "roll MPC"}, {"", "rad"},
+                {lambda, -0.125 * s}};
+    ASSERT_TRUE(rec.record_channels(channels));
   }
   ASSERT_TRUE(rec.close(err)) << err;
 
@@ -166,7 +177,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.begin('{');
   j.key("profile").str("ros2").key("library").str(version()).key("dataSectionCrc").str("ok");
   j.key("statistics").begin('{');
-  j.key("messageCount").num(7.0 * kSteps).key("schemaCount").num(7).key("channelCount").num(7);
+  j.key("messageCount").num(8.0 * kSteps).key("schemaCount").num(8).key("channelCount").num(8);
   j.key("metadataCount").num(1).key("messageStartTime").num(0);
   j.key("messageEndTime").num(static_cast<double>((kSteps - 1) * kPeriodNs));
   j.end('}');
@@ -181,7 +192,8 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   }
   j.end(']');
   j.key("metadata").begin('[').begin('{').key("name").str("mixpilot").key("keys").begin('[');
-  for (const char* k : {"control_period_ns", "pilot", "scenario", "scenario_path", "seed", "version"})
+  for (const char* k :
+       {"control_period_ns", "mode", "pilot", "scenario", "scenario_path", "seed", "version"})
     j.str(k);
   j.end(']').end('}').end(']');
   j.key("last").begin('{');
@@ -200,6 +212,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.end('}');
   j.key("/joy").begin('{').key("header").begin('{').stamp(t).key("frame_id").str(joy.frame_id);
   j.end('}').key("axes").nums(joy.axes).key("buttons").nums(joy.buttons).end('}');
+  j.key("/mode/channels").begin('{').stamp(t).key("step").num(channels.step);
+  j.key("events").num(channels.events).key("names").strs(channels.names);
+  j.key("units").strs(channels.units).key("values").nums(channels.values).end('}');
   j.key("/pilot/command").begin('{').stamp(t).key("step").num(pilot.step);
   j.key("roll").num(pilot.roll).key("pitch").num(pilot.pitch);
   j.key("rotor_speed").nums(pilot.rotor_speed).key("source").str(pilot.source).end('}');

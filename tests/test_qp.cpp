@@ -13,7 +13,7 @@
 #include "core/qp/qp_condensed_dense.hpp"
 #include "core/qp/qp_dense_active_set.hpp"
 #include "core/qp/qp_dense_ipm.hpp"
-#include "core/qp/qp_kernels.hpp"
+#include "core/qp/detail/qp_kernels.hpp"
 #include "core/qp/qp_riccati_ipm.hpp"
 #include "core/qp/qp_riccati_ipm_pairs.hpp"
 #include "qp_dense_reference.hpp"

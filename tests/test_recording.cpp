@@ -79,6 +79,10 @@ TEST(RecordingMessages, EveryTypeRoundTripsBitExactly) {
   expect_bit_exact_round_trip(pred);
   PredictionMsg empty{};
   expect_bit_exact_round_trip(empty);
+  ModeChannelsMsg channels{{11, 12}, 13, 0x11, {"lambda", "", "roll MPC ü"}, {"", "m", "rad"},
+                           {kDoubles[0], kDoubles[5], kDoubles[6]}};
+  expect_bit_exact_round_trip(channels);
+  expect_bit_exact_round_trip(ModeChannelsMsg{});
 
   // And == where NaN is absent.
   CdrWriter w;
@@ -115,7 +119,7 @@ TEST(RecordingMessages, DecodeRejectsTrailingBytes) {
 
 TEST(RecordingMessages, SchemasAreRos2msgWithDependencies) {
   const auto types = recorded_types();
-  ASSERT_EQ(types.size(), 7u);
+  ASSERT_EQ(types.size(), 8u);
   const std::string sep(80, '=');
   for (const auto& t : types) {
     const std::string text = t.schema_text;
@@ -134,8 +138,8 @@ TEST(RecordingMessages, SchemasAreRos2msgWithDependencies) {
 constexpr uint64_t kPeriodNs = 15'000'000;  // Δt = 15 ms (SPEC §5.4)
 
 SessionInfo test_info() {
-  return {"[scenario]\nname = \"helix\"\n# ü\n", "scenarios/mi_helix.toml", 1234567890123ull,
-          "novice"};
+  return {"mixed_initiative", "[scenario]\nname = \"helix\"\n# ü\n", "scenarios/mi_helix.toml",
+          1234567890123ull, "novice"};
 }
 
 // Records `steps` control steps of every topic. Values depend on the step so order shows.
@@ -156,6 +160,8 @@ void record_session(SessionRecorder& rec, uint64_t steps) {
     ASSERT_TRUE(rec.record_applied({{}, k, {0.07, 0.08, 0.09, s}, 0.1, 0.2, {1, 2, 3, 4}}));
     ASSERT_TRUE(rec.record_solver({{}, k, 0, static_cast<uint32_t>(k), 1, 2, 3, 6 + s, k % 2 == 1}));
     ASSERT_TRUE(rec.record_prediction({{}, k, std::vector<double>(33, s), std::vector<double>(33, -s)}));
+    ASSERT_TRUE(rec.record_channels({{}, k, uint32_t(k % 4), {"lambda", "deviation"}, {"", "m"},
+                                     {1.0 / (1.0 + s), 0.01 * s}}));
   }
 }
 
@@ -178,6 +184,7 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
   EXPECT_EQ(r->metadata.at("version"), version());
   EXPECT_EQ(r->metadata.at("seed"), "1234567890123");
   EXPECT_EQ(r->metadata.at("pilot"), "novice");
+  EXPECT_EQ(r->metadata.at("mode"), "mixed_initiative");
   for (const auto& t : recorded_types()) EXPECT_EQ(r->message_counts.at(t.topic), 20u) << t.topic;
   ASSERT_EQ(r->pilot.size(), 20u);
   for (uint64_t k = 0; k < 20; ++k) {
@@ -195,6 +202,9 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
     EXPECT_EQ(r->solver[k].fallback, k % 2 == 1);
     EXPECT_EQ(r->predictions[k].reference.size(), 33u);
     EXPECT_EQ(r->applied[k].u[3], static_cast<double>(k));
+    EXPECT_EQ(r->channels[k].events, k % 4);
+    EXPECT_EQ(r->channels[k].names[1], "deviation");
+    EXPECT_EQ(r->channels[k].values[1], 0.01 * static_cast<double>(k));
   }
   // Log times in the container are k·Δt too.
   std::string e2;
@@ -262,7 +272,7 @@ std::vector<uint8_t> small_recording() {
   const fs::path p = temp_path("small.mcap");
   SessionRecorder rec;
   std::string err;
-  EXPECT_TRUE(rec.open(p.string(), kPeriodNs, {"x = 1\n", "s.toml", 1, "gamepad"}, err));
+  EXPECT_TRUE(rec.open(p.string(), kPeriodNs, {"mixed_initiative", "x = 1\n", "s.toml", 1, "gamepad"}, err));
   record_session(rec, 2);
   EXPECT_TRUE(rec.close(err)) << err;
   return slurp(p);

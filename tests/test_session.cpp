@@ -9,10 +9,11 @@
 #include <memory>
 
 #include "core/control/pilot_emulated.hpp"
-#include "core/scenario/scenario_toml.hpp"
+#include "core/modes/mi_mode.hpp"
 #include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot {
 namespace {
@@ -30,7 +31,7 @@ const Scenario& mi_helix() {
 // Extremes of the plant's rotor speeds and torques over a session.
 struct BoundsSink final : TelemetrySink {
   double omega_min = 1e9, omega_max = -1e9, tau_min = 1e9, tau_max = -1e9;
-  void on_sample(const TelemetrySample& s) override {
+  void on_sample(const Telemetry& s) override {
     omega_min = std::min(omega_min, s.x.tail<4>().minCoeff());
     omega_max = std::max(omega_max, s.x.tail<4>().maxCoeff());
     tau_min = std::min(tau_min, s.u.minCoeff());
@@ -56,17 +57,15 @@ struct Flight {
 };
 
 Flight fly(const Scenario& sc, const std::string& pilot_name) {
-  auto pilot = make_pilot(sc, pilot_name);
-  Session session;
-  std::string error;
-  EXPECT_TRUE(session.setup(sc, *pilot, error)) << error;
-  ScoreAccumulator acc(sc);
+  MiMode mode;
+  const SetupResult r = mode.setup(sc, make_pilot(sc, pilot_name));
+  EXPECT_TRUE(r) << r.reason();
+  Session session(mode);
   Flight f;
-  session.add_sink(&acc);
   session.add_sink(&f.bounds);
   session.run();
-  f.score = acc.finish();
-  f.lost = session.lost();
+  f.score = mode.score();
+  f.lost = mode.lost();
   return f;
 }
 
@@ -150,7 +149,7 @@ TEST(MixedInitiative, SafetyConstraintsStopARecklessPilotNearAnObstacle) {
 struct TraceSink final : TelemetrySink {
   std::vector<Eigen::VectorXd> x, u;
   std::vector<double> lambda;
-  void on_sample(const TelemetrySample& s) override {
+  void on_sample(const Telemetry& s) override {
     x.push_back(s.x);
     u.push_back(s.u);
     lambda.push_back(s.lambda);
@@ -170,19 +169,22 @@ TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
       (std::filesystem::temp_directory_path() / "mixpilot_test_replay.mcap").string();
 
   TraceSink original;
-  ScoreAccumulator original_score(sc);
+  Score original_score;
   {
-    auto pilot = make_pilot(sc, "novice");
-    Session session;
+    MiMode mode;
+    const SetupResult r = mode.setup(sc, make_pilot(sc, "novice"));
+    ASSERT_TRUE(r) << r.reason();
+    Session session(mode);
     std::string error;
-    ASSERT_TRUE(session.setup(sc, *pilot, error)) << error;
     RecordingSink recorder;
-    ASSERT_TRUE(recorder.open(path, sc, pilot->name(), error)) << error;
+    SessionInfo info{"mixed_initiative", sc.source_text, sc.source_path, sc.plant.seed, "novice"};
+    ASSERT_TRUE(recorder.open(path, mode, info, error)) << error;
     session.add_sink(&original);
-    session.add_sink(&original_score);
     session.add_sink(&recorder);
     session.run();
     ASSERT_TRUE(recorder.close(error)) << error;
+    EXPECT_EQ(recorder.dropped(), 0);
+    original_score = mode.score();
   }
 
   std::string error;
@@ -196,13 +198,13 @@ TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
   auto embedded = parse_scenario(rec->metadata.at("scenario"), "embedded", error);
   ASSERT_TRUE(embedded) << error;
   embedded->duration = sc.duration;
-  ReplayPilot replay(rec->pilot, "replay");
   TraceSink replayed;
-  ScoreAccumulator replayed_score(*embedded);
-  Session session;
-  ASSERT_TRUE(session.setup(*embedded, replay, error)) << error;
+  MiMode mode;
+  const SetupResult r =
+      mode.setup(*embedded, std::make_unique<ReplayPilot>(rec->pilot, "replay"));
+  ASSERT_TRUE(r) << r.reason();
+  Session session(mode);
   session.add_sink(&replayed);
-  session.add_sink(&replayed_score);
   session.run();
 
   ASSERT_EQ(replayed.x.size(), original.x.size());
@@ -213,8 +215,10 @@ TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
     ASSERT_EQ(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(rec->states[k].x.data(), 16)),
               original.x[k]);
   }
-  EXPECT_EQ(to_json(without_timing(replayed_score.finish())),
-            to_json(without_timing(original_score.finish())));
+  EXPECT_EQ(to_metrics(without_timing(mode.score())), to_metrics(without_timing(original_score)));
+  ASSERT_EQ(rec->channels.size(), original.x.size());
+  EXPECT_EQ(rec->channels[0].names.size(), std::size_t(mode.telemetry().num_channels));
+  EXPECT_EQ(rec->metadata.at("mode"), "mixed_initiative");
   std::filesystem::remove(path);
 }
 
@@ -225,23 +229,24 @@ TEST(Session, ReplayStopsAtTheEndOfTheRecording) {
     commands[k].step = k;
     commands[k].rotor_speed.fill(models::MikroKopter{}.hover_speed());
   }
-  ReplayPilot replay(commands, "replay");
-  Session session;
-  std::string error;
-  ASSERT_TRUE(session.setup(sc, replay, error)) << error;
+  MiMode mode;
+  const SetupResult r = mode.setup(sc, std::make_unique<ReplayPilot>(commands, "replay"));
+  ASSERT_TRUE(r) << r.reason();
+  Session session(mode);
   session.run();
-  EXPECT_EQ(session.steps_done(), 10);
-  EXPECT_TRUE(session.finished());
+  EXPECT_EQ(mode.steps_done(), 10);
+  EXPECT_TRUE(mode.finished());
 }
 
 TEST(Session, RejectsAPlantRateThatDoesNotDivideTheControlPeriod) {
   Scenario sc = mi_helix();
   sc.plant.rate_hz = 1234.0;
-  auto pilot = make_pilot(sc, "novice");
-  Session session;
-  std::string error;
-  EXPECT_FALSE(session.setup(sc, *pilot, error));
-  EXPECT_NE(error.find("rate_hz"), std::string::npos) << error;
+  MiMode mode;
+  const SetupResult r = mode.setup(sc, make_pilot(sc, "novice"));
+  EXPECT_FALSE(r);
+  EXPECT_NE(r.reason().find("rate_hz"), std::string::npos) << r.reason();
+  EXPECT_TRUE(mode.finished());
+  EXPECT_FALSE(mode.step());
 }
 
 }  // namespace

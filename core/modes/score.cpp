@@ -8,8 +8,10 @@
 
 namespace mixpilot {
 
-ScoreAccumulator::ScoreAccumulator(const Scenario& scenario)
-    : scenario_(scenario), dt_(scenario.controller.dt) {
+void ScoreAccumulator::setup(const Scenario& scenario) {
+  *this = ScoreAccumulator{};
+  scenario_ = &scenario;
+  dt_ = scenario.controller.dt;
   const auto steps = std::size_t(std::lround(scenario.duration / dt_)) + 1;
   position_.reserve(steps);
   reference_.reserve(steps);
@@ -17,10 +19,10 @@ ScoreAccumulator::ScoreAccumulator(const Scenario& scenario)
   rti_us_.reserve(steps);
 }
 
-void ScoreAccumulator::on_sample(const TelemetrySample& s) {
+bool ScoreAccumulator::add(const Telemetry& s) {
   const Eigen::Vector3d p = s.x.head<3>();
   position_.push_back(p);
-  reference_.push_back(s.reference);
+  reference_.push_back(s.reference.head<3>());
   lambda_.push_back(s.lambda);
   rti_us_.push_back(s.stats.total_us);
   if (s.stats.status == RtiStatus::fallback) ++fallbacks_;
@@ -35,27 +37,29 @@ void ScoreAccumulator::on_sample(const TelemetrySample& s) {
   prev_pitch_ = s.pilot.pitch;
 
   // Clearance of the vehicle sphere to obstacles, walls and floor.
-  const double rv = scenario_.controller.vehicle_radius;
+  const double rv = scenario_->controller.vehicle_radius;
   double clearance = 1e9;
-  for (const Obstacle& o : scenario_.arena.obstacles) {
+  for (const Obstacle& o : scenario_->arena.obstacles) {
     const double c = (p - o.center).norm() - o.radius - rv;
     min_clearance_ = std::min(min_clearance_, c);
     clearance = std::min(clearance, c);
   }
-  const Arena& a = scenario_.arena;
+  const Arena& a = scenario_->arena;
   for (int i = 0; i < 3; ++i) {
     clearance = std::min({clearance, p(i) - a.min(i) - rv, a.max(i) - p(i) - rv});
   }
   const bool contact = clearance < 0.0;
-  if (contact && !in_contact_) ++collisions_;
+  const bool started = contact && !in_contact_;
+  if (started) ++collisions_;
   in_contact_ = contact;
+  return started;
 }
 
 Score ScoreAccumulator::finish() const {
   Score sc;
   const std::size_t K = position_.size();
   if (K == 0) return sc;
-  const double r = scenario_.controller.ph.r;
+  const double r = scenario_->controller.ph.r;
   sc.duration_s = double(K) * dt_;
 
   double sum_sq = 0, max_dev = 0;
@@ -73,7 +77,7 @@ Score ScoreAccumulator::finish() const {
   // Waypoint k counts as flown if the vehicle came within r of it within ±1 s; the reference
   // is the whole scenario's, so a session cut short (end of a recording) makes less progress.
   const auto window = std::int64_t(std::lround(1.0 / dt_));
-  const auto total = std::int64_t(std::lround(scenario_.duration / dt_));
+  const auto total = std::int64_t(std::lround(scenario_->duration / dt_));
   std::int64_t reached = 0;
   for (std::int64_t k = 0; k < std::int64_t(K); ++k) {
     const std::int64_t lo = std::max<std::int64_t>(0, k - window);
@@ -95,7 +99,7 @@ Score ScoreAccumulator::finish() const {
   sc.mean_lambda = sum_l / double(K);
   sc.min_lambda = min_l;
   sc.collisions = collisions_;
-  sc.min_clearance_m = scenario_.arena.obstacles.empty() ? 0.0 : min_clearance_;
+  sc.min_clearance_m = scenario_->arena.obstacles.empty() ? 0.0 : min_clearance_;
   sc.override_rms = std::sqrt(sum_override_sq_ / double(K));
   sc.stick_smoothness = K > 1 ? std::sqrt(sum_stick_sq_ / double(K - 1)) : 0.0;
 
@@ -117,62 +121,25 @@ void set_timing(Score& sc, std::vector<double> t, double dt) {
   sc.rti_p99_us = percentile(t, 0.99);
 }
 
-namespace {
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
-std::string to_json(const Score& s, const std::vector<std::pair<std::string, std::string>>& labels,
-                    int indent) {
-  const std::string pad(std::size_t(std::max(indent, 0)), ' ');
-  std::string out = "{\n";
-  for (const auto& [key, value] : labels) {
-    out += pad + "\"" + json_escape(key) + "\": \"" + json_escape(value) + "\",\n";
-  }
-  char buf[128];
-  const auto num = [&](const char* key, double v, bool last = false) {
-    std::snprintf(buf, sizeof buf, "%s\"%s\": %.17g%s\n", pad.c_str(), key, v, last ? "" : ",");
-    out += buf;
+Metrics to_metrics(const Score& s) {
+  return {
+      {"duration_s", s.duration_s},
+      {"progress", s.progress},
+      {"time_in_ball", s.time_in_ball},
+      {"max_deviation_m", s.max_deviation_m},
+      {"rms_deviation_m", s.rms_deviation_m},
+      {"mean_lambda", s.mean_lambda},
+      {"min_lambda", s.min_lambda},
+      {"collisions", double(s.collisions)},
+      {"min_clearance_m", s.min_clearance_m},
+      {"override_rms", s.override_rms},
+      {"stick_smoothness", s.stick_smoothness},
+      {"rti_median_us", s.rti_median_us},
+      {"rti_p99_us", s.rti_p99_us},
+      {"deadline_misses", double(s.deadline_misses)},
+      {"fallbacks", double(s.fallbacks)},
+      {"skill", s.skill},
   };
-  const auto integer = [&](const char* key, long long v) {
-    std::snprintf(buf, sizeof buf, "%s\"%s\": %lld,\n", pad.c_str(), key, v);
-    out += buf;
-  };
-  num("duration_s", s.duration_s);
-  num("progress", s.progress);
-  num("time_in_ball", s.time_in_ball);
-  num("max_deviation_m", s.max_deviation_m);
-  num("rms_deviation_m", s.rms_deviation_m);
-  num("mean_lambda", s.mean_lambda);
-  num("min_lambda", s.min_lambda);
-  integer("collisions", s.collisions);
-  num("min_clearance_m", s.min_clearance_m);
-  num("override_rms", s.override_rms);
-  num("stick_smoothness", s.stick_smoothness);
-  num("rti_median_us", s.rti_median_us);
-  num("rti_p99_us", s.rti_p99_us);
-  integer("deadline_misses", s.deadline_misses);
-  integer("fallbacks", s.fallbacks);
-  num("skill", s.skill, true);
-  out += "}";
-  return out;
 }
 
 }  // namespace mixpilot

@@ -26,8 +26,8 @@
 
 #include <Eigen/Core>
 
+#include "core/modes/mode.hpp"
 #include "core/scenario/scenario.hpp"
-#include "core/modes/session.hpp"
 
 namespace mixpilot {
 
@@ -50,24 +50,27 @@ struct Score {
   double skill = 0;
 };
 
-// JSON object with the fields above (17 significant digits: exact round trip), preceded by
-// the given string-valued labels (e.g. scenario, pilot).
-std::string to_json(const Score& score,
-                    const std::vector<std::pair<std::string, std::string>>& labels = {},
-                    int indent = 2);
+// The fields above in this order, as metrics.
+Metrics to_metrics(const Score& score);
 
 // Timing fields from per-step controller times [µs] (median, p99, misses of dt).
 void set_timing(Score& score, std::vector<double> total_us, double dt);
 
-class ScoreAccumulator final : public TelemetrySink {
+// The score of a flight, one step at a time. add() allocates nothing for the steps setup()
+// sized it for.
+class ScoreAccumulator {
  public:
-  explicit ScoreAccumulator(const Scenario& scenario);
-  void on_sample(const TelemetrySample& sample) override;
+  ScoreAccumulator() = default;
+  explicit ScoreAccumulator(const Scenario& scenario) { setup(scenario); }
+  // Starts over for a flight of `scenario` (which must outlive the accumulator).
+  void setup(const Scenario& scenario);
+  // Adds one step; true when the vehicle sphere started touching something in it.
+  bool add(const Telemetry& step);
   Score finish() const;
 
  private:
-  const Scenario& scenario_;
-  double dt_;
+  const Scenario* scenario_ = nullptr;
+  double dt_ = 0.015;
   std::vector<Eigen::Vector3d> position_;
   std::vector<Eigen::Vector3d> reference_;
   std::vector<double> lambda_;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/qp/qp_kernels.hpp"
+#include "core/qp/detail/qp_kernels.hpp"
 
 // Notation (per stage i; see core/qp/ocp_qp.hpp for the problem).
 //   v = [u; x] (nv = nu + nx),  d(v) = [u[idxbu]; x[idxbx]; C x + D u] (nc constraints),

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <array>
 
-#include "core/qp/qp_kernels.hpp"
+#include "core/qp/detail/qp_kernels.hpp"
 
 namespace mixpilot {
 

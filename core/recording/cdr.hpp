@@ -50,6 +50,11 @@ class CdrWriter {
     append(s.data(), s.size());
     buf_.push_back(0);
   }
+  // string[]: count, then each string.
+  void write_strings(std::span<const std::string> v) {
+    write<uint32_t>(static_cast<uint32_t>(v.size()));
+    for (const std::string& s : v) write_string(s);
+  }
   // Unbounded or bounded sequence (T[] / T[<=N]): count, then elements.
   template <class T>
   void write_sequence(std::span<const T> v) {
@@ -127,6 +132,18 @@ class CdrReader {
     if (data_[pos_ + n - 1] != 0) return fail(pos_ + n - 1, "string is not NUL-terminated");
     s.assign(reinterpret_cast<const char*>(data_.data() + pos_), n - 1);
     pos_ += n;
+    return true;
+  }
+  bool read_strings(std::vector<std::string>& v) {
+    uint32_t n = 0;
+    if (!read(n)) return false;
+    // Each string takes at least its 4-byte length: a corrupt count cannot allocate much.
+    if (static_cast<uint64_t>(n) * 4 > remaining())
+      return fail(pos_ - 4, "sequence of " + std::to_string(n) + " strings exceeds the " +
+                                std::to_string(remaining()) + " remaining bytes");
+    v.resize(n);
+    for (std::string& s : v)
+      if (!read_string(s)) return false;
     return true;
   }
   template <class T>

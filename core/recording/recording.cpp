@@ -94,6 +94,15 @@ constexpr const char kPredictionSchema[] =
     "float64[] position\n"
     "float64[] reference\n"
     "\n" MIXPILOT_TIME_DEP;
+constexpr const char kModeChannelsSchema[] =
+    "# A mode's named scalars of one control step, and what happened in it.\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "uint32 events      # bits: 1 fallback, 2 collision, 4 violation, 8 controller switch, 16 lost\n"
+    "string[] names\n"
+    "string[] units\n"
+    "float64[] values\n"
+    "\n" MIXPILOT_TIME_DEP;
 #undef MIXPILOT_TIME_DEP
 #undef MIXPILOT_SEP
 
@@ -106,6 +115,7 @@ constexpr RecordedType kTypes[] = {
     {"/controller/applied", "mixpilot_msgs/msg/AppliedCommand", kAppliedCommandSchema},
     {"/controller/solver", "mixpilot_msgs/msg/SolverStats", kSolverStatsSchema},
     {"/controller/prediction", "mixpilot_msgs/msg/Prediction", kPredictionSchema},
+    {"/mode/channels", "mixpilot_msgs/msg/ModeChannels", kModeChannelsSchema},
 };
 
 // rosbag2's serialization of one QoS profile (reliable, volatile, default durations): the ros2
@@ -141,6 +151,7 @@ void encode_body(const VehicleStateMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const ModeChannelsMsg& m, const RosTime& stamp, CdrWriter& w);
 
 namespace {
 void put_time(const RosTime& t, CdrWriter& w) {
@@ -274,6 +285,22 @@ bool decode(std::span<const uint8_t> d, PredictionMsg& m, std::string& error) {
   return finish(r, error);
 }
 
+void encode(const ModeChannelsMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const ModeChannelsMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write(m.events);
+  w.write_strings(m.names);
+  w.write_strings(m.units);
+  w.write_sequence(std::span<const double>(m.values));
+}
+bool decode(std::span<const uint8_t> d, ModeChannelsMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.events) && r.read_strings(m.names) &&
+         r.read_strings(m.units) && r.read_sequence(m.values));
+  return finish(r, error);
+}
+
 void encode_float64(double v, CdrWriter& w) { w.write(v); }
 bool decode_float64(std::span<const uint8_t> d, double& v, std::string& error) {
   CdrReader r(d);
@@ -298,7 +325,8 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                                       {{"offered_qos_profiles", kQosProfiles}});
   }
   // Metadata first, so a crashed session's .tmp still says what it was.
-  writer_.write_metadata("mixpilot", {{"scenario", info.scenario},
+  writer_.write_metadata("mixpilot", {{"mode", info.mode},
+                                      {"scenario", info.scenario},
                                       {"scenario_path", info.scenario_path},
                                       {"version", version()},
                                       {"seed", std::to_string(info.seed)},
@@ -334,6 +362,9 @@ bool SessionRecorder::record_applied(const AppliedCommandMsg& m) {
 bool SessionRecorder::record_solver(const SolverStatsMsg& m) { return put(kSolver, m.step, m); }
 bool SessionRecorder::record_prediction(const PredictionMsg& m) {
   return put(kPrediction, m.step, m);
+}
+bool SessionRecorder::record_channels(const ModeChannelsMsg& m) {
+  return put(kChannels, m.step, m);
 }
 bool SessionRecorder::record_lambda(uint64_t step, double lambda) {
   cdr_.reset();
@@ -398,6 +429,7 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
       case 4: ok = decode(data, out.applied.emplace_back(), why); break;
       case 5: ok = decode(data, out.solver.emplace_back(), why); break;
       case 6: ok = decode(data, out.predictions.emplace_back(), why); break;
+      case 7: ok = decode(data, out.channels.emplace_back(), why); break;
       default: break;
     }
     if (!ok)

@@ -98,6 +98,18 @@ struct LambdaSample {
   bool operator==(const LambdaSample&) const = default;
 };
 
+// mixpilot_msgs/msg/ModeChannels on /mode/channels: a mode's named scalars of one step and its
+// events (core/modes/mode.hpp), for plots of any mode.
+struct ModeChannelsMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  uint32_t events = 0;  // ModeEvent bit flags
+  std::vector<std::string> names;
+  std::vector<std::string> units;
+  std::vector<double> values;
+  bool operator==(const ModeChannelsMsg&) const = default;
+};
+
 // ---- encoding ---------------------------------------------------------------------------
 
 // The ros2msg schema (top-level definition followed by its dependencies) and schema name of
@@ -118,6 +130,7 @@ void encode(const VehicleStateMsg& m, CdrWriter& out);
 void encode(const AppliedCommandMsg& m, CdrWriter& out);
 void encode(const SolverStatsMsg& m, CdrWriter& out);
 void encode(const PredictionMsg& m, CdrWriter& out);
+void encode(const ModeChannelsMsg& m, CdrWriter& out);
 void encode_float64(double v, CdrWriter& out);
 bool decode(std::span<const uint8_t> data, JoyMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PilotCommandMsg& m, std::string& error);
@@ -125,16 +138,18 @@ bool decode(std::span<const uint8_t> data, VehicleStateMsg& m, std::string& erro
 bool decode(std::span<const uint8_t> data, AppliedCommandMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, SolverStatsMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PredictionMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, ModeChannelsMsg& m, std::string& error);
 bool decode_float64(std::span<const uint8_t> data, double& v, std::string& error);
 
 // ---- recording --------------------------------------------------------------------------
 
 // What the "mixpilot" Metadata record holds besides version and control_period_ns.
 struct SessionInfo {
+  std::string mode;           // "mixed_initiative", "pendubot_swingup", ...
   std::string scenario;       // full scenario file text
   std::string scenario_path;
   uint64_t seed = 0;
-  std::string pilot;          // pilot source, as in PilotCommandMsg::source
+  std::string pilot;          // pilot source, as in PilotCommandMsg::source (mixed initiative)
 };
 
 // Writes one session. Each record_* call appends one message at log time step·Δt and fills
@@ -158,6 +173,7 @@ class SessionRecorder {
   bool record_applied(const AppliedCommandMsg& m);
   bool record_solver(const SolverStatsMsg& m);
   bool record_prediction(const PredictionMsg& m);
+  bool record_channels(const ModeChannelsMsg& m);
 
   bool flush() { return writer_.flush(); }
   // Completes the file and renames "<path>.tmp" to <path>.
@@ -167,7 +183,9 @@ class SessionRecorder {
   const McapWriter& writer() const { return writer_; }
 
  private:
-  enum Topic { kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kTopicCount };
+  enum Topic {
+    kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kTopicCount
+  };
   template <class Msg>
   bool put(Topic t, uint64_t step, const Msg& m);
   bool put_encoded(Topic t, uint64_t step);
@@ -191,6 +209,7 @@ struct RecordingContents {
   std::vector<AppliedCommandMsg> applied;
   std::vector<SolverStatsMsg> solver;
   std::vector<PredictionMsg> predictions;
+  std::vector<ModeChannelsMsg> channels;
   bool complete = true;  // false: read from a cut-short .tmp (allow_truncated)
 };
 

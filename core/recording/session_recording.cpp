@@ -1,43 +1,97 @@
 #include "core/recording/session_recording.hpp"
 
+#include <chrono>
 #include <cmath>
 
 namespace mixpilot {
 
-bool RecordingSink::open(const std::string& path, const Scenario& scenario,
-                         const std::string& pilot_name, std::string& error) {
-  SessionInfo info;
-  info.scenario = scenario.source_text;
-  info.scenario_path = scenario.source_path;
-  info.seed = scenario.plant.seed;
-  info.pilot = pilot_name;
-  pilot_name_ = pilot_name;
-  const auto period_ns = std::uint64_t(std::llround(scenario.controller.dt * 1e9));
-  return recorder_.open(path, period_ns, info, error);
+RecordingSink::~RecordingSink() {
+  if (open_) {
+    std::string ignored;
+    (void)close(ignored);
+  }
 }
 
-void RecordingSink::on_sample(const TelemetrySample& s) {
+bool RecordingSink::open(const std::string& path, const Mode& mode, const SessionInfo& info,
+                         std::string& error, const Settings& settings) {
+  if (open_) {
+    error = path + ": the recorder is already open";
+    return false;
+  }
+  settings_ = settings;
+  mode_ = mode.kind();
+  pilot_name_ = info.pilot;
+  const auto period_ns = std::uint64_t(std::llround(mode.dt() * 1e9));
+  if (!recorder_.open(path, period_ns, info, error)) return false;
+  // Slots sized like the mode's telemetry: copying a step into one then allocates nothing.
+  slots_.assign(std::size_t(std::max(settings.slots, 2)), mode.telemetry());
+  head_ = 0;
+  tail_ = 0;
+  closing_ = false;
+  dropped_ = 0;
+  open_ = true;
+  writer_ = std::thread([this] { writer_loop(); });
+  return true;
+}
+
+void RecordingSink::on_sample(const Telemetry& sample) {
+  const std::uint64_t head = head_.load(std::memory_order_relaxed);
+  const std::uint64_t n = slots_.size();
+  while (head - tail_.load(std::memory_order_acquire) >= n) {
+    if (settings_.when_full == FullRing::drop) {
+      dropped_.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(20));
+  }
+  slots_[head % n] = sample;
+  head_.store(head + 1, std::memory_order_release);
+  wake_.notify_one();
+}
+
+void RecordingSink::writer_loop() {
+  const std::uint64_t n = slots_.size();
+  for (;;) {
+    const std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+    if (head_.load(std::memory_order_acquire) == tail) {
+      if (closing_.load(std::memory_order_acquire) && head_.load(std::memory_order_acquire) == tail)
+        return;
+      // notify_one() from the stepping thread takes no lock, so a wake-up can slip between the
+      // check and the wait: the timeout bounds that case.
+      std::unique_lock<std::mutex> lock(wake_mutex_);
+      wake_.wait_for(lock, std::chrono::milliseconds(2));
+      continue;
+    }
+    write(slots_[tail % n]);
+    tail_.store(tail + 1, std::memory_order_release);
+  }
+}
+
+void RecordingSink::write(const Telemetry& s) {
   const auto step = std::uint64_t(s.step);
   const RosTime stamp = ros_time_from_ns(recorder_.log_time_ns(step));
-  if (s.joy) {
+  const bool mi = mode_ == ModeKind::mixed_initiative;
+  if (s.has_joy) {
     joy_.stamp = stamp;
-    joy_.axes.assign(s.joy->axes.begin(), s.joy->axes.begin() + s.joy->num_axes);
-    joy_.buttons.assign(s.joy->buttons.begin(), s.joy->buttons.begin() + s.joy->num_buttons);
+    joy_.axes.assign(s.joy.axes.begin(), s.joy.axes.begin() + s.joy.num_axes);
+    joy_.buttons.assign(s.joy.buttons.begin(), s.joy.buttons.begin() + s.joy.num_buttons);
     recorder_.record_joy(step, joy_);
   }
-  pilot_.stamp = stamp;
-  pilot_.step = step;
-  pilot_.roll = s.pilot.roll;
-  pilot_.pitch = s.pilot.pitch;
-  for (int i = 0; i < 4; ++i) pilot_.rotor_speed[std::size_t(i)] = s.pilot.rotor_speed(i);
-  pilot_.source = pilot_name_;
-  recorder_.record_pilot(pilot_);
+  if (mi) {
+    pilot_.stamp = stamp;
+    pilot_.step = step;
+    pilot_.roll = s.pilot.roll;
+    pilot_.pitch = s.pilot.pitch;
+    for (int i = 0; i < 4; ++i) pilot_.rotor_speed[std::size_t(i)] = s.pilot.rotor_speed(i);
+    pilot_.source = pilot_name_;
+    recorder_.record_pilot(pilot_);
+  }
 
   state_.stamp = stamp;
   state_.step = step;
   state_.x.assign(s.x.data(), s.x.data() + s.x.size());
   recorder_.record_state(state_);
-  recorder_.record_lambda(step, s.lambda);
+  if (mi) recorder_.record_lambda(step, s.lambda);
 
   applied_.stamp = stamp;
   applied_.step = step;
@@ -58,17 +112,41 @@ void RecordingSink::on_sample(const TelemetrySample& s) {
   solver_.fallback = s.stats.status == RtiStatus::fallback;
   recorder_.record_solver(solver_);
 
-  if (s.predicted && s.predicted_reference) {
+  if (s.predicted.cols() > 0) {
     prediction_.stamp = stamp;
     prediction_.step = step;
-    prediction_.position.assign(s.predicted->data(), s.predicted->data() + s.predicted->size());
-    prediction_.reference.assign(s.predicted_reference->data(),
-                                 s.predicted_reference->data() + s.predicted_reference->size());
+    prediction_.position.assign(s.predicted.data(), s.predicted.data() + s.predicted.size());
+    prediction_.reference.assign(s.predicted_reference.data(),
+                                 s.predicted_reference.data() + s.predicted_reference.size());
     recorder_.record_prediction(prediction_);
   }
+
+  channels_.stamp = stamp;
+  channels_.step = step;
+  channels_.events = s.events;
+  const auto nc = std::size_t(s.num_channels);
+  channels_.names.resize(nc);
+  channels_.units.resize(nc);
+  channels_.values.resize(nc);
+  for (std::size_t i = 0; i < nc; ++i) {
+    channels_.names[i] = s.channels[i].name;
+    channels_.units[i] = s.channels[i].unit;
+    channels_.values[i] = s.channels[i].value;
+  }
+  recorder_.record_channels(channels_);
 }
 
-bool RecordingSink::close(std::string& error) { return recorder_.close(error); }
+bool RecordingSink::close(std::string& error) {
+  if (!open_) {
+    error = "the recorder is not open";
+    return false;
+  }
+  closing_.store(true, std::memory_order_release);
+  wake_.notify_one();
+  writer_.join();
+  open_ = false;
+  return recorder_.close(error);
+}
 
 bool ReplayPilot::command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) {
   if (step < 0 || step >= std::int64_t(commands_.size())) return false;

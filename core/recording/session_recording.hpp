@@ -1,34 +1,84 @@
 #pragma once
-// Sessions to and from recordings (core/recording/recording.hpp): a telemetry sink that records every
-// control step, and a pilot source that replays a recording's pilot commands into a fresh
-// session. With the same scenario and build, a replay reproduces the original telemetry exactly.
+// Sessions to and from recordings (core/recording/recording.hpp): a telemetry sink that records
+// every control step of any mode, and a pilot source that replays a recording's pilot commands
+// into a fresh mixed-initiative session. With the same scenario and build, a replay reproduces
+// the original telemetry exactly.
+//
+// The sink never writes on the stepping thread: on_sample() copies the step's telemetry into a
+// ring of slots sized at open(), and a writer thread beside the session encodes and writes it.
+// A full ring either waits for the writer (lossless, for as-fast-as-possible runs: nothing is
+// lost) or drops the step and counts it (real time: the control step never waits on the disk).
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/control/pilot.hpp"
-#include "core/recording/recording.hpp"
 #include "core/modes/session.hpp"
+#include "core/recording/recording.hpp"
 
 namespace mixpilot {
 
 class RecordingSink final : public TelemetrySink {
  public:
-  // Opens `path` (written as "<path>.tmp" until close()) for a session of `scenario`.
-  bool open(const std::string& path, const Scenario& scenario, const std::string& pilot_name,
-            std::string& error);
-  void on_sample(const TelemetrySample& sample) override;
-  // Completes the file; false with a message if anything failed on the way.
+  enum class FullRing { wait, drop };
+
+  struct Settings {
+    FullRing when_full = FullRing::wait;
+    int slots = 256;  // steps the writer may lag behind
+  };
+
+  RecordingSink() = default;
+  ~RecordingSink() override;
+  RecordingSink(const RecordingSink&) = delete;
+  RecordingSink& operator=(const RecordingSink&) = delete;
+
+  // Opens `path` (written as "<path>.tmp" until close()) for a session of `mode`, whose
+  // current telemetry gives the slot sizes, and starts the writer thread.
+  bool open(const std::string& path, const Mode& mode, const SessionInfo& info,
+            std::string& error, const Settings& settings);
+  bool open(const std::string& path, const Mode& mode, const SessionInfo& info,
+            std::string& error) {
+    return open(path, mode, info, error, Settings{});
+  }
+  // Hands the step to the writer. Allocates nothing; waits only when the ring is full and
+  // the settings say so.
+  void on_sample(const Telemetry& sample) override;
+  // Writes what is queued, stops the writer and completes the file; false with a message if
+  // anything failed on the way.
   bool close(std::string& error);
 
+  std::int64_t dropped() const { return dropped_.load(); }  // steps lost to a full ring
+
  private:
+  void writer_loop();
+  void write(const Telemetry& s);
+
   SessionRecorder recorder_;
+  Settings settings_;
+  ModeKind mode_ = ModeKind::mixed_initiative;
   std::string pilot_name_;
+  std::vector<Telemetry> slots_;
+  std::atomic<std::uint64_t> head_{0};  // steps handed over (written by on_sample)
+  std::atomic<std::uint64_t> tail_{0};  // steps written (written by the writer)
+  std::atomic<bool> closing_{false};
+  std::atomic<std::int64_t> dropped_{0};
+  std::mutex wake_mutex_;
+  std::condition_variable wake_;
+  std::thread writer_;
+  bool open_ = false;
+
+  // Message buffers of the writer thread.
   PilotCommandMsg pilot_;
   VehicleStateMsg state_;
   AppliedCommandMsg applied_;
   SolverStatsMsg solver_;
   PredictionMsg prediction_;
   JoyMsg joy_;
+  ModeChannelsMsg channels_;
 };
 
 class ReplayPilot final : public PilotSource {

@@ -1,7 +1,8 @@
 #pragma once
-// Small dense kernels of the Riccati recursion (core/qp_riccati_ipm.cpp), on column-major
-// storage with leading dimensions. Sizes are those of one stage (≲ 30), where general BLAS-style
-// blocking does not pay; see qp_kernels.cpp for the register-blocked versions.
+// Internal to the qp layer (core/qp/detail/). Small dense kernels of the Riccati recursion
+// (core/qp/qp_riccati_ipm.cpp), on column-major storage with leading dimensions. Sizes are
+// those of one stage (≲ 30), where general BLAS-style blocking does not pay; see qp_kernels.cpp
+// for the register-blocked versions.
 namespace mixpilot::kernels {
 
 // Y (n x m) = A (n x m) · L (m x m, lower triangular).

@@ -1,4 +1,4 @@
-#include "core/qp/qp_kernels.hpp"
+#include "core/qp/detail/qp_kernels.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -1,0 +1,63 @@
+#include "core/modes/make_mode.hpp"
+
+#include <utility>
+
+#include "core/modes/mi_mode.hpp"
+#include "core/scenario/scenario_toml.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& source_name,
+                                   ModeRequest& request, std::string& error) {
+  std::optional<Scenario> scenario = parse_scenario(text, source_name, error);
+  if (!scenario) return nullptr;
+  if (request.duration) scenario->duration = *request.duration;
+  std::unique_ptr<PilotSource> pilot = std::move(request.pilot_source);
+  if (!pilot) {
+    const std::string& name =
+        request.pilot_name.empty() ? scenario->default_pilot : request.pilot_name;
+    pilot = make_scenario_pilot(*scenario, name, error);
+    if (!pilot) return nullptr;
+  }
+  auto mode = std::make_unique<MiMode>();
+  if (SetupResult r = mode->setup(std::move(*scenario), std::move(pilot)); !r) {
+    error = source_name + ": " + r.reason();
+    return nullptr;
+  }
+  return mode;
+}
+
+}  // namespace
+
+std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source_name,
+                                ModeRequest request, std::string& error) {
+  const std::optional<std::string> name = scenario_mode(text, source_name, error);
+  if (!name) return nullptr;
+  const std::optional<ModeKind> kind = mode_kind_from_string(*name);
+  if (!kind) {
+    error = source_name + ": mode \"" + *name + "\" is not one of " + mode_kind_names();
+    return nullptr;
+  }
+  if (*kind != ModeKind::mixed_initiative && (request.pilot_source || !request.pilot_name.empty())) {
+    error = source_name + ": a pilot flies only mixed_initiative scenarios, this one is " + *name;
+    return nullptr;
+  }
+  switch (*kind) {
+    case ModeKind::mixed_initiative: return make_mi_mode(text, source_name, request, error);
+    case ModeKind::pendubot_swingup:
+    case ModeKind::crazyflie_tracking:
+    case ModeKind::obstacle_avoidance: break;
+  }
+  error = source_name + ": mode \"" + *name + "\" cannot be stepped yet";
+  return nullptr;
+}
+
+std::unique_ptr<Mode> load_mode(const std::string& path, ModeRequest request, std::string& error) {
+  std::string text;
+  if (!read_text_file(path, text, error)) return nullptr;
+  return make_mode(text, path, std::move(request), error);
+}
+
+}  // namespace mixpilot

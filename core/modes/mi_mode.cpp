@@ -1,0 +1,209 @@
+#include "core/modes/mi_mode.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/control/pilot_emulated.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+// Channel slots of the mixed-initiative telemetry.
+enum MiChannel {
+  kLambda,
+  kDeviation,
+  kBallRadius,
+  kRollPilot,
+  kRollMpc,
+  kPitchPilot,
+  kPitchMpc,
+  kRotorSpeedMax,
+  kRotorSpeedBound,
+  kRtiTime,
+};
+
+}  // namespace
+
+SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot) {
+  scenario_ = std::move(scenario);
+  pilot_ = std::move(pilot);
+  finished_ = true;  // until setup succeeds
+  if (!pilot_) return SetupResult::failure("no pilot source");
+  if (scenario_.mode != "mixed_initiative" || scenario_.model != "mikrokopter")
+    return SetupResult::failure("only mode 'mixed_initiative' on model 'mikrokopter' is supported");
+  dt_ = scenario_.controller.dt;
+  const double substeps = scenario_.plant.rate_hz * dt_;
+  substeps_ = int(std::lround(substeps));
+  if (substeps_ < 1 || std::abs(substeps - substeps_) > 1e-9)
+    return SetupResult::failure("plant.rate_hz × controller.dt must be a whole number of substeps");
+  model_ = models::MikroKopter{};
+  plant_ = IntegratorErk4<models::MikroKopter>(model_);
+  if (SetupResult r = controller_.setup(model_, scenario_.controller, scenario_.arena,
+                                        scenario_.reference);
+      !r)
+    return SetupResult::failure("the controller settings do not form a valid OCP: " + r.reason());
+  x_ = model_.hover_state(scenario_.reference.position(0.0));
+  controller_.reset(x_);
+  const int delay_steps = int(std::lround(scenario_.plant.input_delay / dt_));
+  u_delay_.assign(std::size_t(delay_steps) + 1, model_.hover_input());
+  rng_.seed(scenario_.plant.seed);
+  noise_.reset();
+  scorer_.setup(scenario_);
+  step_ = 0;
+  steps_total_ = std::int64_t(std::lround(scenario_.duration / dt_));
+  finished_ = steps_total_ <= 0;
+  lost_ = false;
+  lost_at_ = -1.0;
+
+  Telemetry& s = telemetry_;
+  s = Telemetry{};
+  s.mode = ModeKind::mixed_initiative;
+  s.x = x_;
+  s.x_measured = x_;
+  s.u = model_.hover_input();
+  s.reference = Eigen::VectorXd::Zero(3);
+  set_reference(0.0);
+  s.predicted = controller_.predicted_positions();
+  s.predicted_reference = controller_.reference_positions();
+  s.lambda = controller_.lambda();
+  s.pilot.rotor_speed.setConstant(model_.hover_speed());
+  s.applied = s.pilot;
+  set_channels();
+  return {};
+}
+
+// RK4 at the plant rate with the input held (ZOH) over the control period.
+void MiMode::plant_step(const Eigen::VectorXd& u) {
+  models::MikroKopter::State x = x_, xn;
+  const models::MikroKopter::Input us = u;
+  const double h = dt_ / substeps_;
+  for (int s = 0; s < substeps_; ++s) {
+    plant_.step(x, us, h, xn);
+    x = xn;
+  }
+  x_ = x;
+}
+
+// η^r(t), element by element: GCC 12 takes Eigen's packet copy of a Vector3d into a VectorXd
+// for an out-of-bounds read (-Warray-bounds).
+void MiMode::set_reference(double t) {
+  const Eigen::Vector3d p = scenario_.reference.position(t);
+  for (int i = 0; i < 3; ++i) telemetry_.reference(i) = p(i);
+}
+
+// The controller's view of the state: the true state, positions with noise if configured.
+void MiMode::measure(double t) {
+  Telemetry& s = telemetry_;
+  s.step = step_;
+  s.t = t;
+  s.x = x_;
+  s.x_measured = x_;
+  if (scenario_.plant.position_noise > 0.0) {
+    for (int i = 0; i < 3; ++i) s.x_measured(i) += scenario_.plant.position_noise * noise_(rng_);
+  }
+}
+
+void MiMode::set_channels() {
+  Telemetry& s = telemetry_;
+  const double deviation = (s.x.head<3>() - s.reference.head<3>()).norm();
+  s.set_channel(kLambda, "lambda", "", s.lambda);
+  s.set_channel(kDeviation, "deviation", "m", deviation);
+  s.set_channel(kBallRadius, "ball radius r", "m", scenario_.controller.ph.r);
+  s.set_channel(kRollPilot, "roll pilot", "rad", s.pilot.roll);
+  s.set_channel(kRollMpc, "roll MPC", "rad", s.applied.roll);
+  s.set_channel(kPitchPilot, "pitch pilot", "rad", s.pilot.pitch);
+  s.set_channel(kPitchMpc, "pitch MPC", "rad", s.applied.pitch);
+  s.set_channel(kRotorSpeedMax, "rotor speed max", "kHz", s.x.tail<4>().maxCoeff());
+  s.set_channel(kRotorSpeedBound, "rotor speed bound", "kHz", model_.p.omega_max);
+  s.set_channel(kRtiTime, "RTI time", "us", s.stats.total_us);
+}
+
+bool MiMode::step() {
+  if (finished_) return false;
+  const double t = double(step_) * dt_;
+  Telemetry& s = telemetry_;
+  measure(t);
+  if (!pilot_->command(step_, t, x_, s.pilot)) {
+    finished_ = true;
+    return false;
+  }
+  const JoyInput* joy = pilot_->joy();
+  s.has_joy = joy != nullptr;
+  if (joy) s.joy = *joy;
+  controller_.step(t, s.x_measured, s.pilot);
+  s.solved = true;
+  s.lambda = controller_.lambda();
+  s.applied = controller_.applied_command();
+  set_reference(t);
+  s.stats = controller_.rti().stats();
+  s.predicted = controller_.predicted_positions();
+  s.predicted_reference = controller_.reference_positions();
+
+  // The command enters the delay line; the rotors get the one sent input_delay ago.
+  const std::size_t n = u_delay_.size();
+  u_delay_[std::size_t(step_) % n] = controller_.control();
+  s.u = u_delay_[std::size_t(step_ + 1) % n];
+  s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
+  if (scorer_.add(s)) s.events |= kEventCollision;
+  set_channels();
+
+  plant_step(s.u);
+  ++step_;
+  if (!x_.allFinite()) {  // never hand a non-finite state to anyone
+    x_ = s.x;
+    lost_ = finished_ = true;
+    lost_at_ = t;
+    s.events |= kEventLost;
+  }
+  if (step_ >= steps_total_) finished_ = true;
+  return true;
+}
+
+std::string MiMode::summary() const {
+  const Score s = score();
+  char buf[768];
+  std::snprintf(buf, sizeof buf,
+                "mixpilot fly: %s, pilot %s\n"
+                "  flew %.1f s; RTI median %.0f us, p99 %.0f us, %d deadline misses, %lld "
+                "fallbacks\n"
+                "  lambda mean %.3f (min %.3f); deviation max %.3f m, rms %.3f m; in ball %.1f%%; "
+                "progress %.1f%%\n"
+                "  collisions %d; min clearance %.3f m; override %.4f rad rms; skill %.1f / 100\n",
+                scenario_.name.c_str(), pilot_ ? pilot_->name().c_str() : "?", s.duration_s,
+                s.rti_median_us, s.rti_p99_us, s.deadline_misses,
+                static_cast<long long>(s.fallbacks), s.mean_lambda, s.min_lambda,
+                s.max_deviation_m, s.rms_deviation_m, 100.0 * s.time_in_ball, 100.0 * s.progress,
+                s.collisions, s.min_clearance_m, s.override_rms, s.skill);
+  std::string out = buf;
+  if (lost_) out += "  the vehicle was lost: the plant state stopped being finite\n";
+  return out;
+}
+
+std::unique_ptr<PilotSource> make_scenario_pilot(const Scenario& scenario, const std::string& name,
+                                                 std::string& error) {
+  const models::MikroKopter model;
+  if (name == "reckless") {
+    const auto it = scenario.pilots.find("reckless");
+    const double tilt = it != scenario.pilots.end() ? it->second.max_tilt : PilotProfile{}.max_tilt;
+    return std::make_unique<RecklessPilot>(model, scenario.arena, tilt);
+  }
+  const auto it = scenario.pilots.find(name);
+  if (it == scenario.pilots.end()) {
+    error = "unknown pilot '" + name + "': the scenario defines";
+    for (const auto& [profile, _] : scenario.pilots) error += " " + profile;
+    error += ", plus reckless and RECORDING.mcap";
+    return nullptr;
+  }
+  auto pilot = std::make_unique<EmulatedPilot>();
+  PilotProfile profile = it->second;
+  profile.name = name;
+  if (SetupResult r = pilot->setup(model, profile, scenario.reference, scenario.controller.dt);
+      !r) {
+    error = "pilot profile '" + name + "' does not form a valid OCP: " + r.reason();
+    return nullptr;
+  }
+  return pilot;
+}
+
+}  // namespace mixpilot

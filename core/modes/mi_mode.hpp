@@ -1,0 +1,85 @@
+#pragma once
+// The mixed-initiative mode (SPEC §5.4): the MikroKopter plant (RK4 at plant.rate_hz, input held
+// over the control period, optional input delay and position noise), the mixed-initiative
+// controller at Δt, and one pilot-input source (emulated pilot, recording, device). Its metrics
+// are the score (core/modes/score.hpp), kept up to date step by step.
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/control/mi_controller.hpp"
+#include "core/control/pilot.hpp"
+#include "core/modes/mode.hpp"
+#include "core/modes/score.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/numerics/setup_result.hpp"
+#include "core/scenario/scenario.hpp"
+
+namespace mixpilot {
+
+class MiMode final : public Mode {
+ public:
+  MiMode() = default;
+  MiMode(const MiMode&) = delete;  // the controller and the scorer point into this object
+  MiMode& operator=(const MiMode&) = delete;
+
+  // Prepares a flight of `scenario` by `pilot`. Fails with the reason when the scenario cannot
+  // be flown (wrong mode or model, substeps, an invalid OCP).
+  SetupResult setup(Scenario scenario, std::unique_ptr<PilotSource> pilot);
+
+  ModeKind kind() const override { return ModeKind::mixed_initiative; }
+  const std::string& scenario_name() const override { return scenario_.name; }
+  double dt() const override { return dt_; }
+  std::int64_t steps_total() const override { return steps_total_; }
+  std::int64_t steps_done() const override { return step_; }
+  // Ends early (returning false) when the pilot source has nothing more to give.
+  [[nodiscard]] bool step() override;
+  bool finished() const override { return finished_; }
+  bool lost() const override { return lost_; }
+  double lost_at() const override { return lost_at_; }
+  const Telemetry& telemetry() const override { return telemetry_; }
+  Metrics metrics() const override { return to_metrics(score()); }
+  std::string summary() const override;
+
+  Score score() const { return scorer_.finish(); }
+  const Scenario& scenario() const { return scenario_; }
+  const PilotSource& pilot() const { return *pilot_; }
+  const MiController& controller() const { return controller_; }
+  const Eigen::VectorXd& state() const { return x_; }
+
+ private:
+  void measure(double t);
+  void set_reference(double t);
+  void set_channels();
+  void plant_step(const Eigen::VectorXd& u);
+
+  Scenario scenario_;
+  std::unique_ptr<PilotSource> pilot_;
+  models::MikroKopter model_{};
+  IntegratorErk4<models::MikroKopter> plant_{};
+  MiController controller_;
+  ScoreAccumulator scorer_;  // sized in setup() for the whole flight
+  Telemetry telemetry_;
+  Eigen::VectorXd x_;                      // nx: true state
+  std::vector<Eigen::VectorXd> u_delay_;   // ring of commands in flight, each nu
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> noise_{0.0, 1.0};
+  double dt_ = 0.015;
+  int substeps_ = 15;
+  std::int64_t step_ = 0;
+  std::int64_t steps_total_ = 0;
+  bool finished_ = false;
+  bool lost_ = false;
+  double lost_at_ = -1.0;
+};
+
+// The scenario's emulated pilot of that name: a profile of the scenario's [pilots], or
+// "reckless". Fails with the known names.
+std::unique_ptr<PilotSource> make_scenario_pilot(const Scenario& scenario, const std::string& name,
+                                                 std::string& error);
+
+}  // namespace mixpilot

@@ -1,0 +1,17 @@
+#pragma once
+// Reports: a mode's metrics as a JSON object (`mixpilot fly --report`, `mixpilot score --json`).
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/modes/mode.hpp"
+
+namespace mixpilot {
+
+using Labels = std::vector<std::pair<std::string, std::string>>;
+
+// {"label": "value", ..., "metric": number, ...}: string labels first, then the metrics with 17
+// significant digits (an exact round trip), whole numbers without a fraction.
+std::string to_json(const Labels& labels, const Metrics& metrics, int indent = 2);
+
+}  // namespace mixpilot
