@@ -15,8 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "core/recording/recording.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/session.hpp"
 #include "core/numerics/version.hpp"
+#include "core/recording/recording.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 #ifndef MIXPILOT_NODE
 #define MIXPILOT_NODE ""
@@ -224,6 +228,53 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.end('}');
 
   EXPECT_EQ(actual, j.text());
+}
+
+// A recording of another mode, made the way `mixpilot fly --record` makes it: the Pendubot
+// swing-up (4 states, 1 input, no pilot, no prediction) is read by the independent reader too.
+TEST(McapIndependentReader, ReadsAPendubotRecording) {
+  const std::string node = MIXPILOT_NODE;
+  if (node.empty()) GTEST_SKIP() << "node not found at configure time";
+  const fs::path check_dir = fs::path(MIXPILOT_SOURCE_DIR) / "tests" / "mcap_check";
+  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
+  fs::create_directories(dir);
+  const fs::path file = dir / "pendubot.mcap";
+  const std::string scenario = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/pendubot_swingup.toml";
+
+  std::string err, text;
+  ASSERT_TRUE(read_text_file(scenario, text, err)) << err;
+  ModeRequest request;
+  request.duration = 0.5;  // 250 steps of 2 ms
+  auto mode = make_mode(text, scenario, std::move(request), err);
+  ASSERT_TRUE(mode) << err;
+  RecordingSink recorder;
+  ASSERT_TRUE(recorder.open(file.string(), *mode, {"pendubot_swingup", text, scenario, 0, ""}, err))
+      << err;
+  Session session(*mode);
+  session.add_sink(&recorder);
+  session.run();
+  ASSERT_TRUE(recorder.close(err)) << err;
+  ASSERT_EQ(mode->steps_done(), 250);
+
+  const std::string out =
+      run("'" + node + "' '" + (check_dir / "check.mjs").string() + "' '" + file.string() + "' 2>&1");
+  const auto has = [&](const std::string& s) {
+    EXPECT_NE(out.find(s), std::string::npos) << "missing " << s << " in\n" << out.substr(0, 2000);
+  };
+  has(R"("profile":"ros2")");
+  has(R"("dataSectionCrc":"ok")");
+  for (const char* topic : {"/vehicle/state", "/controller/applied", "/controller/solver"}) {
+    has(std::string(R"({"topic":")") + topic + R"(","schemaName":")");
+  }
+  has(R"("schemaName":"mixpilot_msgs/msg/ModeChannels","schemaEncoding":"ros2msg","messageEncoding":"cdr","messages":250,"statistics":250})");
+  has(R"("schemaName":"mixpilot_msgs/msg/VehicleState","schemaEncoding":"ros2msg","messageEncoding":"cdr","messages":250,"statistics":250})");
+  has(R"("schemaName":"mixpilot_msgs/msg/PilotCommand","schemaEncoding":"ros2msg","messageEncoding":"cdr","messages":0,"statistics":0})");
+  const Telemetry& last = mode->telemetry();
+  ASSERT_GT(last.num_channels, 0);
+  has(std::string(R"("names":[")") + last.channels[0].name + "\"");
+  Json x;
+  x.nums(std::vector<double>(last.x.data(), last.x.data() + last.x.size()));
+  has(R"("step":249,"x":)" + x.text());  // the last state, decoded from CDR by the reader
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ SetupResult EmulatedPilot::setup(const models::MikroKopter& model, const PilotPr
 bool EmulatedPilot::command(std::int64_t step, double t, const Eigen::VectorXd& x,
                             PilotCommand& out) {
   if (!started_) {
-    const Eigen::VectorXd hover = model_.hover_state(x.head<3>());
+    const models::MikroKopter::State hover = model_.hover_state(x.head<3>());
     for (auto& xi : rti_.trajectory().x) xi = hover;
     for (auto& ui : rti_.trajectory().u) ui = model_.hover_input();
     started_ = true;

@@ -118,13 +118,34 @@ void QpDenseActiveSet::initialize(const OcpQpStage& st, const OcpQpSolution& sol
   (void)st;
 }
 
+namespace {
+
+// x = L⁻¹ x for the nf x nf lower factor L (leading dimension ld).
+void forward_solve(const double* L, int ld, int nf, double* x) {
+  for (int p = 0; p < nf; ++p) {
+    const double* lp = L + std::ptrdiff_t(p) * ld;
+    const double xp = x[p] / lp[p];
+    x[p] = xp;
+    for (int r = p + 1; r < nf; ++r) x[r] -= lp[r] * xp;
+  }
+}
+
+}  // namespace
+
 // The equality-constrained QP of the current states: u, d(u) and every side's multiplier.
 QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
+  assemble(st);
+  if (const QpStatus s = factor_free(); s != QpStatus::success) return s;
+  if (const QpStatus s = project_holds(); s != QpStatus::success) return s;
+  return recover();
+}
+
+// H̃ = R + Σ_pen Z aaᵀ and g̃ = r + Σ_pen a(z − Z b) of the current penalty sides.
+void QpDenseActiveSet::assemble(const OcpQpStage& st) {
   Workspace& w = ws_;
   const int n = w.n, nb = w.nb, nc = w.nc;
   double* H = w.H.data();
   double* g = w.g.data();
-  double* u = w.u.data();
   const int* state = w.state.data();
   const double* R = st.R.data();
   for (int i = 0; i < n * n; ++i) H[i] = R[i];
@@ -151,7 +172,17 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
       }
     }
   }
-  // Boxes in hold fix their variable.
+}
+
+// Boxes in hold fix their variable; the free ones F get y = −(g_F + H_FX u_X), the Cholesky
+// factor L of H̃_FF, and y ← L⁻¹ y.
+QpStatus QpDenseActiveSet::factor_free() {
+  Workspace& w = ws_;
+  const int n = w.n, nb = w.nb, nc = w.nc;
+  const double* H = w.H.data();
+  const double* g = w.g.data();
+  double* u = w.u.data();
+  const int* state = w.state.data();
   int* fixed = w.fixed.data();
   for (int c = 0; c < n; ++c) fixed[c] = -1;
   for (int s = 0; s < 2 * nc; ++s) {
@@ -174,7 +205,7 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     else
       X[nx++] = c;
   }
-  // y = −(g_F + H_FX u_X); L = chol(H_FF) in place, column by column.
+  // L = chol(H_FF) in place, column by column.
   double* y = w.y.data();
   double* L = w.L.data();
   for (int p = 0; p < nf; ++p) {
@@ -199,16 +230,22 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
     lp[p] = d;
     for (int r = p + 1; r < nf; ++r) lp[r] *= inv;
   }
-  auto forward = [&](double* x) {  // x = L⁻¹ x
-    for (int p = 0; p < nf; ++p) {
-      const double* lp = L + std::ptrdiff_t(p) * n;
-      const double xp = x[p] / lp[p];
-      x[p] = xp;
-      for (int r = p + 1; r < nf; ++r) x[r] -= lp[r] * xp;
-    }
-  };
-  forward(y);
-  // General rows in hold: Y = L⁻¹ A_hFᵀ, S = YᵀY, ν = S⁻¹(Yᵀy − b'), y −= Y ν.
+  forward_solve(L, n, nf, y);
+  w.nf = nf;
+  w.nfix = nx;
+  return QpStatus::success;
+}
+
+// General rows in hold: Y = L⁻¹ A_hFᵀ, S = YᵀY, ν = S⁻¹(Yᵀy − b'), y −= Y ν.
+QpStatus QpDenseActiveSet::project_holds() {
+  Workspace& w = ws_;
+  const int n = w.n, nb = w.nb, nc = w.nc, nf = w.nf, nx = w.nfix;
+  const int* state = w.state.data();
+  const int* F = w.freev.data();
+  const int* X = w.fixv.data();
+  const double* u = w.u.data();
+  const double* L = w.L.data();
+  double* y = w.y.data();
   int* hold = w.hold.data();
   int nh = 0;
   for (int s = 0; s < 2 * nc; ++s) {
@@ -228,7 +265,7 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
       double b = w.bnd[s];
       for (int q = 0; q < nx; ++q) b -= a[X[q] * ng] * u[X[q]];
       for (int p = 0; p < nf; ++p) yh[p] = a[F[p] * ng];
-      forward(yh);
+      forward_solve(L, n, nf, yh);
       double r = -b;
       for (int p = 0; p < nf; ++p) r += yh[p] * y[p];
       nu[h] = r;
@@ -277,6 +314,25 @@ QpStatus QpDenseActiveSet::solve_states(const OcpQpStage& st) {
       for (int p = 0; p < nf; ++p) y[p] -= yh[p] * nu[h];
     }
   }
+  w.nh = nh;
+  return QpStatus::success;
+}
+
+// u_F = L⁻ᵀ y, then d(u) and the multipliers of every side.
+QpStatus QpDenseActiveSet::recover() {
+  Workspace& w = ws_;
+  const int n = w.n, nb = w.nb, nc = w.nc, nf = w.nf, nx = w.nfix, nh = w.nh;
+  const double* H = w.H.data();
+  const double* g = w.g.data();
+  const double* L = w.L.data();
+  const int* state = w.state.data();
+  const int* fixed = w.fixed.data();
+  const int* F = w.freev.data();
+  const int* X = w.fixv.data();
+  const int* hold = w.hold.data();
+  const double* nu = w.nu.data();
+  double* u = w.u.data();
+  double* y = w.y.data();
   // u_F = L⁻ᵀ y.
   for (int p = nf - 1; p >= 0; --p) {
     const double* lp = L + std::ptrdiff_t(p) * n;

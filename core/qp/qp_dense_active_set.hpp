@@ -61,6 +61,7 @@ struct QpDenseActiveSetWorkspace {
   Eigen::VectorXi freev;    // n: free variables
   Eigen::VectorXi fixv;     // n: fixed variables
   Eigen::VectorXi hold;     // nc: sides of general rows in hold
+  int nf = 0, nfix = 0, nh = 0;  // free variables, fixed variables, general rows in hold
   Eigen::MatrixXd Y;        // n x ng: L⁻¹ a_h (nf x nh used)
   Eigen::MatrixXd S;        // ng x ng: YᵀY, then its Cholesky factor
   Eigen::VectorXd u, y, nu, grad;  // n, n, ng, n
@@ -91,6 +92,10 @@ class QpDenseActiveSet final : public QpSolver {
   bool load(const OcpQpStage& st);
   void initialize(const OcpQpStage& st, const OcpQpSolution& sol, QpWarmStart warm);
   QpStatus solve_states(const OcpQpStage& st);  // u, λ of the current states
+  void assemble(const OcpQpStage& st);           // H̃, g̃ of the penalty sides
+  QpStatus factor_free();                        // fixed boxes, chol(H̃_FF), y = L⁻¹(...)
+  QpStatus project_holds();                      // general rows in hold (Schur complement)
+  QpStatus recover();                            // u, d(u), multipliers
   bool update_states();                          // true when some state moved
   void write_solution(const OcpQpStage& st, OcpQpSolution& sol);
 

@@ -1,0 +1,233 @@
+// Every mode behind the one Mode interface (core/modes/mode.hpp), made from its shipped
+// scenario through make_mode(): two runs are identical bit for bit, step() allocates nothing
+// (this executable links the engine built with EIGEN_RUNTIME_NO_MALLOC and counts every
+// malloc), the metrics show the thesis behaviour, and a recording of the run reads back with
+// one state and one channel message per step.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/modes/make_mode.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
+#include "no_malloc.hpp"
+
+namespace mixpilot {
+namespace {
+
+using MetricMap = std::map<std::string, double>;
+
+struct ModeCase {
+  const char* name;      // test name
+  const char* scenario;  // under scenarios/
+  const char* pilot;     // mixed initiative only
+  ModeKind kind;
+  std::function<void(const MetricMap&)> thesis;  // the behaviour the mode's own tests check
+};
+
+std::string print_case(const testing::TestParamInfo<ModeCase>& info) { return info.param.name; }
+
+std::unique_ptr<Mode> make(const ModeCase& c) {
+  ModeRequest request;
+  if (c.pilot) request.pilot_name = c.pilot;
+  std::string error;
+  auto mode = load_mode(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + c.scenario,
+                        std::move(request), error);
+  EXPECT_TRUE(mode) << error;
+  return mode;
+}
+
+MetricMap metric_map(const Metrics& metrics) {
+  MetricMap m;
+  for (const auto& [name, value] : metrics) m[name] = value;
+  return m;
+}
+
+// Every metric but the timings (which measure the machine, not the flight).
+Metrics without_timing(Metrics metrics) {
+  std::erase_if(metrics, [](const auto& m) {
+    return m.first.ends_with("_us") || m.first == "deadline_misses";
+  });
+  return metrics;
+}
+
+class EveryMode : public testing::TestWithParam<ModeCase> {};
+
+TEST_P(EveryMode, RunsDeterministicallyWithoutAllocatingAndShowsTheThesisBehaviour) {
+  const ModeCase& c = GetParam();
+  auto a = make(c);
+  auto b = make(c);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->kind(), c.kind);
+  ASSERT_GT(a->steps_total(), 0);
+  ASSERT_FALSE(a->finished());
+  const int nx = int(a->telemetry().x.size());
+  ASSERT_GT(nx, 0);
+
+  std::vector<Eigen::VectorXd> xa, ua;
+  xa.reserve(std::size_t(a->steps_total()));
+  ua.reserve(std::size_t(a->steps_total()));
+  long allocations = 0;
+  std::int64_t steps = 0;
+  for (;;) {
+    bool stepped = false;
+    {
+      NoMalloc guard;
+      stepped = a->step();
+      allocations += NoMalloc::count();
+    }
+    if (!stepped) break;
+    ++steps;
+    const Telemetry& t = a->telemetry();
+    ASSERT_EQ(t.step, steps - 1);
+    ASSERT_EQ(t.mode, c.kind);
+    ASSERT_EQ(t.x.size(), nx);
+    ASSERT_LE(t.num_channels, Telemetry::kMaxChannels);
+    xa.push_back(t.x);
+    ua.push_back(t.u);
+  }
+  EXPECT_EQ(allocations, 0) << "allocations inside step()";
+  EXPECT_TRUE(a->finished());
+  EXPECT_FALSE(a->lost());
+  EXPECT_EQ(a->steps_done(), steps);
+  EXPECT_EQ(steps, a->steps_total());
+
+  std::size_t k = 0;
+  while (b->step()) {
+    ASSERT_LT(k, xa.size());
+    ASSERT_EQ(b->telemetry().x, xa[k]) << "step " << k;  // bit for bit
+    ASSERT_EQ(b->telemetry().u, ua[k]) << "step " << k;
+    ++k;
+  }
+  EXPECT_EQ(k, xa.size());
+  EXPECT_EQ(without_timing(b->metrics()), without_timing(a->metrics()));
+  c.thesis(metric_map(a->metrics()));
+  EXPECT_FALSE(a->summary().empty());
+}
+
+TEST_P(EveryMode, RecordsEveryStepAndReadsItBack) {
+  const ModeCase& c = GetParam();
+  auto mode = make(c);
+  ASSERT_TRUE(mode);
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            (std::string("mixpilot_test_modes_") + c.name + ".mcap"))
+                               .string();
+  std::string error, text;
+  ASSERT_TRUE(read_text_file(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + c.scenario, text,
+                             error));
+  RecordingSink recorder;
+  RecordingSink::Settings settings;
+  settings.slots = 4;  // a small ring: the stepping thread must wait for the writer, not lose
+  SessionInfo info{to_string(mode->kind()), text, c.scenario, 1, c.pilot ? c.pilot : ""};
+  ASSERT_TRUE(recorder.open(path, *mode, info, error, settings)) << error;
+  Session session(*mode);
+  session.add_sink(&recorder);
+  std::vector<Eigen::VectorXd> states;
+  struct Trace final : TelemetrySink {
+    std::vector<Eigen::VectorXd>* x;
+    void on_sample(const Telemetry& s) override { x->push_back(s.x); }
+  } trace;
+  trace.x = &states;
+  session.add_sink(&trace);
+  session.run();
+  ASSERT_TRUE(recorder.close(error)) << error;
+  EXPECT_EQ(recorder.dropped(), 0);
+
+  const auto rec = read_recording(path, error);
+  ASSERT_TRUE(rec) << error;
+  EXPECT_EQ(rec->metadata.at("mode"), to_string(c.kind));
+  EXPECT_EQ(rec->metadata.at("scenario"), text);
+  ASSERT_EQ(rec->states.size(), states.size());
+  ASSERT_EQ(rec->channels.size(), states.size());
+  ASSERT_EQ(rec->solver.size(), states.size());
+  EXPECT_EQ(rec->pilot.size(), c.kind == ModeKind::mixed_initiative ? states.size() : 0u);
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    ASSERT_EQ(rec->states[k].step, k);
+    ASSERT_EQ(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(rec->states[k].x.data(),
+                                                                   Eigen::Index(rec->states[k].x.size()))),
+              states[k])
+        << "step " << k;
+  }
+  const Telemetry& last = mode->telemetry();
+  ASSERT_EQ(rec->channels.back().names.size(), std::size_t(last.num_channels));
+  for (int i = 0; i < last.num_channels; ++i) {
+    EXPECT_EQ(rec->channels.back().names[std::size_t(i)], last.channels[std::size_t(i)].name);
+    EXPECT_EQ(rec->channels.back().values[std::size_t(i)], last.channels[std::size_t(i)].value);
+  }
+  std::filesystem::remove(path);
+}
+
+double at(const MetricMap& m, const std::string& name) {
+  const auto it = m.find(name);
+  EXPECT_NE(it, m.end()) << "no metric " << name;
+  return it == m.end() ? 0.0 : it->second;
+}
+
+// The thesis behaviour of each mode, as its own tests check it (test_session, test_pendubot,
+// test_tracking, test_obstacles), read from the metrics.
+const ModeCase kCases[] = {
+    {"mi_helix_novice", "mi_helix.toml", "novice", ModeKind::mixed_initiative,
+     [](const MetricMap& m) {  // Fig. 7.6: inside B (to 2 cm), nothing hit, authority shared
+       EXPECT_EQ(at(m, "collisions"), 0);
+       EXPECT_LE(at(m, "max_deviation_m"), 0.175 + 0.02);
+       EXPECT_EQ(at(m, "progress"), 1.0);
+       EXPECT_LT(at(m, "mean_lambda"), 0.65);
+       EXPECT_EQ(at(m, "fallbacks"), 0);
+     }},
+    {"mi_helix_experienced", "mi_helix.toml", "experienced", ModeKind::mixed_initiative,
+     [](const MetricMap& m) {  // Fig. 7.5: the experienced pilot keeps the authority
+       EXPECT_EQ(at(m, "collisions"), 0);
+       EXPECT_GE(at(m, "mean_lambda"), 0.8);
+       EXPECT_EQ(at(m, "progress"), 1.0);
+     }},
+    {"pendubot_swingup", "pendubot_swingup.toml", nullptr, ModeKind::pendubot_swingup,
+     [](const MetricMap& m) {  // ch. 4: up-up within 2.5 s and held; |u| ≤ 0.4 N·m
+       EXPECT_GT(at(m, "swingup_time_s"), 0.0);
+       EXPECT_LT(at(m, "swingup_time_s"), 2.5);
+       EXPECT_GT(at(m, "hold_time_s"), 5.0);
+       EXPECT_LE(at(m, "max_abs_u"), 0.4 + 1e-9);
+       EXPECT_EQ(at(m, "velocity_violations"), 0);
+       EXPECT_GE(at(m, "lqr_entries"), 1);
+     }},
+    {"pendubot_swingup_encoders", "pendubot_swingup_encoders.toml", nullptr,
+     ModeKind::pendubot_swingup,
+     [](const MetricMap& m) {  // quantized encoders: still up-up and held
+       EXPECT_GT(at(m, "swingup_time_s"), 0.0);
+       EXPECT_GT(at(m, "hold_time_s"), 4.0);
+       EXPECT_LE(at(m, "max_abs_u"), 0.4 + 1e-9);
+     }},
+    {"tracking_smooth_step", "tracking_smooth_step.toml", nullptr, ModeKind::crazyflie_tracking,
+     [](const MetricMap& m) {  // ch. 5, RTT 60 ms with the predictor: tracks within 1 cm RMS
+       EXPECT_LT(at(m, "tracking_rms_m"), 0.01);
+       EXPECT_LT(at(m, "final_error_m"), 0.01);
+       EXPECT_EQ(at(m, "lost"), 0);
+       EXPECT_EQ(at(m, "fallbacks"), 0);
+     }},
+    {"tracking_helix", "tracking_helix.toml", nullptr, ModeKind::crazyflie_tracking,
+     [](const MetricMap& m) {
+       EXPECT_LT(at(m, "tracking_rms_m"), 0.01);
+       EXPECT_EQ(at(m, "lost"), 0);
+     }},
+    {"obstacles_thrown_balls", "obstacles_thrown_balls.toml", nullptr,
+     ModeKind::obstacle_avoidance,
+     [](const MetricMap& m) {  // ch. 6, LCL: the clearance d_C = 0.2 m holds to 1 mm
+       EXPECT_GE(at(m, "min_distance_m"), 0.2 - 1e-3);
+       EXPECT_EQ(at(m, "violations"), 0);
+       EXPECT_EQ(at(m, "fallbacks"), 0);
+     }},
+    {"obstacles_cluttered", "obstacles_cluttered.toml", nullptr, ModeKind::obstacle_avoidance,
+     [](const MetricMap& m) {
+       EXPECT_GE(at(m, "min_distance_m"), 0.2 - 1e-3);
+       EXPECT_EQ(at(m, "violations"), 0);
+     }},
+};
+
+INSTANTIATE_TEST_SUITE_P(Shipped, EveryMode, testing::ValuesIn(kCases), print_case);
+
+}  // namespace
+}  // namespace mixpilot
