@@ -11,7 +11,7 @@
 
 #include "core/modes/mode.hpp"
 #include "core/control/obstacle_constraint.hpp"
-#include "core/modes/obstacles.hpp"
+#include "core/modes/obstacle_mode.hpp"
 
 namespace mixpilot {
 namespace {

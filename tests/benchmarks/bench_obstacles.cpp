@@ -9,7 +9,7 @@
 #include <chrono>
 #include <string>
 
-#include "core/modes/obstacles.hpp"
+#include "core/scenario/obstacle_scenario.hpp"
 
 namespace mixpilot {
 namespace {
