@@ -63,7 +63,7 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   const double distance = check_distances(0.0, violated);
   if (violated) ++violations_;
   check_control_instant(0.0);
-  set_channels(distance, 0.0);
+  set_channels(distance, (x_.head<3>() - ref.x[0].head<3>()).norm());
   ready_ = true;
   finished_ = steps_total_ <= 0;
   return {};

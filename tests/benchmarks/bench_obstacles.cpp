@@ -9,6 +9,8 @@
 #include <chrono>
 #include <string>
 
+#include "core/nlp/rti.hpp"
+#include "core/numerics/setup_result.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 
 namespace mixpilot {
