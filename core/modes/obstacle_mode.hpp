@@ -49,6 +49,13 @@ struct ObstacleRunResult {
   std::vector<int> step_status;            // RtiStatus
 };
 
+// Telemetry of step k: x = x_measured = the state at t_k (13), u (4), reference = p_ref(t_k)
+// (3), predicted / predicted_reference = the RTI plan's positions and the reference positions at
+// the N + 1 nodes, the RTI statistics; events kEventFallback, kEventViolation (a substep of the
+// step came closer than d_C − 1 mm to an obstacle), kEventLost (the plant state stopped being
+// finite: the run ends, state() keeps the last finite one); channels "min distance" (over the
+// obstacles and the step's plant substeps, ∞ without obstacles), "clearance margin" (that − d_C),
+// "tracking error" (‖p_k − p_ref(t_k)‖), "QP iterations".
 class ObstacleMode final : public Mode {
  public:
   ObstacleMode() = default;
@@ -103,8 +110,8 @@ class ObstacleMode final : public Mode {
   std::optional<ObstacleAvoidanceOcp> problem_;  // rebuilt by setup(); rti_ points into it
   RtiSolver rti_;
   Telemetry telemetry_;
-  models::Crazyflie::State x_;  // true state
-  std::vector<double> rti_us_;  // per step: prepare + feedback; reserved for steps_total_
+  models::Crazyflie::State x_;  // 13: true plant state
+  std::vector<double> rti_us_;  // steps_total_: per step, RTI prepare + feedback [us]
   int substeps_ = 15;           // plant RK4 steps per Δt
   int last_x_ = 0;              // last index of the reference states
   std::int64_t step_ = 0;
