@@ -8,7 +8,7 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/nlp/nlp_ipopt.hpp"
 #include "core/modes/pendubot_swingup.hpp"
-#include "core/modes/obstacles.hpp"
+#include "core/control/obstacle_avoidance.hpp"
 #include "core/nlp/trajectory_io.hpp"
 
 namespace {

@@ -1,6 +1,6 @@
 #include "core/modes/mode.hpp"
 
-#include "core/modes/obstacles.hpp"
+#include "core/modes/obstacle_mode.hpp"
 #include "core/modes/pendubot_swingup.hpp"
 #include "core/modes/tracking.hpp"
 

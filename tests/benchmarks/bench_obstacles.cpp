@@ -9,7 +9,9 @@
 #include <chrono>
 #include <string>
 
-#include "core/modes/obstacles.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/numerics/setup_result.hpp"
+#include "core/scenario/obstacle_scenario.hpp"
 
 namespace mixpilot {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
-// Obstacle avoidance with the LCL constraint, SPEC §5.3 (thesis ch. 6): the mode
-// `obstacle_avoidance` of `mixpilot fly`.
+// Obstacle avoidance with the LCL constraint, SPEC §5.3 (thesis ch. 6): the controller's world
+// model and its OCP.
 //
 // OCP (ObstacleAvoidanceOcp): Crazyflie, Δt = 15 ms, N = 50, y = (ξ − ξʳ, u − uʳ) with
 //   W = blkdiag(30·I2, 60, 0.1·I4, 2, 3, 5, 3·I3, 0.05·I4), W_N = W without the input block,
@@ -12,21 +12,15 @@
 // position until its throw time, then flies ballistically (exact, no drag). The controller
 // predicts each ball from its current state: ballistic once thrown, at rest before (it does
 // not know when the ball will be thrown).
-// Closed loop (run_obstacle_avoidance): one RTI per Δt; plant = the same model with RK4 at
-// ≥ 1 kHz substeps, the input held over Δt. Distances are checked at every plant substep.
-#include <optional>
-#include <string>
-#include <string_view>
+// The closed loop is core/modes/obstacle_mode.hpp; the scenario file core/scenario/
+// obstacle_scenario.hpp.
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "core/numerics/integrator_erk4.hpp"
-#include "core/modes/mode.hpp"
 #include "core/control/obstacle_constraint.hpp"
 #include "core/nlp/ocp.hpp"
-#include "core/nlp/rti.hpp"
-#include "core/nlp/trajectory_io.hpp"
+#include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/types.hpp"
 #include "models/crazyflie.hpp"
 
@@ -66,25 +60,6 @@ struct ObstacleControllerSettings {
   double slack_l2 = obstacle_defaults::kSlackL2;
 };
 
-struct ObstacleScenario {
-  std::string name;
-  std::string source_path;
-  double duration = 4.0;       // [s]
-  std::string reference_file;  // resolved against the scenario file's directory
-  TrajectoryFile reference;    // read and checked by the loader (13 states, 4 inputs, Δt)
-  ObstacleControllerSettings controller;
-  ObstacleWorld world;
-  double plant_rate_hz = obstacle_defaults::kPlantRateHz;
-};
-
-// Scenario files (docs/scenario-format.md, "Obstacle avoidance"). On failure: nullopt and one
-// `<file>:<line>:<col>: <key path>: <what was expected>` line per problem. Never throws.
-std::optional<ObstacleScenario> parse_obstacle_scenario(std::string_view text,
-                                                        const std::string& source_name,
-                                                        std::string& error);
-std::optional<ObstacleScenario> load_obstacle_scenario(const std::string& path,
-                                                       std::string& error);
-
 // The OCP of SPEC §5.3 with `num_obstacles` soft clearance constraints (0: the obstacle-free
 // reference problem). Owns what its Ocp points to.
 class ObstacleAvoidanceOcp {
@@ -119,52 +94,12 @@ class ObstacleAvoidanceOcp {
   ObstacleControllerSettings settings_;
   int num_obstacles_;
   IntegratorErk4<models::Crazyflie> integrator_;
-  SelectionOutput output_;
-  SelectionOutput terminal_output_;
+  SelectionOutput output_;           // y = (x, u): 17 selected entries
+  SelectionOutput terminal_output_;  // y_N = x: 13 selected entries
   ObstacleConstraint constraint_;
   Ocp ocp_;
-  Eigen::VectorXd stage_weights_;
-  Eigen::VectorXd terminal_weights_;
+  Eigen::VectorXd stage_weights_;     // nx + nu: diagonal of W
+  Eigen::VectorXd terminal_weights_;  // nx: diagonal of W_N
 };
-
-struct ObstacleRunOptions {
-  std::optional<double> duration;        // overrides the scenario's
-  std::optional<ObstacleForm> form;      // overrides the scenario's constraint_form
-  bool keep_trajectory = false;          // fill ObstacleRunResult::positions
-};
-
-struct ObstacleRunResult {
-  ObstacleForm form = ObstacleForm::lcl;
-  int steps = 0;
-  double min_distance_m = 0.0;   // min over plant substeps and obstacles of ‖p − o‖
-  double min_margin_m = 0.0;     // min_distance_m − d_C
-  // The same at the control instants only: where the constraint is imposed (thesis §6.3.2:
-  // between shooting nodes the path may cut the clearance sphere slightly).
-  double min_distance_control_m = 0.0;
-  double min_distance_time = 0.0;  // when it happened [s]
-  int closest_obstacle = -1;
-  int violations = 0;            // control intervals with ‖p − o‖ < d_C − 1 mm at some substep
-  double tracking_rms_m = 0.0;   // RMS of ‖p − p_ref‖ at the control instants
-  double final_error_m = 0.0;    // ‖p − p_ref,last‖ at the end
-  double rti_median_us = 0.0;    // prepare + feedback
-  double rti_p99_us = 0.0;
-  double rti_max_us = 0.0;
-  int fallbacks = 0;
-  bool lost = false;             // the plant state stopped being finite
-  int qp_iterations_max = 0;
-  // keep_trajectory: per control step k (and positions[steps] = the final one)
-  std::vector<Eigen::Vector3d> positions;  // p at t_k
-  std::vector<double> step_us;             // RTI prepare + feedback
-  std::vector<int> step_qp_iterations;
-  std::vector<int> step_status;            // RtiStatus
-};
-
-// Flies a loaded scenario along its reference (the loader checked that it fits).
-ObstacleRunResult run_obstacle_avoidance(const ObstacleScenario& scenario,
-                                         const ObstacleRunOptions& options = {});
-
-// The mode runner (core/modes/mode.hpp). Metrics: min_distance_m, min_margin_m, violations,
-// tracking_rms_m, final_error_m, rti_median_us, rti_p99_us, fallbacks, form (0 lcl, 1 squared).
-ModeResult fly_obstacle_avoidance(const std::string& scenario_path, const ModeOptions& options);
 
 }  // namespace mixpilot

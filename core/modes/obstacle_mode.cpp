@@ -1,0 +1,362 @@
+#include "core/modes/obstacle_mode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+
+#include "core/numerics/stats.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Channel slots of the obstacle-avoidance telemetry.
+enum ObstacleChannel {
+  kMinDistance,     // min over obstacles and this step's plant substeps of ‖p − o‖ (∞: none)
+  kClearanceMargin, // that minus d_C: negative when the path cut the clearance sphere
+  kTrackingError,   // ‖p_k − p_ref,k‖ at t_k
+  kQpIterations,
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Setup
+
+SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<ObstacleForm> form) {
+  scenario_ = std::move(scenario);
+  settings_ = scenario_.controller;
+  if (form) settings_.form = *form;
+  finished_ = true;  // until setup succeeds
+  ready_ = false;
+  lost_ = false;
+  lost_at_ = -1.0;
+  step_ = 0;
+  steps_total_ = 0;
+  problem_.emplace(scenario_.world.size(), settings_);
+  if (SetupResult r = rti_.setup(problem_->ocp()); !r)
+    return SetupResult::failure("controller: " + r.reason());
+  if (SetupResult r = check_scenario(); !r) return r;
+
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  last_x_ = int(ref.x.size()) - 1;
+  substeps_ = int(std::lround(settings_.dt * scenario_.plant_rate_hz));
+  steps_total_ = std::lround(scenario_.duration / settings_.dt);
+  x_ = ref.x[0];
+  warm_start();
+  rti_us_.clear();
+  rti_us_.reserve(std::size_t(std::max<std::int64_t>(steps_total_, 0)));
+  min_distance_ = kInf;
+  min_distance_time_ = 0.0;
+  closest_obstacle_ = -1;
+  min_distance_control_ = kInf;
+  violations_ = 0;
+  sq_tracking_ = 0.0;
+  qp_iterations_max_ = 0;
+
+  reset_telemetry();
+  bool violated = false;
+  const double distance = check_distances(0.0, violated);
+  if (violated) ++violations_;
+  check_control_instant(0.0);
+  set_channels(distance, (x_.head<3>() - ref.x[0].head<3>()).norm());
+  ready_ = true;
+  finished_ = steps_total_ <= 0;
+  return {};
+}
+
+// What the loader checks, for scenarios built in code: the loop indexes the reference and
+// divides Δt into substeps.
+SetupResult ObstacleMode::check_scenario() const {
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  if (ref.x.empty()) return SetupResult::failure("reference: no states");
+  for (const Eigen::VectorXd& x : ref.x)
+    if (x.size() != ObstacleAvoidanceOcp::nx)
+      return SetupResult::failure("reference: expected Crazyflie states (13 entries)");
+  for (const Eigen::VectorXd& u : ref.u)
+    if (u.size() != ObstacleAvoidanceOcp::nu)
+      return SetupResult::failure("reference: expected Crazyflie inputs (4 entries)");
+  const double substeps = settings_.dt * scenario_.plant_rate_hz;
+  if (!(std::lround(substeps) >= 1) || std::abs(substeps - std::round(substeps)) > 1e-9 * substeps)
+    return SetupResult::failure("plant.rate_hz × controller.dt must be a whole number ≥ 1");
+  return {};
+}
+
+// The reference itself (obstacle-free) from its first state; hover past its last input.
+void ObstacleMode::warm_start() {
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  OcpTrajectory& traj = rti_.trajectory();
+  for (int i = 0; i <= settings_.N; ++i) traj.x[i] = ref.x[std::min(i, last_x_)];
+  for (int i = 0; i < settings_.N; ++i) {
+    if (i < int(ref.u.size()))
+      traj.u[i] = ref.u[i];
+    else
+      traj.u[i] = problem_->model().hover_input();
+  }
+}
+
+// Sizes every telemetry member for the run: the initial state, the warm start as prediction.
+void ObstacleMode::reset_telemetry() {
+  Telemetry& s = telemetry_;
+  s = Telemetry{};
+  s.mode = ModeKind::obstacle_avoidance;
+  s.x = x_;
+  s.x_measured = x_;
+  s.u = problem_->model().hover_input();
+  s.reference = Eigen::VectorXd::Zero(3);
+  s.predicted = Eigen::Matrix3Xd::Zero(3, settings_.N + 1);
+  s.predicted_reference = Eigen::Matrix3Xd::Zero(3, settings_.N + 1);
+  // Step 0 sets the same stage data again: this only shows its reference before the start.
+  problem_->set_reference(rti_.data(), scenario_.reference.trajectory, 0);
+  problem_->set_obstacles(rti_.data(), scenario_.world, 0.0);
+  set_reference_position(0);
+  set_predictions();
+}
+
+// ---------------------------------------------------------------------------------------------
+// One control period
+
+bool ObstacleMode::step() {
+  if (finished_) return false;
+  const int k = int(step_);
+  const double t = k * settings_.dt;
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  problem_->set_reference(rti_.data(), ref, k);
+  problem_->set_obstacles(rti_.data(), scenario_.world, t);
+  rti_.prepare();
+  rti_.feedback(x_);
+  const RtiStats& st = rti_.stats();
+  rti_us_.push_back(st.total_us);
+  qp_iterations_max_ = std::max(qp_iterations_max_, st.qp_iterations);
+  const models::Crazyflie::Input u = rti_.control();
+
+  Telemetry& s = telemetry_;
+  s.step = step_;
+  s.t = t;
+  s.x = x_;
+  s.x_measured = x_;
+  s.u = u;
+  s.solved = true;
+  s.stats = st;
+  set_reference_position(k);
+  set_predictions();
+  const double sq_error = (x_.head<3>() - ref.x[std::min(k, last_x_)].head<3>()).squaredNorm();
+  sq_tracking_ += sq_error;
+
+  bool violated = false;
+  const double distance = plant_step(u, t, violated);
+  if (violated) ++violations_;
+  check_control_instant(t + settings_.dt);
+  ++step_;
+  s.events = st.status == RtiStatus::fallback ? kEventFallback : 0u;
+  if (violated) s.events |= kEventViolation;
+  set_channels(distance, std::sqrt(sq_error));
+  if (!x_.allFinite()) {  // never hand a non-finite state to anyone
+    x_ = s.x;
+    lost_ = finished_ = true;
+    lost_at_ = t;
+    s.events |= kEventLost;
+    return true;
+  }
+  rti_.shift();
+  if (step_ >= steps_total_) finished_ = true;
+  return true;
+}
+
+// RK4 at the plant rate with u held over [t, t + Δt], the distances checked after every
+// substep. Returns the smallest distance of the step; `violated` when one is below d_C − 1 mm.
+double ObstacleMode::plant_step(const models::Crazyflie::Input& u, double t, bool& violated) {
+  const IntegratorErk4<models::Crazyflie>& erk4 = problem_->integrator();
+  const double h = settings_.dt / substeps_;
+  models::Crazyflie::State xn;
+  double distance = kInf;
+  for (int s = 0; s < substeps_; ++s) {
+    erk4.step(x_, u, h, xn);
+    x_ = xn;
+    distance = std::min(distance, check_distances(t + (s + 1) * h, violated));
+  }
+  return distance;
+}
+
+// Distance of the vehicle to every obstacle at time t, into the run's minimum. Returns the
+// smallest; sets `violated` when one is below d_C − 1 mm.
+double ObstacleMode::check_distances(double t, bool& violated) {
+  double smallest = kInf;
+  for (int j = 0; j < scenario_.world.size(); ++j) {
+    const double dist = (x_.head<3>() - scenario_.world.position(j, t)).norm();
+    if (dist < min_distance_) {
+      min_distance_ = dist;
+      min_distance_time_ = t;
+      closest_obstacle_ = j;
+    }
+    smallest = std::min(smallest, dist);
+    violated |= dist < settings_.clearance - obstacle_defaults::kViolationTolerance;
+  }
+  return smallest;
+}
+
+// The same at a control instant, where the constraint is imposed.
+void ObstacleMode::check_control_instant(double t) {
+  for (int j = 0; j < scenario_.world.size(); ++j)
+    min_distance_control_ =
+        std::min(min_distance_control_, (x_.head<3>() - scenario_.world.position(j, t)).norm());
+}
+
+// η^r(t_k) = the reference position of step k (clamped to the last state), element by element
+// (a fixed-size segment into a VectorXd: no temporary).
+void ObstacleMode::set_reference_position(int k) {
+  const Eigen::VectorXd& r = scenario_.reference.trajectory.x[std::min(k, last_x_)];
+  for (int i = 0; i < 3; ++i) telemetry_.reference(i) = r(i);
+}
+
+// Predicted positions of the RTI trajectory and the reference positions at the N + 1 nodes.
+void ObstacleMode::set_predictions() {
+  const OcpTrajectory& traj = rti_.trajectory();
+  const OcpStageData& data = rti_.data();
+  for (int i = 0; i <= settings_.N; ++i) {
+    telemetry_.predicted.col(i) = traj.x[i].head<3>();
+    telemetry_.predicted_reference.col(i) = data.yref[i].head<3>();
+  }
+}
+
+void ObstacleMode::set_channels(double step_min_distance, double tracking_error) {
+  Telemetry& s = telemetry_;
+  s.set_channel(kMinDistance, "min distance", "m", step_min_distance);
+  s.set_channel(kClearanceMargin, "clearance margin", "m",
+                step_min_distance - settings_.clearance);
+  s.set_channel(kTrackingError, "tracking error", "m", tracking_error);
+  s.set_channel(kQpIterations, "QP iterations", "", double(s.stats.qp_iterations));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Results
+
+ObstacleRunResult ObstacleMode::result() const {
+  ObstacleRunResult r;
+  r.form = settings_.form;
+  if (!ready_) {
+    r.error = "not set up";
+    return r;
+  }
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  r.steps = int(step_);
+  r.min_distance_m = min_distance_;
+  r.min_margin_m = min_distance_ - settings_.clearance;
+  r.min_distance_control_m = min_distance_control_;
+  r.min_distance_time = min_distance_time_;
+  r.closest_obstacle = closest_obstacle_;
+  r.violations = violations_;
+  r.tracking_rms_m = r.steps > 0 ? std::sqrt(sq_tracking_ / r.steps) : 0.0;
+  r.final_error_m = (x_.head<3>() - ref.x[last_x_].head<3>()).norm();
+  r.rti_median_us = percentile(rti_us_, 0.5);
+  r.rti_p99_us = percentile(rti_us_, 0.99);
+  r.rti_max_us = rti_us_.empty() ? 0.0 : *std::max_element(rti_us_.begin(), rti_us_.end());
+  r.fallbacks = int(rti_.stats().fallbacks);
+  r.lost = lost_;
+  r.qp_iterations_max = qp_iterations_max_;
+  return r;
+}
+
+Metrics ObstacleMode::metrics() const {
+  const ObstacleRunResult r = result();
+  return {
+      {"min_distance_m", r.min_distance_m},
+      {"min_margin_m", r.min_margin_m},
+      {"min_distance_control_m", r.min_distance_control_m},
+      {"clearance_m", settings_.clearance},
+      {"violations", double(r.violations)},
+      {"tracking_rms_m", r.tracking_rms_m},
+      {"final_error_m", r.final_error_m},
+      {"rti_median_us", r.rti_median_us},
+      {"rti_p99_us", r.rti_p99_us},
+      {"fallbacks", double(r.fallbacks)},
+      {"form", r.form == ObstacleForm::lcl ? 0.0 : 1.0},
+      {"steps", double(r.steps)},
+  };
+}
+
+std::string ObstacleMode::summary() const {
+  const ObstacleRunResult r = result();
+  char buf[768];
+  std::snprintf(buf, sizeof buf,
+                "%s: obstacle avoidance (SPEC 5.3), form %s, %zu spheres, %zu balls, %d steps "
+                "of %.0f ms\n"
+                "  min distance %.4f m (d_C %.3f m, margin %+.4f m) at t = %.3f s (obstacle %d), "
+                "%.4f m at the control instants; violations %d\n"
+                "  tracking rms %.3f m, final error %.3f m; RTI median %.0f us, p99 %.0f us, "
+                "max %.0f us; fallbacks %d%s\n",
+                scenario_.name.c_str(), to_string(r.form), scenario_.world.spheres.size(),
+                scenario_.world.balls.size(), r.steps, 1e3 * settings_.dt, r.min_distance_m,
+                settings_.clearance, r.min_margin_m, r.min_distance_time, r.closest_obstacle,
+                r.min_distance_control_m, r.violations, r.tracking_rms_m, r.final_error_m,
+                r.rti_median_us, r.rti_p99_us, r.rti_max_us, r.fallbacks,
+                r.lost ? "\n  the vehicle was lost" : "");
+  return buf;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Whole runs
+
+ObstacleRunResult run_obstacle_avoidance(const ObstacleScenario& scenario,
+                                         const ObstacleRunOptions& options) {
+  ObstacleScenario sc = scenario;
+  if (options.duration) sc.duration = *options.duration;
+  ObstacleMode mode;
+  if (SetupResult setup = mode.setup(std::move(sc), options.form); !setup) {
+    ObstacleRunResult failed;
+    failed.error = setup.reason();
+    return failed;
+  }
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<double> step_us;
+  std::vector<int> step_qp_iterations, step_status;
+  if (options.keep_trajectory) {
+    const std::size_t n = std::size_t(mode.steps_total());
+    positions.reserve(n + 1);
+    step_us.reserve(n);
+    step_qp_iterations.reserve(n);
+    step_status.reserve(n);
+  }
+  while (mode.step()) {
+    if (!options.keep_trajectory) continue;
+    const Telemetry& s = mode.telemetry();
+    positions.push_back(s.x.head<3>());
+    step_us.push_back(s.stats.total_us);
+    step_qp_iterations.push_back(s.stats.qp_iterations);
+    step_status.push_back(int(s.stats.status));
+  }
+  ObstacleRunResult r = mode.result();
+  if (options.keep_trajectory) {
+    positions.push_back(mode.state().head<3>());
+    r.positions = std::move(positions);
+    r.step_us = std::move(step_us);
+    r.step_qp_iterations = std::move(step_qp_iterations);
+    r.step_status = std::move(step_status);
+  }
+  return r;
+}
+
+ModeResult fly_obstacle_avoidance(const std::string& scenario_path, const ModeOptions& options) {
+  ModeResult out;
+  std::optional<ObstacleScenario> sc = load_obstacle_scenario(scenario_path, out.error);
+  if (!sc) return out;
+  if (options.duration) sc->duration = *options.duration;
+  ObstacleMode mode;
+  if (SetupResult setup = mode.setup(std::move(*sc)); !setup) {
+    out.error = scenario_path + ": " + setup.reason();
+    return out;
+  }
+  while (mode.step()) {
+  }
+  out.summary = mode.summary();
+  out.metrics = mode.metrics();
+  out.ok = !mode.lost();
+  if (mode.lost()) out.error = scenario_path + ": the vehicle was lost (plant state not finite)";
+  return out;
+}
+
+}  // namespace mixpilot
