@@ -3,6 +3,8 @@
 #include <utility>
 
 #include "core/modes/mi_mode.hpp"
+#include "core/modes/obstacle_mode.hpp"
+#include "core/scenario/obstacle_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot {
@@ -29,6 +31,22 @@ std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& sou
   return mode;
 }
 
+// A mode whose scenario struct comes from `parse` and which flies on its own.
+template <class M, class Parse>
+std::unique_ptr<Mode> make_solo_mode(std::string_view text, const std::string& source_name,
+                                     const ModeRequest& request, Parse parse,
+                                     std::string& error) {
+  auto scenario = parse(text, source_name, error);
+  if (!scenario) return nullptr;
+  if (request.duration) scenario->duration = *request.duration;
+  auto mode = std::make_unique<M>();
+  if (SetupResult r = mode->setup(std::move(*scenario)); !r) {
+    error = source_name + ": " + r.reason();
+    return nullptr;
+  }
+  return mode;
+}
+
 }  // namespace
 
 std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source_name,
@@ -46,9 +64,11 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
   }
   switch (*kind) {
     case ModeKind::mixed_initiative: return make_mi_mode(text, source_name, request, error);
+    case ModeKind::obstacle_avoidance:
+      return make_solo_mode<ObstacleMode>(text, source_name, request, parse_obstacle_scenario,
+                                          error);
     case ModeKind::pendubot_swingup:
-    case ModeKind::crazyflie_tracking:
-    case ModeKind::obstacle_avoidance: break;
+    case ModeKind::crazyflie_tracking: break;
   }
   error = source_name + ": mode \"" + *name + "\" cannot be stepped yet";
   return nullptr;
