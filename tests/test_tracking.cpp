@@ -1,5 +1,6 @@
-// Crazyflie tracking under delay (core/modes/tracking_mode.hpp, SPEC §5.2, thesis Fig. 5.6, issue 6): the
-// RTT study, the predictor's exactness, the 12-state LQR, the shipped scenarios and their errors.
+// Crazyflie tracking under delay (core/modes/tracking_mode.hpp, SPEC §5.2, thesis Fig. 5.6): the
+// RTT study, the predictor's exactness, the 12-state LQR, the mode's telemetry and steps, the
+// shipped scenarios and their errors.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -43,7 +44,7 @@ std::string cell(const TrackingResult& r) {
   return buf;
 }
 
-// The RTT study of issue 6 (thesis Fig. 5.6): RMS tracking error / overshoot [m] of the smooth
+// The RTT study (thesis Fig. 5.6): RMS tracking error / overshoot [m] of the smooth
 // step for RTT 0, 30, 60, 90 ms, NMPC and LQR, each without and with the ERK4 predictor.
 TEST(TrackingDelay, RttStudy) {
   const TrackingScenario base = load(kStep);
@@ -78,7 +79,7 @@ TEST(TrackingDelay, RttStudy) {
     EXPECT_NEAR(nmpc[i][1].overshoot_m, nmpc[0][1].overshoot_m, 1e-6) << rtts[i];
     EXPECT_NEAR(lqr[i][1].tracking_rms_m, lqr[0][1].tracking_rms_m, 1e-6) << rtts[i];
   }
-  // Issue 6: at the thesis's 60 ms the predictor's error is clearly below the uncompensated one.
+  // At the thesis's 60 ms the predictor's error is clearly below the uncompensated one.
   // Here the uncompensated NMPC does not survive 30 ms or more at all (TrackingDelay.Fig56).
   for (int i = 1; i < 4; ++i) {
     EXPECT_TRUE(nmpc[i][0].lost || nmpc[i][1].tracking_rms_m <= 0.7 * nmpc[i][0].tracking_rms_m)

@@ -102,7 +102,16 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   predict_us_.reserve(std::size_t(steps_total_));
   if (n_c_ == 0) sample(0, x_init_);  // boundary 0 is σ = t_0
 
-  const int nodes = problem_ ? c.N + 1 : 0;
+  init_telemetry();
+  ok_ = true;
+  finished_ = false;
+  return {};
+}
+
+// Before the first step: the vehicle at rest, x(σ = 0) = x0 = the initial state, the hover
+// input; the NMPC's plan is its initial guess.
+void TrackingMode::init_telemetry() {
+  const int nodes = problem_ ? scenario_.controller.N + 1 : 0;
   telemetry_ = Telemetry{};
   telemetry_.mode = ModeKind::crazyflie_tracking;
   telemetry_.x = x_init_;
@@ -117,9 +126,6 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   }
   set_telemetry();
   set_channels(0.0, 0.0);
-  ok_ = true;
-  finished_ = false;
-  return {};
 }
 
 // y = the state of boundary k·s − n_m (the initial state before the start), then x0: its
@@ -268,7 +274,7 @@ void TrackingMode::set_channels(double predictor_us, double controller_us) {
   s.set_channel(kTrackingError, "tracking error", "m", position_error(p, pr));
   s.set_channel(kRtt, "RTT", "s", scenario_.plant.rtt);
   s.set_channel(kPredictorTime, "predictor time", "us", predictor_us);
-  s.set_channel(kControllerTime, problem_ ? "RTI time" : "LQR time", "us", controller_us);
+  s.set_channel(kControllerTime, nmpc() ? "RTI time" : "LQR time", "us", controller_us);
   for (int i = 0; i < 4; ++i) s.set_channel(kRotorSpeed1 + i, kRotorSpeedNames[i], "krpm", s.u(i));
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "krpm", model_.p.omega_max);
   s.set_channel(kCompensation, "compensation", "", scenario_.controller.compensation ? 1.0 : 0.0);
@@ -303,7 +309,7 @@ TrackingResult TrackingMode::result() const {
 
 Metrics TrackingMode::metrics() const {
   const TrackingResult r = result();
-  const bool nmpc = problem_ != nullptr;
+  const bool rti = nmpc();
   Metrics m;
   m.emplace_back("tracking_rms_m", r.tracking_rms_m);
   m.emplace_back("max_error_m", r.max_error_m);
@@ -312,9 +318,9 @@ Metrics TrackingMode::metrics() const {
     m.emplace_back("overshoot_m", r.overshoot_m);
     m.emplace_back("settle_time_s", r.settle_time_s);
   }
-  m.emplace_back(nmpc ? "rti_median_us" : "lqr_median_us", r.solve_median_us);
-  m.emplace_back(nmpc ? "rti_p99_us" : "lqr_p99_us", r.solve_p99_us);
-  if (nmpc) m.emplace_back("fallbacks", double(r.fallbacks));
+  m.emplace_back(rti ? "rti_median_us" : "lqr_median_us", r.solve_median_us);
+  m.emplace_back(rti ? "rti_p99_us" : "lqr_p99_us", r.solve_p99_us);
+  if (rti) m.emplace_back("fallbacks", double(r.fallbacks));
   m.emplace_back("predictor_median_us", r.predictor_median_us);
   m.emplace_back("max_input_violation", r.max_input_violation);
   m.emplace_back("rtt_s", scenario_.plant.rtt);
@@ -326,13 +332,13 @@ Metrics TrackingMode::metrics() const {
 
 std::string TrackingMode::summary() const {
   const TrackingResult r = result();
-  const bool nmpc = problem_ != nullptr;
+  const bool rti = nmpc();
   const bool step = scenario_.reference.kind == TrackingReferenceKind::smooth_step;
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "mixpilot fly: %s (crazyflie_tracking, %s, %s, RTT %.0f ms, compensation %s)\n"
                 "  %d steps; tracking RMS %.4f m, max %.4f m, final %.4f m",
-                scenario_.name.c_str(), nmpc ? "NMPC" : "LQR", step ? "smooth step" : "helix",
+                scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
                 1e3 * scenario_.plant.rtt, scenario_.controller.compensation ? "on" : "off",
                 r.steps, r.tracking_rms_m, r.max_error_m, r.final_error_m);
   std::string out = buf;
@@ -341,9 +347,9 @@ std::string TrackingMode::summary() const {
                   r.settle_time_s);
     out += buf;
   }
-  const std::string fallbacks = nmpc ? ", " + std::to_string(r.fallbacks) + " fallbacks" : "";
+  const std::string fallbacks = rti ? ", " + std::to_string(r.fallbacks) + " fallbacks" : "";
   std::snprintf(buf, sizeof buf, "\n  %s median %.0f us, p99 %.0f us%s; predictor median %.1f us%s\n",
-                nmpc ? "RTI" : "LQR", r.solve_median_us, r.solve_p99_us, fallbacks.c_str(),
+                rti ? "RTI" : "LQR", r.solve_median_us, r.solve_p99_us, fallbacks.c_str(),
                 r.predictor_median_us, r.lost ? "\n  the vehicle was lost" : "");
   out += buf;
   return out;

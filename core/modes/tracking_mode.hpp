@@ -102,6 +102,7 @@ class TrackingMode final : public Mode {
   void integrate_to(long end);
   bool process_to(long end);
   void sample(long m, const State& x);
+  void init_telemetry();
   void set_telemetry();
   void set_channels(double predictor_us, double controller_us);
 
