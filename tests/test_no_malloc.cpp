@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "core/control/crazyflie_tracking.hpp"
+#include "core/control/tracking.hpp"
+#include "core/modes/tracking_mode.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/nlp/rti.hpp"
 #include "models/crazyflie.hpp"
@@ -74,6 +76,39 @@ TEST(NoMalloc, RtiPrepareFeedbackShift) {
       x(2) += 0.01;  // a new measurement
     }
     EXPECT_TRUE(u.allFinite());
+  }
+}
+
+// Tracking under delay: every step() of the helix, NMPC and LQR, with the predictor over a
+// 60 ms RTT split so that x(σ = t_k) lies past the step's own boundary (n_c > s).
+TEST(NoMalloc, TrackingModeStep) {
+  for (TrackingControllerKind kind : {TrackingControllerKind::nmpc, TrackingControllerKind::lqr}) {
+    TrackingScenario sc;
+    sc.name = "helix";
+    sc.duration = 0.6;
+    sc.reference.kind = TrackingReferenceKind::helix;
+    sc.controller.kind = kind;
+    sc.plant.rtt = 0.06;
+    sc.plant.measurement_fraction = 0.25;
+    sc.reference_trajectory =
+        helix_reference(sc.reference.helix, sc.controller.dt, models::Crazyflie{});
+    TrackingMode mode;
+    const SetupResult r = mode.setup(sc);
+    ASSERT_TRUE(r.ok()) << r.reason();
+    long allocations = 0, steps = 0;
+    for (;;) {
+      bool stepped = false;
+      {
+        NoMalloc guard;
+        stepped = mode.step();
+        allocations += NoMalloc::count();
+      }
+      if (!stepped) break;
+      ++steps;
+    }
+    EXPECT_EQ(steps, mode.steps_total());
+    EXPECT_EQ(allocations, 0);
+    EXPECT_FALSE(mode.lost());
   }
 }
 

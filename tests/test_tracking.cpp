@@ -1,5 +1,6 @@
-// Crazyflie tracking under delay (core/modes/tracking.hpp, SPEC §5.2, thesis Fig. 5.6, issue 6): the
-// RTT study, the predictor's exactness, the 12-state LQR, the shipped scenarios and their errors.
+// Crazyflie tracking under delay (core/modes/tracking_mode.hpp, SPEC §5.2, thesis Fig. 5.6): the
+// RTT study, the predictor's exactness, the 12-state LQR, the mode's telemetry and steps, the
+// shipped scenarios and their errors.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -11,7 +12,7 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/modes/mode.hpp"
-#include "core/modes/tracking.hpp"
+#include "core/modes/tracking_mode.hpp"
 
 namespace mixpilot {
 namespace {
@@ -43,7 +44,7 @@ std::string cell(const TrackingResult& r) {
   return buf;
 }
 
-// The RTT study of issue 6 (thesis Fig. 5.6): RMS tracking error / overshoot [m] of the smooth
+// The RTT study (thesis Fig. 5.6): RMS tracking error / overshoot [m] of the smooth
 // step for RTT 0, 30, 60, 90 ms, NMPC and LQR, each without and with the ERK4 predictor.
 TEST(TrackingDelay, RttStudy) {
   const TrackingScenario base = load(kStep);
@@ -66,20 +67,19 @@ TEST(TrackingDelay, RttStudy) {
     EXPECT_EQ(nmpc[i][1].fallbacks, 0) << rtts[i];
     EXPECT_LE(nmpc[i][1].max_input_violation, 1e-8);  // QP tolerance
     EXPECT_FALSE(lqr[i][1].lost) << rtts[i];
-    EXPECT_LE(lqr[i][0].max_input_violation, 0.0);  // clipped
   }
   // At RTT 0 the predictor integrates over nothing: identical runs.
   EXPECT_EQ(nmpc[0][0].tracking_rms_m, nmpc[0][1].tracking_rms_m);
   EXPECT_EQ(nmpc[0][0].overshoot_m, nmpc[0][1].overshoot_m);
   EXPECT_EQ(lqr[0][0].tracking_rms_m, lqr[0][1].tracking_rms_m);
   // With a matched model the predictor restores the delay-free loop on the controller's clock
-  // (core/modes/tracking.hpp): the compensated error does not depend on the RTT.
+  // (core/modes/tracking_mode.hpp): the compensated error does not depend on the RTT.
   for (int i = 1; i < 4; ++i) {
     EXPECT_NEAR(nmpc[i][1].tracking_rms_m, nmpc[0][1].tracking_rms_m, 1e-6) << rtts[i];
     EXPECT_NEAR(nmpc[i][1].overshoot_m, nmpc[0][1].overshoot_m, 1e-6) << rtts[i];
     EXPECT_NEAR(lqr[i][1].tracking_rms_m, lqr[0][1].tracking_rms_m, 1e-6) << rtts[i];
   }
-  // Issue 6: at the thesis's 60 ms the predictor's error is clearly below the uncompensated one.
+  // At the thesis's 60 ms the predictor's error is clearly below the uncompensated one.
   // Here the uncompensated NMPC does not survive 30 ms or more at all (TrackingDelay.Fig56).
   for (int i = 1; i < 4; ++i) {
     EXPECT_TRUE(nmpc[i][0].lost || nmpc[i][1].tracking_rms_m <= 0.7 * nmpc[i][0].tracking_rms_m)
@@ -212,7 +212,7 @@ TEST(TrackingDelay, PredictorReproducesThePlant) {
       TrackingLog log;
       const TrackingResult r = fly(sc, TrackingControllerKind::nmpc, rtt, true, &log);
       ASSERT_EQ(log.x0.size(), std::size_t(r.steps));
-      ASSERT_GE(log.x_true.size(), log.x0.size());
+      ASSERT_EQ(log.x_true.size(), log.x0.size());
       double worst = 0;
       for (std::size_t k = 0; k < log.x0.size(); ++k)
         worst = std::max(worst, (log.x0[k] - log.x_true[k]).lpNorm<Eigen::Infinity>());
@@ -246,17 +246,21 @@ TEST(TrackingDelay, SplitOfTheRttDoesNotMatter) {
 
 TEST(TrackingLqr, RiccatiAndGain) {
   TrackingLqr lqr;
-  ASSERT_TRUE(lqr.setup(models::Crazyflie{}, 0.015));
+  const SetupResult setup = lqr.setup(models::Crazyflie{}, 0.015);
+  ASSERT_TRUE(setup.ok()) << setup.reason();
   EXPECT_LE(lqr.dare_residual(), 1e-10);
   const Eigen::Matrix<double, 12, 12> Acl = lqr.A() - lqr.B() * lqr.K();
   const double rho = Acl.eigenvalues().cwiseAbs().maxCoeff();
   std::printf("LQR: DARE residual %.1e, closed-loop spectral radius %.6f\n", lqr.dare_residual(), rho);
   EXPECT_LT(rho, 1.0);
-  // Q's order is (p, q_x q_y q_z, v_b, ω): 102·W_ξ of the NMPC without q_w, z raised to 9e5.
+  // Q's order is (p, q_x q_y q_z, v_b, ω): 102·W_ξ of the NMPC's own stage weights without
+  // q_w, the z weight raised to 9e5.
+  const Eigen::VectorXd w_nmpc = CrazyflieTracking::stage_weights();
   Eigen::Matrix<double, 12, 1> w;
-  w << 120, 100, 100, 1e-3, 1e-3, 1e-3, 0.7, 1, 4, 1e-5, 1e-5, 10;
+  w << w_nmpc.head<3>(), w_nmpc.segment<9>(4);
   Eigen::Matrix<double, 12, 1> q = TrackingLqr::q_diagonal();
-  q(2) = 102 * 100;
+  EXPECT_EQ(q(2), 9e5);
+  q(2) = 102 * w(2);
   EXPECT_LE(((q - 102 * w).array().abs() / q.array()).maxCoeff(), 1e-12);
 }
 
@@ -310,6 +314,164 @@ TEST(TrackingMode, ShippedScenariosFly) {
     EXPECT_GT(rms, 0.0) << path;
     EXPECT_LT(rms, 0.02) << path;  // centimetre tracking with the predictor at RTT 60 ms
   }
+}
+
+// The value of the telemetry channel `name`; NaN when there is none.
+double channel(const Telemetry& s, const char* name) {
+  for (int i = 0; i < s.num_channels; ++i)
+    if (std::string(s.channels[std::size_t(i)].name) == name) return s.channels[std::size_t(i)].value;
+  return std::nan("");
+}
+
+double metric(const Metrics& metrics, const std::string& name) {
+  for (const auto& [k, v] : metrics)
+    if (k == name) return v;
+  return std::nan("");
+}
+
+// The telemetry is on the controller's clock: step k reports x(σ = t_k), the state the error
+// sample m = k is taken from. So the errors of the telemetry, with the last sample (m = K, after
+// the last step), give the run's RMS and maximum, for every split of the RTT (the state is known
+// before (n_c < s), at (n_c = 0) or after (n_c > s) the step's own boundary).
+TEST(TrackingMode, TelemetryIsOnTheControllersClock) {
+  TrackingScenario base = load(kStep);
+  base.duration = 1.5;
+  base.plant.rtt = 0.06;
+  const OcpTrajectory ref = base.reference_trajectory;
+  const long last = long(ref.x.size()) - 1;
+  for (const double fraction : {0.0, 0.5, 0.9, 1.0}) {
+    TrackingScenario sc = base;
+    sc.plant.measurement_fraction = fraction;
+    TrackingMode mode;
+    const SetupResult setup = mode.setup(sc);
+    ASSERT_TRUE(setup.ok()) << setup.reason();
+    const int N = sc.controller.N;
+    EXPECT_EQ(mode.steps_total(), 100);
+    EXPECT_FALSE(mode.telemetry().solved);
+    EXPECT_EQ(mode.telemetry().x, mode.telemetry().x_measured);  // at rest before the start
+    double sum2 = 0.0, max_e = 0.0, worst_x0 = 0.0, worst_node0 = 0.0;
+    long k = 0;
+    while (mode.step()) {
+      const Telemetry& s = mode.telemetry();
+      ASSERT_EQ(s.step, k);
+      EXPECT_EQ(s.t, double(k) * sc.controller.dt);
+      EXPECT_TRUE(s.solved);
+      EXPECT_EQ(s.events, 0u);
+      const Eigen::Vector3d pr = ref.x[std::size_t(std::min(k, last))].head<3>();
+      EXPECT_EQ(Eigen::Vector3d(s.reference), pr);
+      const double e = (Eigen::Vector3d(s.x.head<3>()) - pr).norm();
+      EXPECT_EQ(channel(s, "tracking error"), e);
+      sum2 += e * e;
+      max_e = std::max(max_e, e);
+      // The controller starts from the prediction of x(σ = t_k), its plan from there.
+      worst_x0 = std::max(worst_x0, (s.x - s.x_measured).lpNorm<Eigen::Infinity>());
+      ASSERT_EQ(s.predicted.cols(), N + 1);
+      ASSERT_EQ(s.predicted_reference.cols(), N + 1);
+      worst_node0 = std::max(worst_node0, (s.predicted.col(0) - s.x_measured.head<3>()).norm());
+      EXPECT_EQ(Eigen::Vector3d(s.predicted_reference.col(N)),
+                Eigen::Vector3d(ref.x[std::size_t(std::min(k + N, last))].head<3>()));
+      for (int i = 0; i < 4; ++i)
+        EXPECT_EQ(channel(s, (std::string("rotor speed ") + char('1' + i)).c_str()), s.u(i));
+      EXPECT_EQ(channel(s, "RTI time"), s.stats.total_us);
+      ++k;
+    }
+    EXPECT_TRUE(mode.finished());
+    EXPECT_FALSE(mode.lost());
+    EXPECT_EQ(mode.lost_at(), -1.0);
+    EXPECT_EQ(k, mode.steps_total());
+    EXPECT_FALSE(mode.step());
+    EXPECT_EQ(mode.steps_done(), k);
+    EXPECT_LE(worst_x0, 1e-12) << fraction;
+    EXPECT_LE(worst_node0, 1e-9) << fraction;  // x_0 = x̄_0 to the QP's rounding
+    const TrackingResult r = mode.result();
+    const double e_K = r.final_error_m;
+    EXPECT_NEAR(std::sqrt((sum2 + e_K * e_K) / double(k + 1)), r.tracking_rms_m,
+                1e-12 * r.tracking_rms_m) << fraction;
+    EXPECT_EQ(std::max(max_e, e_K), r.max_error_m) << fraction;
+    EXPECT_EQ(metric(mode.metrics(), "tracking_rms_m"), r.tracking_rms_m);
+  }
+}
+
+// The LQR: no plan, its law timed as the controller; the bound is reached on the smooth step (the
+// feedforward of the saturated start), clipped, and the step is still flown.
+TEST(TrackingMode, LqrSaturatesAndTracks) {
+  TrackingScenario sc = load(kStep);
+  sc.controller.kind = TrackingControllerKind::lqr;
+  sc.controller.compensation = false;
+  sc.plant.rtt = 0.0;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  const double u_max = models::Crazyflie{}.p.omega_max, u_min = models::Crazyflie{}.p.omega_min;
+  int saturated = 0;
+  while (mode.step()) {
+    const Telemetry& s = mode.telemetry();
+    EXPECT_FALSE(s.solved);
+    EXPECT_EQ(s.predicted.cols(), 0);
+    EXPECT_EQ(channel(s, "LQR time"), s.stats.total_us);
+    EXPECT_EQ(channel(s, "compensation"), 0.0);
+    EXPECT_EQ(channel(s, "rotor speed bound"), u_max);
+    if (s.u.maxCoeff() == u_max || s.u.minCoeff() == u_min) ++saturated;
+  }
+  EXPECT_GT(saturated, 0);
+  const TrackingResult r = mode.result();
+  EXPECT_FALSE(r.lost);
+  EXPECT_EQ(r.max_input_violation, 0.0);
+  EXPECT_LT(r.final_error_m, 0.01);
+  const Metrics m = mode.metrics();
+  EXPECT_TRUE(std::isnan(metric(m, "fallbacks")));
+  EXPECT_EQ(metric(m, "lqr_median_us"), r.solve_median_us);
+}
+
+// Without compensation the NMPC loses the vehicle at 60 ms RTT: the step that finds it lost
+// reports it, hands out finite states only, and the run is over.
+TEST(TrackingMode, LostRunEndsWithTheEvent) {
+  TrackingScenario sc = load(kStep);
+  sc.plant.rtt = 0.06;
+  sc.controller.compensation = false;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  std::uint32_t events = 0;
+  while (mode.step()) {
+    EXPECT_EQ(events & kEventLost, 0u);  // only the last step reports it
+    events = mode.telemetry().events;
+    EXPECT_TRUE(mode.telemetry().x.allFinite());
+  }
+  EXPECT_NE(events & kEventLost, 0u);
+  EXPECT_TRUE(mode.lost());
+  EXPECT_TRUE(mode.finished());
+  EXPECT_FALSE(mode.step());
+  EXPECT_LT(mode.steps_done(), mode.steps_total());
+  const double t_last = mode.telemetry().t;
+  EXPECT_GT(mode.lost_at(), 0.0);
+  EXPECT_LE(mode.lost_at(), t_last + sc.controller.dt);
+  const Metrics m = mode.metrics();
+  EXPECT_EQ(metric(m, "lost"), 1.0);
+  EXPECT_EQ(metric(m, "steps"), double(mode.steps_done()));
+}
+
+TEST(TrackingMode, SetupFailsWithTheReason) {
+  TrackingScenario sc = load(kStep);
+  TrackingMode mode;
+  TrackingScenario no_ref = sc;
+  no_ref.reference_trajectory = OcpTrajectory{};
+  SetupResult r = mode.setup(no_ref);
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.reason(), "no reference trajectory");
+  EXPECT_TRUE(mode.finished());
+  EXPECT_FALSE(mode.step());
+  TrackingScenario no_horizon = sc;
+  no_horizon.controller.N = 0;
+  r = mode.setup(no_horizon);
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.reason(), "the tracking NMPC cannot be set up: the OCP is invalid: N must be at least 1");
+  EXPECT_FALSE(mode.step());
+  // A failed setup does not stay: the next one flies.
+  sc.duration = 0.15;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  int steps = 0;
+  while (mode.step()) ++steps;
+  EXPECT_EQ(steps, 10);
+  EXPECT_EQ(run_tracking(no_ref).error, "no reference trajectory");
 }
 
 // Header every inline case starts from (4 lines: the case's own lines are 5, 6, ...).

@@ -2,7 +2,7 @@
 
 #include "core/modes/obstacle_mode.hpp"
 #include "core/modes/pendubot_swingup.hpp"
-#include "core/modes/tracking.hpp"
+#include "core/modes/tracking_mode.hpp"
 
 
 namespace mixpilot {

@@ -143,7 +143,7 @@ inline constexpr double kGravity = 9.81;        // [m/s²], thrown balls
 inline constexpr double kViolationTolerance = 1e-3;  // a violation is ‖p − o‖ < d_C − 1 mm
 }  // namespace obstacle_defaults
 
-// Crazyflie tracking under delay, SPEC §5.2 (core/modes/tracking.hpp).
+// Crazyflie tracking under delay, SPEC §5.2 (core/control/tracking.hpp).
 namespace tracking_defaults {
 inline constexpr int kHorizon = 50;                 // N
 inline constexpr double kDt = 0.015;                // [s]

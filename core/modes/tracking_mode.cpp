@@ -1,0 +1,406 @@
+#include "core/modes/tracking_mode.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "core/numerics/stats.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+// Channel slots of the tracking telemetry.
+enum TrackingChannel {
+  kTrackingError,
+  kRtt,
+  kPredictorTime,
+  kControllerTime,
+  kRotorSpeed1,  // .. kRotorSpeed1 + 3
+  kRotorSpeedBound = kRotorSpeed1 + 4,
+  kCompensation,
+};
+
+constexpr const char* kRotorSpeedNames[4] = {"rotor speed 1", "rotor speed 2", "rotor speed 3",
+                                             "rotor speed 4"};
+
+double microseconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// ‖p − p_ref‖ on 3-vectors: the error of a sample and of the telemetry, evaluated alike.
+double position_error(const Eigen::Vector3d& p, const Eigen::Vector3d& p_ref) {
+  return (p - p_ref).norm();
+}
+
+}  // namespace
+
+SetupResult TrackingMode::setup(TrackingScenario scenario) {
+  scenario_ = std::move(scenario);
+  ok_ = lost_ = false;
+  finished_ = true;  // until setup succeeds
+  lost_at_ = -1.0;
+  step_ = steps_total_ = 0;
+  problem_.reset();
+  rti_.reset();
+  const TrackingControllerSettings& c = scenario_.controller;
+  const TrackingPlantSettings& pl = scenario_.plant;
+  const OcpTrajectory& ref = scenario_.reference_trajectory;
+  if (ref.x.empty() || ref.u.empty()) return SetupResult::failure("no reference trajectory");
+  if (!(c.dt > 0.0) || !(pl.rate_hz > 0.0) || !(scenario_.duration > 0.0))
+    return SetupResult::failure("controller.dt, plant.rate_hz and duration must be positive");
+  s_ = std::max(1L, std::lround(c.dt * pl.rate_hz));
+  h_ = c.dt / double(s_);
+  n_r_ = std::lround(pl.rtt * pl.rate_hz);
+  n_m_ = std::lround(pl.measurement_fraction * double(n_r_));
+  n_c_ = n_r_ - n_m_;
+  if (n_r_ < 0 || n_m_ < 0 || n_c_ < 0)
+    return SetupResult::failure("plant.rtt must be >= 0 and plant.measurement_fraction in [0, 1]");
+  steps_total_ = std::max(1L, std::lround(scenario_.duration / c.dt));
+  last_x_ = long(ref.x.size()) - 1;
+  last_u_ = long(ref.u.size()) - 1;
+
+  model_ = models::Crazyflie{};
+  plant_ = IntegratorErk4<models::Crazyflie>(model_);
+  if (c.kind == TrackingControllerKind::nmpc) {
+    problem_ = std::make_unique<CrazyflieTracking>(c.N, c.dt, model_);
+    rti_ = std::make_unique<RtiSolver>();
+    if (SetupResult r = rti_->setup(problem_->ocp()); !r)
+      return SetupResult::failure("the tracking NMPC cannot be set up: " + r.reason());
+    problem_->hover_guess(rti_->trajectory(), pl.start);
+    problem_->set_reference(rti_->data(), ref, 0);  // for the telemetry before the first step
+  } else if (SetupResult r = lqr_.setup(model_, c.dt); !r) {
+    return r;
+  }
+  predictor_.setup(model_, int(s_), h_, int(n_r_));
+
+  // Ring sizes. States: step k reads boundary k·s − n_m and then integrates at most to
+  // (k+1)·s + n_c while boundaries from k·s on are still needed: n_r + s + 1 boundaries.
+  // Commands: the substeps integrated in step k use commands k − ⌈n_c/s⌉ .. k.
+  x_init_ = model_.hover_state(pl.start);
+  states_.assign(std::size_t(n_r_ + s_ + 1), x_init_);
+  cmds_.assign(std::size_t((n_c_ + s_ - 1) / s_ + 2), Input::Zero());
+  j_sim_ = j_ = 0;
+  j_lost_ = -1;
+  y_ = x0_ = x_init_;
+  u_ = model_.hover_input();
+
+  ref_start_ = ref.x.front().head<3>();
+  ref_target_ = ref.x.back().head<3>();
+  const Eigen::Vector3d step = ref_target_ - ref_start_;
+  step_len_ = step.norm();
+  step_dir_ = step_len_ > 0 ? Eigen::Vector3d(step / step_len_) : Eigen::Vector3d::Zero();
+  max_error_ = final_error_ = max_progress_ = max_input_violation_ = 0.0;
+  err2_.clear();
+  err2_.reserve(std::size_t(steps_total_) + 1);
+  last_outside_ = -1;
+  solve_us_.clear();
+  solve_us_.reserve(std::size_t(steps_total_));
+  predict_us_.clear();
+  predict_us_.reserve(std::size_t(steps_total_));
+  if (n_c_ == 0) sample(0, x_init_);  // boundary 0 is σ = t_0
+
+  init_telemetry();
+  ok_ = true;
+  finished_ = false;
+  return {};
+}
+
+// Before the first step: the vehicle at rest, x(σ = 0) = x0 = the initial state, the hover
+// input; the NMPC's plan is its initial guess.
+void TrackingMode::init_telemetry() {
+  const int nodes = problem_ ? scenario_.controller.N + 1 : 0;
+  telemetry_ = Telemetry{};
+  telemetry_.mode = ModeKind::crazyflie_tracking;
+  telemetry_.x = x_init_;
+  telemetry_.x_measured = x_init_;
+  telemetry_.u = u_;
+  telemetry_.reference = Eigen::VectorXd::Zero(3);
+  telemetry_.predicted.setZero(3, nodes);
+  telemetry_.predicted_reference.setZero(3, nodes);
+  for (int i = 0; i < nodes; ++i) {
+    telemetry_.predicted.col(i) = rti_->trajectory().x[std::size_t(i)].head<3>();
+    telemetry_.predicted_reference.col(i) = rti_->data().yref[std::size_t(i)].head<3>();
+  }
+  set_telemetry();
+  set_channels(0.0, 0.0);
+}
+
+// y = the state of boundary k·s − n_m (the initial state before the start), then x0: its
+// prediction over τ_r, or y itself.
+void TrackingMode::measure() {
+  const long b = long(step_) * s_ - n_m_;
+  y_ = b <= 0 ? x_init_ : states_[ring(b)];
+  const auto t0 = std::chrono::steady_clock::now();
+  if (scenario_.controller.compensation) {
+    predictor_.predict(y_, x0_);
+  } else {
+    x0_ = y_;
+  }
+  predict_us_.push_back(microseconds_since(t0));
+}
+
+// u_k from x0: one RTI step (its plan kept for the telemetry before the shift), or the LQR law.
+void TrackingMode::control() {
+  const long k = long(step_);
+  const OcpTrajectory& ref = scenario_.reference_trajectory;
+  Telemetry& s = telemetry_;
+  if (problem_) {
+    RtiSolver& rti = *rti_;
+    problem_->set_reference(rti.data(), ref, int(k));
+    rti.prepare();
+    rti.feedback(x0_);
+    u_ = rti.control();
+    s.solved = true;
+    s.stats = rti.stats();
+    for (int i = 0; i <= scenario_.controller.N; ++i) {
+      s.predicted.col(i) = rti.trajectory().x[std::size_t(i)].head<3>();
+      s.predicted_reference.col(i) = rti.data().yref[std::size_t(i)].head<3>();
+    }
+    rti.shift();
+    solve_us_.push_back(s.stats.total_us);
+  } else {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Eigen::VectorXd& xr = ref.x[std::size_t(std::min(k, last_x_))];
+    lqr_.control(x0_, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), u_);
+    const double us = microseconds_since(t0);
+    s.solved = false;
+    s.stats = RtiStats{};
+    s.stats.total_us = us;
+    solve_us_.push_back(us);
+  }
+}
+
+// u_k leaves: into the predictor's and the plant's command rings.
+void TrackingMode::send() {
+  max_input_violation_ = std::max({max_input_violation_, model_.p.omega_min - u_.minCoeff(),
+                                   u_.maxCoeff() - model_.p.omega_max});
+  predictor_.record_sent(u_);
+  cmds_[std::size_t(step_ % std::int64_t(cmds_.size()))] = u_;
+}
+
+// RK4 substeps up to boundary `end`, each with the command on the rotors during it (none before
+// the first command arrives at boundary n_c: the vehicle rests).
+void TrackingMode::integrate_to(long end) {
+  while (j_sim_ < end) {
+    const long m = floor_div(j_sim_ - n_c_, s_);
+    const State& x = states_[ring(j_sim_)];
+    State& xn = states_[ring(j_sim_ + 1)];
+    if (m >= 0) {
+      plant_.step<double>(x, cmds_[std::size_t(m % long(cmds_.size()))], h_, xn);
+    } else {
+      xn = x;
+    }
+    ++j_sim_;
+  }
+}
+
+// Checks and samples the boundaries up to `end` (integrated already); false at the first one
+// where the vehicle is lost: not finite, or outside the kLostRadius ball around its start.
+bool TrackingMode::process_to(long end) {
+  const Eigen::Vector3d& start = scenario_.plant.start;
+  while (j_ < end) {
+    ++j_;
+    const State& x = states_[ring(j_)];
+    if (!x.allFinite() || (x.head<3>() - start).norm() > tracking_defaults::kLostRadius) {
+      j_lost_ = j_;
+      return false;
+    }
+    if (j_ >= n_c_ && (j_ - n_c_) % s_ == 0) sample((j_ - n_c_) / s_, x);
+  }
+  return true;
+}
+
+// Error sample m: x = x(σ = t_m) against p_ref(t_m) (the last node held).
+void TrackingMode::sample(long m, const State& x) {
+  const OcpTrajectory& ref = scenario_.reference_trajectory;
+  const Eigen::Vector3d p = x.head<3>();
+  const Eigen::Vector3d pr = ref.x[std::size_t(std::min(m, last_x_))].head<3>();
+  const double e = position_error(p, pr);
+  err2_.push_back(e * e);
+  max_error_ = std::max(max_error_, e);
+  final_error_ = e;
+  if (scenario_.reference.kind == TrackingReferenceKind::smooth_step) {
+    max_progress_ = std::max(max_progress_, (p - ref_start_).dot(step_dir_));
+    if ((p - ref_target_).norm() > tracking_defaults::kSettleRadius) last_outside_ = m;
+  }
+}
+
+bool TrackingMode::step() {
+  if (finished_) return false;
+  const long k = long(step_);
+  measure();
+  control();
+  send();
+  // The plant to the next control boundary; after the last step on to K·s + n_c (sample K).
+  const long end = (k + 1) * s_ + (k + 1 == steps_total_ ? n_c_ : 0);
+  integrate_to(std::max(end, k * s_ + n_c_));
+  const bool alive = process_to(end);
+  if (!alive) {
+    lost_ = true;
+    lost_at_ = double(j_lost_ - n_c_) * h_;
+  }
+  set_telemetry();
+  set_channels(predict_us_.back(), solve_us_.back());
+  ++step_;
+  finished_ = lost_ || step_ >= steps_total_;
+  return true;
+}
+
+// Step k's telemetry on the controller's clock: x(σ = t_k), boundary k·s + n_c (when the vehicle
+// is lost before it, the last state inside the world), x0, u_k, p_ref(t_k).
+void TrackingMode::set_telemetry() {
+  const long k = long(step_);
+  Telemetry& s = telemetry_;
+  s.step = step_;
+  s.t = double(k) * scenario_.controller.dt;
+  long jx = k * s_ + n_c_;
+  if (j_lost_ >= 0 && jx >= j_lost_) jx = j_lost_ - 1;
+  s.x = states_[ring(jx)];
+  s.x_measured = x0_;
+  s.u = u_;
+  const Eigen::VectorXd& xr = scenario_.reference_trajectory.x[std::size_t(std::min(k, last_x_))];
+  for (int i = 0; i < 3; ++i) s.reference(i) = xr(i);
+  s.events = 0;
+  if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
+  if (lost_) s.events |= kEventLost;
+}
+
+void TrackingMode::set_channels(double predictor_us, double controller_us) {
+  Telemetry& s = telemetry_;
+  const Eigen::Vector3d p = s.x.head<3>(), pr = s.reference.head<3>();
+  s.set_channel(kTrackingError, "tracking error", "m", position_error(p, pr));
+  s.set_channel(kRtt, "RTT", "s", scenario_.plant.rtt);
+  s.set_channel(kPredictorTime, "predictor time", "us", predictor_us);
+  s.set_channel(kControllerTime, nmpc() ? "RTI time" : "LQR time", "us", controller_us);
+  for (int i = 0; i < 4; ++i) s.set_channel(kRotorSpeed1 + i, kRotorSpeedNames[i], "krpm", s.u(i));
+  s.set_channel(kRotorSpeedBound, "rotor speed bound", "krpm", model_.p.omega_max);
+  s.set_channel(kCompensation, "compensation", "", scenario_.controller.compensation ? 1.0 : 0.0);
+}
+
+TrackingResult TrackingMode::result() const {
+  TrackingResult r;
+  r.ok = ok_;
+  r.lost = lost_;
+  r.steps = int(step_);
+  // Squares rounded one by one, then summed in order: a running sum would let the compiler
+  // fuse each square into the addition (FMA) and round differently.
+  double sum = 0.0;
+  for (double e2 : err2_) sum += e2;
+  r.tracking_rms_m = err2_.empty() ? 0.0 : std::sqrt(sum / double(err2_.size()));
+  r.max_error_m = max_error_;
+  r.final_error_m = final_error_;
+  if (scenario_.reference.kind == TrackingReferenceKind::smooth_step) {
+    r.overshoot_m = std::max(0.0, max_progress_ - step_len_);
+    r.settle_time_s = double(last_outside_ + 1) * scenario_.controller.dt;
+  }
+  r.max_input_violation = max_input_violation_;
+  r.solve_median_us = percentile(solve_us_, 0.5);
+  r.solve_p99_us = percentile(solve_us_, 0.99);
+  r.predictor_median_us = scenario_.controller.compensation ? percentile(predict_us_, 0.5) : 0.0;
+  r.fallbacks = rti_ ? long(rti_->stats().fallbacks) : 0;
+  r.rtt_substeps = int(n_r_);
+  r.measurement_substeps = int(n_m_);
+  r.command_substeps = int(n_c_);
+  return r;
+}
+
+Metrics TrackingMode::metrics() const {
+  const TrackingResult r = result();
+  const bool rti = nmpc();
+  Metrics m;
+  m.emplace_back("tracking_rms_m", r.tracking_rms_m);
+  m.emplace_back("max_error_m", r.max_error_m);
+  m.emplace_back("final_error_m", r.final_error_m);
+  if (scenario_.reference.kind == TrackingReferenceKind::smooth_step) {
+    m.emplace_back("overshoot_m", r.overshoot_m);
+    m.emplace_back("settle_time_s", r.settle_time_s);
+  }
+  m.emplace_back(rti ? "rti_median_us" : "lqr_median_us", r.solve_median_us);
+  m.emplace_back(rti ? "rti_p99_us" : "lqr_p99_us", r.solve_p99_us);
+  if (rti) m.emplace_back("fallbacks", double(r.fallbacks));
+  m.emplace_back("predictor_median_us", r.predictor_median_us);
+  m.emplace_back("max_input_violation", r.max_input_violation);
+  m.emplace_back("rtt_s", scenario_.plant.rtt);
+  m.emplace_back("compensation", scenario_.controller.compensation ? 1.0 : 0.0);
+  m.emplace_back("steps", double(r.steps));
+  m.emplace_back("lost", r.lost ? 1.0 : 0.0);
+  return m;
+}
+
+std::string TrackingMode::summary() const {
+  const TrackingResult r = result();
+  const bool rti = nmpc();
+  const bool step = scenario_.reference.kind == TrackingReferenceKind::smooth_step;
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "mixpilot fly: %s (crazyflie_tracking, %s, %s, RTT %.0f ms, compensation %s)\n"
+                "  %d steps; tracking RMS %.4f m, max %.4f m, final %.4f m",
+                scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
+                1e3 * scenario_.plant.rtt, scenario_.controller.compensation ? "on" : "off",
+                r.steps, r.tracking_rms_m, r.max_error_m, r.final_error_m);
+  std::string out = buf;
+  if (step) {
+    std::snprintf(buf, sizeof buf, "; overshoot %.4f m, settled at %.2f s", r.overshoot_m,
+                  r.settle_time_s);
+    out += buf;
+  }
+  const std::string fallbacks = rti ? ", " + std::to_string(r.fallbacks) + " fallbacks" : "";
+  std::snprintf(buf, sizeof buf, "\n  %s median %.0f us, p99 %.0f us%s; predictor median %.1f us%s\n",
+                rti ? "RTI" : "LQR", r.solve_median_us, r.solve_p99_us, fallbacks.c_str(),
+                r.predictor_median_us, r.lost ? "\n  the vehicle was lost" : "");
+  out += buf;
+  return out;
+}
+
+TrackingResult run_tracking(const TrackingScenario& scenario, TrackingLog* log) {
+  TrackingMode mode;
+  if (SetupResult r = mode.setup(scenario); !r) {
+    TrackingResult res;
+    res.error = r.reason();
+    return res;
+  }
+  if (log) {
+    *log = TrackingLog{};
+    const std::size_t n = std::size_t(mode.steps_total());
+    log->t.reserve(n);
+    log->p.reserve(n);
+    log->p_ref.reserve(n);
+    log->x_true.reserve(n);
+    log->x0.reserve(n);
+    log->u.reserve(n);
+  }
+  while (mode.step()) {
+    if (!log) continue;
+    const Telemetry& s = mode.telemetry();
+    log->t.push_back(s.t);
+    log->p.push_back(s.x.head<3>());
+    log->p_ref.push_back(s.reference.head<3>());
+    log->x_true.push_back(s.x);
+    log->x0.push_back(s.x_measured);
+    log->u.push_back(s.u);
+  }
+  return mode.result();
+}
+
+ModeResult fly_crazyflie_tracking(const std::string& path, const ModeOptions& options) {
+  ModeResult out;
+  std::optional<TrackingScenario> sc = load_tracking_scenario(path, out.error);
+  if (!sc) return out;
+  if (options.duration) sc->duration = *options.duration;
+  TrackingMode mode;
+  if (SetupResult r = mode.setup(std::move(*sc)); !r) {
+    out.error = path + ": " + r.reason();
+    return out;
+  }
+  while (mode.step()) {
+  }
+  out.metrics = mode.metrics();
+  out.summary = mode.summary();
+  out.ok = true;
+  return out;
+}
+
+}  // namespace mixpilot

@@ -1,0 +1,175 @@
+#pragma once
+// Crazyflie position tracking under a communication round-trip delay (SPEC §5.2, thesis ch. 5):
+// mode `crazyflie_tracking`. The delay model, the predictor and the controllers are in
+// core/control/tracking.hpp; the scenario file in core/scenario/tracking_scenario.hpp.
+//
+// Clocks. On the controller's clock σ = t − τ_c (the time a command was sent), the plant state
+// when u_k starts acting is x(σ = t_k), and the measurement at t_k is x(σ = t_k − τ_r): the
+// closed loop depends on τ_r only. Tracking errors are taken on that clock, e_k = p(t_k + τ_c)
+// − p_ref(t_k): the command link's transport lag itself is not an error (a reference on the
+// controller's clock cannot reach the vehicle sooner), so runs with different splits agree. The
+// telemetry is on the same clock: step k reports x(σ = t_k), the controller's initial state x0
+// (the prediction of x(σ = t_k) when compensating, else the measurement), u_k and p_ref(t_k).
+//
+// Step k: measure the state of plant boundary k·s − n_m, predict it over τ_r (timed), run the
+// NMPC (one RTI step) or the LQR law, send u_k, and simulate the plant to boundary (k+1)·s, where
+// the loss check and the error samples are taken. After the last step the plant runs on to
+// K·s + n_c, so the last command's effect is sampled (m = K). The plant is integrated ahead as
+// far as the commands already sent determine it (to k·s + n_c at least), so that x(σ = t_k) is
+// known when step k ends; integrating ahead changes no state.
+//
+// setup() sizes everything; step() allocates nothing.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/control/crazyflie_tracking.hpp"
+#include "core/control/tracking.hpp"
+#include "core/modes/mode.hpp"
+#include "core/nlp/rti.hpp"
+#include "core/numerics/integrator_erk4.hpp"
+#include "core/numerics/setup_result.hpp"
+#include "core/scenario/tracking_scenario.hpp"
+#include "models/crazyflie.hpp"
+
+namespace mixpilot {
+
+// The run's results so far (TrackingMode::result()).
+struct TrackingResult {
+  bool ok = false;      // the run happened (false: setup failed; see error)
+  std::string error;
+  bool lost = false;    // the plant state stopped being finite or left a 100 m ball
+  int steps = 0;
+  double tracking_rms_m = 0;  // RMS over the samples m of ‖e_m‖
+  double max_error_m = 0;
+  double final_error_m = 0;   // ‖e‖ of the last sample
+  // Smooth step only: with d the unit step direction and L the step length, the overshoot is
+  // max(0, max_m (p_m − p_start)·d − L), the progress past the target along the step; the
+  // settle time is the first σ after which ‖p − target‖ ≤ kSettleRadius for good.
+  double overshoot_m = 0;
+  double settle_time_s = 0;
+  double max_input_violation = 0;  // max over k of the applied input outside [0, 22] krpm
+  double solve_median_us = 0;      // controller (RTI prepare + feedback, or LQR law)
+  double solve_p99_us = 0;
+  double predictor_median_us = 0;  // 0 without compensation
+  long fallbacks = 0;              // RTI fallbacks (SPEC §4)
+  int rtt_substeps = 0;
+  int measurement_substeps = 0;
+  int command_substeps = 0;
+};
+
+class TrackingMode final : public Mode {
+ public:
+  using State = models::Crazyflie::State;
+  using Input = models::Crazyflie::Input;
+
+  TrackingMode() = default;
+  TrackingMode(const TrackingMode&) = delete;  // the RTI solver points into problem_
+  TrackingMode& operator=(const TrackingMode&) = delete;
+
+  // Prepares a flight of `scenario`. Fails with the reason when there is no reference or the
+  // controller cannot be set up (invalid OCP, a Riccati equation that does not converge).
+  SetupResult setup(TrackingScenario scenario);
+
+  ModeKind kind() const override { return ModeKind::crazyflie_tracking; }
+  const std::string& scenario_name() const override { return scenario_.name; }
+  double dt() const override { return scenario_.controller.dt; }
+  std::int64_t steps_total() const override { return steps_total_; }
+  std::int64_t steps_done() const override { return step_; }
+  [[nodiscard]] bool step() override;
+  bool finished() const override { return finished_; }
+  bool lost() const override { return lost_; }
+  double lost_at() const override { return lost_at_; }  // σ of the boundary found lost, or −1
+  const Telemetry& telemetry() const override { return telemetry_; }
+  // tracking_rms_m, max_error_m, final_error_m, [overshoot_m, settle_time_s: smooth step],
+  // rti_median_us, rti_p99_us, fallbacks (NMPC) or lqr_median_us, lqr_p99_us (LQR),
+  // predictor_median_us, max_input_violation, rtt_s, compensation, steps, lost.
+  Metrics metrics() const override;
+  std::string summary() const override;
+
+  TrackingResult result() const;
+  const TrackingScenario& scenario() const { return scenario_; }
+  bool nmpc() const { return problem_ != nullptr; }
+
+ private:
+  std::size_t ring(long j) const { return std::size_t(j % long(states_.size())); }
+  void measure();
+  void control();
+  void send();
+  void integrate_to(long end);
+  bool process_to(long end);
+  void sample(long m, const State& x);
+  void init_telemetry();
+  void set_telemetry();
+  void set_channels(double predictor_us, double controller_us);
+
+  TrackingScenario scenario_;
+  models::Crazyflie model_{};
+  IntegratorErk4<models::Crazyflie> plant_{};
+  std::unique_ptr<CrazyflieTracking> problem_;  // NMPC only
+  std::unique_ptr<RtiSolver> rti_;              // NMPC only
+  TrackingLqr lqr_;
+  DelayPredictor predictor_;
+
+  // Delay model in plant substeps (core/control/tracking.hpp).
+  long s_ = 1;    // substeps per control period
+  double h_ = 0;  // substep [s]
+  long n_r_ = 0, n_m_ = 0, n_c_ = 0;  // τ_r, τ_m, τ_c
+  long last_x_ = 0, last_u_ = 0;      // last reference node of x, of u
+
+  // Plant: states at substep boundaries j (ring, index j mod size), integrated up to j_sim_ and
+  // checked and sampled up to j_; the commands sent (ring, index k mod size).
+  std::vector<State> states_;
+  std::vector<Input> cmds_;
+  State x_init_ = State::Zero();
+  long j_sim_ = 0;
+  long j_ = 0;
+  long j_lost_ = -1;  // boundary found lost
+
+  // Step k: the measurement, the controller's initial state, the command.
+  State y_ = State::Zero();
+  State x0_ = State::Zero();
+  Input u_ = Input::Zero();
+
+  // Error samples m = 0..K at boundaries m·s + n_c (σ = t_m).
+  Eigen::Vector3d ref_start_ = Eigen::Vector3d::Zero();   // p_ref of the first node
+  Eigen::Vector3d ref_target_ = Eigen::Vector3d::Zero();  // p_ref of the last node
+  Eigen::Vector3d step_dir_ = Eigen::Vector3d::Zero();    // unit (target − start), or 0
+  double step_len_ = 0;
+  std::vector<double> err2_;  // ‖e_m‖² per sample, reserved for K + 1
+  double max_error_ = 0, final_error_ = 0;
+  double max_progress_ = 0;  // max_m (p_m − start)·dir
+  long last_outside_ = -1;   // last m outside the settle radius
+  double max_input_violation_ = 0;
+  std::vector<double> solve_us_;    // per step, reserved for steps_total
+  std::vector<double> predict_us_;  // per step, reserved for steps_total
+
+  Telemetry telemetry_;
+  std::int64_t step_ = 0;
+  std::int64_t steps_total_ = 0;
+  bool ok_ = false;  // setup succeeded
+  bool finished_ = true;
+  bool lost_ = false;
+  double lost_at_ = -1.0;
+};
+
+// Per control step k (optional log of a run), from the telemetry.
+struct TrackingLog {
+  std::vector<double> t;               // σ = t_k [s]
+  std::vector<Eigen::Vector3d> p;      // p(σ = t_k)
+  std::vector<Eigen::Vector3d> p_ref;  // p_ref(t_k)
+  std::vector<models::Crazyflie::State> x_true;  // x(σ = t_k): state when u_k starts acting
+  std::vector<models::Crazyflie::State> x0;      // the controller's initial state for u_k
+  std::vector<models::Crazyflie::Input> u;       // u_k
+};
+
+// Flies the scenario to its end. `log` (optional) receives one entry per control step.
+TrackingResult run_tracking(const TrackingScenario& scenario, TrackingLog* log = nullptr);
+
+// Legacy mode runner (core/modes/mode.hpp): TrackingMode's metrics and summary.
+ModeResult fly_crazyflie_tracking(const std::string& path, const ModeOptions& options);
+
+}  // namespace mixpilot
