@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -86,6 +87,15 @@ constexpr const char* kScoreUsage =
   std::exit(2);
 }
 
+// Where a recording's embedded scenario came from: its original file (absolute, as recorded),
+// so that paths inside it (reference trajectories) resolve as they did; else a label.
+std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path) {
+  const auto it = rec.metadata.find("scenario_path");
+  if (it != rec.metadata.end() && !it->second.empty() && it->second.front() == '/')
+    return it->second;
+  return path + " (embedded scenario)";
+}
+
 bool ends_with(std::string_view s, std::string_view suffix) {
   return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
 }
@@ -119,7 +129,8 @@ struct FlyOptions {
 // --pilot, and the mode it names.
 struct Flight {
   std::string scenario_text;
-  std::string scenario_source;
+  std::string scenario_source;  // for messages and relative paths
+  std::string scenario_file;    // the scenario's file, absolute (recorded as scenario_path)
   std::unique_ptr<Mode> mode;
   std::string pilot;  // mixed initiative: the pilot source's name
 };
@@ -134,9 +145,11 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error) {
   if (!o.scenario_path.empty()) {
     if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
     f.scenario_source = o.scenario_path;
+    f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
   } else if (recording) {
     f.scenario_text = recording->metadata["scenario"];
-    f.scenario_source = o.pilot + " (embedded scenario)";
+    f.scenario_source = embedded_scenario_source(*recording, o.pilot);
+    f.scenario_file = recording->metadata["scenario_path"];
   } else {
     usage_error("fly", "--scenario FILE is required");
   }
@@ -162,7 +175,7 @@ SessionInfo session_info(const Flight& f) {
   SessionInfo info;
   info.mode = to_string(f.mode->kind());
   info.scenario = f.scenario_text;
-  info.scenario_path = f.scenario_source;
+  info.scenario_path = f.scenario_file;
   info.pilot = f.pilot;
   if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
     info.seed = mi->scenario().plant.seed;
@@ -283,7 +296,7 @@ struct StateCompare final : TelemetrySink {
 // steps as were recorded.
 std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, std::string& error) {
-  const std::string source = path + " (embedded scenario)";
+  const std::string source = embedded_scenario_source(rec, path);
   const auto kind = scenario_mode(text, source, error);
   if (!kind) return nullptr;
   ModeRequest request;

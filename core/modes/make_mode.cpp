@@ -4,8 +4,10 @@
 
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/obstacle_mode.hpp"
+#include "core/modes/tracking_mode.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "core/scenario/tracking_scenario.hpp"
 
 namespace mixpilot {
 
@@ -67,8 +69,10 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
     case ModeKind::obstacle_avoidance:
       return make_solo_mode<ObstacleMode>(text, source_name, request, parse_obstacle_scenario,
                                           error);
-    case ModeKind::pendubot_swingup:
-    case ModeKind::crazyflie_tracking: break;
+    case ModeKind::crazyflie_tracking:
+      return make_solo_mode<TrackingMode>(text, source_name, request, parse_tracking_scenario,
+                                          error);
+    case ModeKind::pendubot_swingup: break;
   }
   error = source_name + ": mode \"" + *name + "\" cannot be stepped yet";
   return nullptr;
