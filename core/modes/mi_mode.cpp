@@ -85,6 +85,14 @@ void MiMode::plant_step(const Eigen::VectorXd& u) {
   x_ = x;
 }
 
+// Lost: a non-finite state, or farther than mi_defaults::kLostMargin outside the arena.
+bool MiMode::left_the_world() const {
+  if (!x_.allFinite()) return true;
+  const Arena& a = scenario_.arena;
+  const Eigen::Vector3d p = x_.head<3>();
+  return (p - p.cwiseMax(a.min).cwiseMin(a.max)).norm() > mi_defaults::kLostMargin;
+}
+
 // η^r(t), element by element: GCC 12 takes Eigen's packet copy of a Vector3d into a VectorXd
 // for an out-of-bounds read (-Warray-bounds).
 void MiMode::set_reference(double t) {
@@ -150,10 +158,10 @@ bool MiMode::step() {
 
   plant_step(s.u);
   ++step_;
-  if (!x_.allFinite()) {  // never hand a non-finite state to anyone
-    x_ = s.x;
+  if (left_the_world()) {
+    if (!x_.allFinite()) x_ = s.x;  // never hand a non-finite state to anyone
     lost_ = finished_ = true;
-    lost_at_ = t;
+    lost_at_ = double(step_) * dt_;
     s.events |= kEventLost;
   }
   if (step_ >= steps_total_) finished_ = true;
@@ -176,7 +184,13 @@ std::string MiMode::summary() const {
                 s.max_deviation_m, s.rms_deviation_m, 100.0 * s.time_in_ball, 100.0 * s.progress,
                 s.collisions, s.min_clearance_m, s.override_rms, s.skill);
   std::string out = buf;
-  if (lost_) out += "  the vehicle was lost: the plant state stopped being finite\n";
+  if (lost_) {
+    std::snprintf(buf, sizeof buf,
+                  "  the vehicle was lost at t = %.3f s: it left the arena by more than %.1f m or "
+                  "its state stopped being finite\n",
+                  lost_at_, mi_defaults::kLostMargin);
+    out += buf;
+  }
   return out;
 }
 

@@ -52,6 +52,7 @@ class MiMode final : public Mode {
   const Eigen::VectorXd& state() const { return x_; }
 
  private:
+  bool left_the_world() const;
   void measure(double t);
   void set_reference(double t);
   void set_channels();

@@ -124,6 +124,8 @@ inline constexpr double kSlackL2 = 1e2;
 // Back-off of the rotor-speed bounds: RTI meets them for the linearized prediction, and the
 // C_D Ω² term adds up to C_D ΔΩ² Δt / J_m ≈ 1e-3 in one step, so the plant keeps its bounds.
 inline constexpr double kRotorSpeedBackoff = 1e-3;
+// A vehicle farther than this outside the arena's box is lost: the flight ends there [m].
+inline constexpr double kLostMargin = 1.0;
 }  // namespace mi_defaults
 
 // Obstacle avoidance with the LCL constraint, SPEC §5.3 (thesis ch. 6).

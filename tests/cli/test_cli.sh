@@ -45,7 +45,35 @@ check "truncated recording error names a byte offset" grep -q "byte" "$work/cut.
 "$mixpilot" fly --pilot "$work/novice.mcap" --headless >"$work/replay.out" 2>&1
 check "fly --pilot REC.mcap replays with the embedded scenario" test $? -eq 0
 
+# fly --pilot REC replays the recording at its own length: the same score as `score`, exactly.
+"$mixpilot" fly --pilot "$work/novice.mcap" --headless --report "$work/replay.json" >"$work/replay2.out" 2>&1
+check "fly --pilot REC exits 0" test $? -eq 0
+check "fly --pilot REC says the replay is exact" grep -q "replay exact" "$work/replay2.out"
+check "fly --pilot REC and score give the same score" diff <(fields "$work/replay.json" | grep -v _us) <(fields "$work/score.json" | grep -v _us)
+"$mixpilot" fly --pilot "$work/novice.mcap" --scenario "$src/scenarios/mi_helix_slow.toml" --headless >"$work/e6" 2>&1
+check "a --scenario other than the embedded one exits 3" test $? -eq 3
+check "... and says so" grep -q "differs from the scenario embedded" "$work/e6"
+
+# ^C ends the flight at the next step: exit 130, a complete recording that replays exactly, the
+# report marked interrupted.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix_slow.toml" --pilot novice --headless \
+  --record "$work/int.mcap" --report "$work/int.json" >"$work/int.out" 2>&1 &
+pid=$!
+sleep 1
+kill -INT $pid
+wait $pid
+check "SIGINT exits 130" test $? -eq 130
+check "interrupted flight says so" grep -q "interrupted at t" "$work/int.out"
+check "interrupted recording is complete" test -f "$work/int.mcap" -a ! -e "$work/int.mcap.tmp"
+check "interrupted report is marked" grep -q '"interrupted": "true"' "$work/int.json"
+"$mixpilot" score "$work/int.mcap" >"$work/int.score" 2>&1
+check "interrupted recording replays exactly" grep -q "exact" "$work/int.score"
+
 # Usage errors exit 2 with a message; --help exits 0.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --record "$work/same" --report "$work/same" >"$work/e7" 2>&1
+check "one path for two outputs is a usage error" test $? -eq 2
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration 1e9 >"$work/e8" 2>&1
+check "a huge duration is a usage error" test $? -eq 2
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice >"$work/e1" 2>&1
 check "fly without --headless is a usage error" test $? -eq 2
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration -3 >"$work/e2" 2>&1

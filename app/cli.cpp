@@ -1,0 +1,98 @@
+#include "app/cli.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+namespace mixpilot::cli {
+
+void usage_error(const char* command, const std::string& message) {
+  std::fprintf(stderr, "mixpilot %s: %s (see 'mixpilot %s --help')\n", command, message.c_str(),
+               command);
+  std::exit(kExitUsage);
+}
+
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+std::optional<double> parse_seconds(std::string_view text, double max) {
+  const std::string v(text);
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(d) || !(d > 0.0) || d > max)
+    return std::nullopt;
+  return d;
+}
+
+bool write_file(const std::string& path, const std::string& text, std::string& error) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f || !(f << text) || !f.flush()) {
+      error = path + ": cannot write";
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    error = path + ": cannot rename " + tmp + " into place";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+extern "C" void on_interrupt(int) { g_interrupted.store(true, std::memory_order_relaxed); }
+
+}  // namespace
+
+void catch_interrupts() {
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;  // the second signal takes the default action
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+bool interrupted() { return g_interrupted.load(std::memory_order_relaxed); }
+
+Progress::Progress(std::string label, std::int64_t total)
+    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+
+void Progress::update(std::int64_t done) {
+  if (!tty_ || total_ <= 0) return;
+  const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                               std::chrono::steady_clock::now().time_since_epoch())
+                               .count();
+  if (drawn_ && now - last_ns_ < 100'000'000 && done < total_) return;
+  last_ns_ = now;
+  constexpr int kWidth = 30;
+  const double f = std::clamp(double(done) / double(total_), 0.0, 1.0);
+  const int filled = int(f * kWidth);
+  std::string bar(std::size_t(filled), '#');
+  bar.append(std::size_t(kWidth - filled), ' ');
+  std::fprintf(stderr, "\r%s [%s] %3d%%", label_.c_str(), bar.c_str(), int(100.0 * f));
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
+void Progress::finish() {
+  if (!drawn_) return;
+  std::fprintf(stderr, "\r\033[K");
+  std::fflush(stderr);
+  drawn_ = false;
+}
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,11 @@
+#pragma once
+// The mixpilot commands (app/mixpilot.cpp dispatches on argv[1]).
+
+namespace mixpilot::cli {
+
+int fly_command(int argc, char** argv);
+int demo_command();
+int score_command(int argc, char** argv);
+int models_command();
+
+}  // namespace mixpilot::cli

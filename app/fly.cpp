@@ -1,0 +1,286 @@
+// mixpilot fly / demo: one session of any mode, as fast as possible.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/cli.hpp"
+#include "app/commands.hpp"
+#include "app/replay.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
+#include "core/modes/report.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/recording.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
+
+#ifndef MIXPILOT_SOURCE_DIR
+#define MIXPILOT_SOURCE_DIR "."
+#endif
+
+namespace mixpilot::cli {
+
+namespace {
+
+constexpr double kMaxDuration = 3600.0;  // [s] --duration: memory and time stay proportionate
+
+constexpr const char* kFlyUsage =
+    "usage: mixpilot fly --scenario FILE --pilot PILOT --headless [options]\n"
+    "\n"
+    "Runs one session of the scenario as fast as possible and prints a short summary. ^C ends\n"
+    "the flight at the next step: the recording and report then hold what was flown.\n"
+    "\n"
+    "  --scenario FILE    scenario file (TOML, docs/scenario-format.md); optional when PILOT is\n"
+    "                     a recording, whose embedded scenario is then used. Its `mode` picks\n"
+    "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
+    "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
+    "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
+    "                     against the recording); default: the scenario's (mixed_initiative only)\n"
+    "  --headless         run without a window (required: this build has no GUI yet)\n"
+    "  --duration S       fly S seconds (at most 3600) instead of the scenario's duration, or\n"
+    "                     instead of the recording's length\n"
+    "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md):\n"
+    "                     every mode's telemetry, plus the pilot's commands in mixed_initiative\n"
+    "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
+    "                     mode's metrics as JSON, with `lost` and `lost_at_s`\n"
+    "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
+    "                     accept a replay that differs from the recording\n"
+    "\n"
+    "exit status: 0 done, 1 bad input or failure, 2 usage, 3 replay differs from the recording,\n"
+    "130 interrupted\n";
+
+struct FlyOptions {
+  std::string scenario_path;
+  std::string pilot;
+  bool headless = false;
+  std::optional<double> duration;
+  std::string record;
+  std::string report;
+  bool allow_mismatch = false;
+};
+
+// The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
+// --pilot, and the mode it names.
+struct Flight {
+  std::string scenario_text;
+  std::string scenario_source;  // for messages and relative paths
+  std::string scenario_file;    // the scenario's file, absolute (recorded as scenario_path)
+  std::optional<RecordingContents> recording;  // --pilot REC.mcap
+  std::unique_ptr<Mode> mode;
+  std::string pilot;  // mixed initiative: the pilot source's name
+};
+
+// Reads the scenario and, for a replay, the recording; on failure `status` may name a more
+// specific exit status than kExitError.
+std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
+  Flight f;
+  if (ends_with(o.pilot, ".mcap")) {
+    f.recording = read_recording(o.pilot, error);
+    if (!f.recording) return std::nullopt;
+    if (!f.recording->metadata.count("scenario")) {
+      error = o.pilot + ": no embedded scenario in the 'mixpilot' metadata record";
+      return std::nullopt;
+    }
+  }
+  if (!o.scenario_path.empty()) {
+    if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
+    f.scenario_source = o.scenario_path;
+    f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
+    if (f.recording && f.recording->metadata.at("scenario") != f.scenario_text &&
+        !o.allow_mismatch) {
+      error = o.scenario_path + " differs from the scenario embedded in " + o.pilot +
+              " (--allow-mismatch flies it anyway)";
+      status = kExitReplayMismatch;
+      return std::nullopt;
+    }
+  } else if (f.recording) {
+    f.scenario_text = f.recording->metadata.at("scenario");
+    f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
+    f.scenario_file = f.recording->metadata["scenario_path"];
+  } else {
+    usage_error("fly", "--scenario FILE is required");
+  }
+  return f;
+}
+
+std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status) {
+  status = kExitError;  // unless said otherwise below
+  std::optional<Flight> f = load_flight(o, error, status);
+  if (!f) return std::nullopt;
+  const auto kind_name = scenario_mode(f->scenario_text, f->scenario_source, error);
+  if (!kind_name) return std::nullopt;
+  if (*kind_name != "mixed_initiative" && !o.pilot.empty())
+    usage_error("fly", "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
+                           " is " + *kind_name);
+  if (f->recording) {
+    f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
+                          o.duration, error);
+  } else {
+    ModeRequest request;
+    request.duration = o.duration;
+    request.pilot_name = o.pilot;
+    f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
+  }
+  if (!f->mode) return std::nullopt;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f->mode.get())) f->pilot = mi->pilot().name();
+  status = kExitOk;
+  return f;
+}
+
+SessionInfo session_info(const Flight& f) {
+  SessionInfo info;
+  info.mode = to_string(f.mode->kind());
+  info.scenario = f.scenario_text;
+  info.scenario_path = f.scenario_file;
+  info.pilot = f.pilot;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
+    info.seed = mi->scenario().plant.seed;
+  return info;
+}
+
+// The mode's metrics with `lost` and `lost_at_s` (every report carries them).
+Metrics report_metrics(const Mode& mode) {
+  Metrics m = mode.metrics();
+  const auto has = [&](const char* name) {
+    for (const auto& [n, v] : m)
+      if (n == name) return true;
+    return false;
+  };
+  if (!has("lost")) m.emplace_back("lost", mode.lost() ? 1.0 : 0.0);
+  if (!has("lost_at_s")) m.emplace_back("lost_at_s", mode.lost_at());
+  return m;
+}
+
+Labels report_labels(const Flight& f, bool was_interrupted) {
+  Labels labels = {{"mode", to_string(f.mode->kind())}, {"scenario", f.mode->scenario_name()}};
+  if (!f.pilot.empty()) labels.emplace_back("pilot", f.pilot);
+  if (was_interrupted) labels.emplace_back("interrupted", "true");
+  return labels;
+}
+
+// Output paths, checked before the flight: distinct, and no existing non-regular file.
+void check_outputs(const FlyOptions& o) {
+  if (!o.record.empty() && o.record == o.report)
+    usage_error("fly", "--record and --report name the same file '" + o.record + "'");
+}
+
+int run_fly(const FlyOptions& o) {
+  check_outputs(o);
+  std::string error;
+  int status = kExitOk;
+  std::optional<Flight> flight = prepare_flight(o, error, status);
+  if (!flight) {
+    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    return status;
+  }
+  Mode& mode = *flight->mode;
+  Session session(mode);
+  RecordingSink recorder;
+  if (!o.record.empty()) {
+    if (!recorder.open(o.record, mode, session_info(*flight), error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      return kExitError;
+    }
+    session.add_sink(&recorder);
+  }
+  std::optional<ReplayCheck> check;
+  if (flight->recording) {
+    check.emplace(*flight->recording);
+    session.add_sink(&*check);
+  }
+
+  catch_interrupts();
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    Progress progress("fly " + mode.scenario_name(), mode.steps_total());
+    while (!interrupted() && session.step()) progress.update(mode.steps_done());
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const bool stopped = interrupted() && !mode.finished();
+
+  if (!o.record.empty() && !recorder.close(error)) {
+    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    status = kExitError;
+  }
+  std::fputs(mode.summary().c_str(), stdout);
+  const double flown = double(mode.steps_done()) * mode.dt();
+  std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
+              flown / std::max(wall, 1e-9));
+  if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
+  if (!o.report.empty()) {
+    const std::string json = to_json(report_labels(*flight, stopped), report_metrics(mode)) + "\n";
+    if (!write_file(o.report, json, error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      status = kExitError;
+    }
+  }
+  if (!o.record.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
+  if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
+  if (stopped) {
+    std::printf("  interrupted at t = %.3f s\n", flown);
+    return kExitInterrupted;
+  }
+  if (check && status == kExitOk) {
+    const std::string diff = check->first_difference(mode.steps_done());
+    if (!diff.empty()) {
+      std::fprintf(stderr, "mixpilot fly: the replay of %s differs from the recording: %s\n",
+                   o.pilot.c_str(), diff.c_str());
+      if (!o.allow_mismatch) return kExitReplayMismatch;
+    } else {
+      std::printf("  replay exact: every recorded step reproduced bit for bit\n");
+    }
+  }
+  return status;
+}
+
+}  // namespace
+
+int fly_command(int argc, char** argv) {
+  FlyOptions o;
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error("fly", std::string(a) + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kFlyUsage, stdout);
+      return kExitOk;
+    } else if (a == "--scenario") {
+      o.scenario_path = value();
+    } else if (a == "--pilot") {
+      o.pilot = value();
+    } else if (a == "--headless") {
+      o.headless = true;
+    } else if (a == "--duration") {
+      const std::string v = value();
+      o.duration = parse_seconds(v, kMaxDuration);
+      if (!o.duration)
+        usage_error("fly", "--duration expects a positive number of seconds up to 3600, got '" +
+                               v + "'");
+    } else if (a == "--record") {
+      o.record = value();
+    } else if (a == "--report") {
+      o.report = value();
+    } else if (a == "--allow-mismatch") {
+      o.allow_mismatch = true;
+    } else {
+      usage_error("fly", "unknown option '" + std::string(a) + "'");
+    }
+  }
+  if (!o.headless) usage_error("fly", "this build has no GUI yet: pass --headless");
+  return run_fly(o);
+}
+
+int demo_command() {
+  FlyOptions o;
+  o.scenario_path = MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml";
+  o.pilot = "novice";
+  o.headless = true;
+  return run_fly(o);
+}
+
+}  // namespace mixpilot::cli

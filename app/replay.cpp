@@ -1,0 +1,87 @@
+#include "app/replay.hpp"
+
+#include <algorithm>
+
+#include "core/modes/make_mode.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
+
+namespace mixpilot::cli {
+
+std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path) {
+  const auto it = rec.metadata.find("scenario_path");
+  if (it != rec.metadata.end() && !it->second.empty() && it->second.front() == '/')
+    return it->second;
+  return path + " (embedded scenario)";
+}
+
+std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
+                                  const std::string& text, const std::string& source,
+                                  std::optional<double> duration, std::string& error) {
+  const auto kind = scenario_mode(text, source, error);
+  if (!kind) return nullptr;
+  ModeRequest request;
+  request.duration = duration;
+  if (*kind == "mixed_initiative") {
+    if (!duration) {
+      const auto scenario = parse_scenario(text, source, error);
+      if (!scenario) return nullptr;
+      request.duration = double(rec.pilot.size()) * scenario->controller.dt;
+    }
+    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
+    return make_mode(text, source, std::move(request), error);
+  }
+  auto mode = make_mode(text, source, std::move(request), error);
+  if (mode && !duration && std::int64_t(rec.states.size()) < mode->steps_total()) {
+    ModeRequest shorter;  // an interrupted run: as many steps as were recorded
+    shorter.duration = double(rec.states.size()) * mode->dt();
+    mode = make_mode(text, source, std::move(shorter), error);
+  }
+  return mode;
+}
+
+namespace {
+
+bool same(const std::vector<double>& recorded, const Eigen::VectorXd& v) {
+  return recorded.size() == std::size_t(v.size()) &&
+         std::equal(v.data(), v.data() + v.size(), recorded.begin());
+}
+
+}  // namespace
+
+void ReplayCheck::on_sample(const Telemetry& s) {
+  if (first_ >= 0) return;
+  const auto k = std::size_t(s.step);
+  const char* what = nullptr;
+  if (k >= rec_->states.size() || !same(rec_->states[k].x, s.x)) {
+    what = "state";
+  } else if (k >= rec_->applied.size() || !same(rec_->applied[k].u, s.u)) {
+    what = "applied input";
+  } else if (s.mode == ModeKind::mixed_initiative &&
+             (k >= rec_->lambda.size() || rec_->lambda[k].lambda != s.lambda)) {
+    what = "lambda";
+  }
+  if (what) {
+    first_ = s.step;
+    what_ = what;
+  }
+}
+
+bool ReplayCheck::matches(std::int64_t steps) const {
+  return first_difference(steps).empty();
+}
+
+std::string ReplayCheck::first_difference(std::int64_t steps) const {
+  if (first_ >= 0)
+    return std::string("the ") + what_ + " of step " + std::to_string(first_) +
+           " differs from the recorded one";
+  if (std::size_t(steps) != rec_->states.size())
+    return std::to_string(steps) + " steps replayed, " + std::to_string(rec_->states.size()) +
+           " recorded";
+  if (!rec_->pilot.empty() && std::size_t(steps) != rec_->pilot.size())
+    return std::to_string(steps) + " steps replayed, " + std::to_string(rec_->pilot.size()) +
+           " pilot commands recorded";
+  return "";
+}
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,44 @@
+#pragma once
+// Flying a recording again: the same mode from its embedded scenario, checked step by step
+// against what was recorded (`mixpilot fly --pilot REC.mcap`, `mixpilot score`).
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/modes/mode.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/recording.hpp"
+
+namespace mixpilot::cli {
+
+// Where a recording's embedded scenario came from: its original file (absolute, as recorded),
+// so that paths inside it (reference trajectories) resolve as they did; else a label.
+std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path);
+
+// A fresh flight of `scenario_text` for the recording: mixed initiative replays the recorded
+// pilot commands and is as long as they are; other modes fly on their own for as many steps as
+// were recorded. `duration` overrides the length.
+std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
+                                  const std::string& scenario_text, const std::string& source,
+                                  std::optional<double> duration, std::string& error);
+
+// Compares each replayed step with the recorded one: the state, the applied input and, in
+// mixed initiative, λ (the last pilot command shows only in the last applied input), and at
+// the end that every recorded step was replayed.
+class ReplayCheck final : public TelemetrySink {
+ public:
+  explicit ReplayCheck(const RecordingContents& rec) : rec_(&rec) {}
+  void on_sample(const Telemetry& s) override;
+  // True when every recorded step was replayed bit for bit (call after the run).
+  bool matches(std::int64_t steps_replayed) const;
+  // What differed first, for messages ("" when nothing did).
+  std::string first_difference(std::int64_t steps_replayed) const;
+
+ private:
+  const RecordingContents* rec_;
+  std::int64_t first_ = -1;  // first differing step
+  const char* what_ = "";
+};
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,199 @@
+// mixpilot score: fly recordings again, check them step by step, score them.
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/cli.hpp"
+#include "app/commands.hpp"
+#include "app/replay.hpp"
+#include "core/modes/mi_mode.hpp"
+#include "core/modes/report.hpp"
+#include "core/modes/score.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/recording.hpp"
+
+namespace mixpilot::cli {
+
+namespace {
+
+constexpr const char* kScoreUsage =
+    "usage: mixpilot score FILE.mcap... [--jobs N] [--json OUT]\n"
+    "\n"
+    "Flies each recording again through a fresh session of its embedded scenario and checks the\n"
+    "replayed states against the recorded ones bit for bit: mixed_initiative recordings replay\n"
+    "their pilot commands and are scored (the timing fields come from the recorded solver\n"
+    "statistics: they describe that flight); other modes are flown for the recorded number of\n"
+    "steps and give their metrics (timing fields from this run). Progress on stderr, a table on\n"
+    "stdout.\n"
+    "\n"
+    "  --jobs N     replay N recordings in parallel (default: the number of cores)\n"
+    "  --json OUT   write a JSON array with one object per recording\n"
+    "  --allow-mismatch  exit 0 even when a replay differs from its recording\n"
+    "\n"
+    "exit status: 0 done, 1 a recording could not be read or replayed, 2 usage, 3 a replay\n"
+    "differs from its recording\n";
+
+struct ScoreRow {
+  std::string file;
+  std::string mode;
+  std::string pilot;
+  std::string scenario;
+  Metrics metrics;
+  Score score;  // mixed initiative
+  bool ok = false;
+  bool matches = false;   // every recorded step replayed bit for bit
+  std::string difference;  // what differed first
+  std::string error;
+};
+
+ScoreRow score_recording(const std::string& path) {
+  ScoreRow row;
+  row.file = path;
+  std::string error;
+  const auto rec = read_recording(path, error);
+  if (!rec) {
+    row.error = error;
+    return row;
+  }
+  const auto meta = rec->metadata.find("scenario");
+  if (meta == rec->metadata.end()) {
+    row.error = path + ": no embedded scenario in the 'mixpilot' metadata record";
+    return row;
+  }
+  std::unique_ptr<Mode> mode = replay_mode(*rec, path, meta->second,
+                                           embedded_scenario_source(*rec, path), {}, error);
+  if (!mode) {
+    row.error = error;
+    return row;
+  }
+  const auto pilot_meta = rec->metadata.find("pilot");
+  row.pilot = pilot_meta != rec->metadata.end() ? pilot_meta->second : "";
+  row.mode = to_string(mode->kind());
+  row.scenario = mode->scenario_name();
+  Session session(*mode);
+  ReplayCheck check(*rec);
+  session.add_sink(&check);
+  session.run();
+  row.metrics = mode->metrics();
+  if (const auto* mi = dynamic_cast<const MiMode*>(mode.get())) {
+    // The timing fields describe the recorded flight, not this replay.
+    row.score = mi->score();
+    std::vector<double> recorded_us;
+    recorded_us.reserve(rec->solver.size());
+    for (const auto& m : rec->solver) recorded_us.push_back(m.total_us);
+    set_timing(row.score, std::move(recorded_us), mode->dt());
+    row.metrics = to_metrics(row.score);
+  }
+  row.difference = check.first_difference(mode->steps_done());
+  row.matches = row.difference.empty();
+  row.ok = true;
+  return row;
+}
+
+}  // namespace
+
+int score_command(int argc, char** argv) {
+  std::vector<std::string> files;
+  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  std::string json_path;
+  bool allow_mismatch = false;
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kScoreUsage, stdout);
+      return kExitOk;
+    } else if (a == "--jobs") {
+      if (i + 1 >= argc) usage_error("score", "--jobs needs a value");
+      const std::string v = argv[++i];
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < 1 || n > 256)
+        usage_error("score", "--jobs expects a whole number from 1 to 256, got '" + v + "'");
+      jobs = int(n);
+    } else if (a == "--json") {
+      if (i + 1 >= argc) usage_error("score", "--json needs a value");
+      json_path = argv[++i];
+    } else if (a == "--allow-mismatch") {
+      allow_mismatch = true;
+    } else if (a.size() > 1 && a[0] == '-') {
+      usage_error("score", "unknown option '" + std::string(a) + "'");
+    } else {
+      files.emplace_back(a);
+    }
+  }
+  if (files.empty()) usage_error("score", "no recordings given");
+
+  std::vector<ScoreRow> rows(files.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::mutex io;
+  const auto worker = [&] {
+    for (std::size_t i = next++; i < files.size(); i = next++) {
+      rows[i] = score_recording(files[i]);
+      const std::size_t d = ++done;
+      const std::lock_guard<std::mutex> lock(io);
+      if (rows[i].ok && rows[i].mode == "mixed_initiative") {
+        std::fprintf(stderr, "[%zu/%zu] %s: skill %.1f\n", d, files.size(), files[i].c_str(),
+                     rows[i].score.skill);
+      } else if (rows[i].ok) {
+        std::fprintf(stderr, "[%zu/%zu] %s: %s\n", d, files.size(), files[i].c_str(),
+                     rows[i].mode.c_str());
+      } else {
+        std::fprintf(stderr, "[%zu/%zu] %s\n", d, files.size(), rows[i].error.c_str());
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int j = 0; j < std::min<int>(jobs, int(files.size())); ++j) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+
+  std::printf("%-32s %-12s %8s %7s %7s %8s %5s %6s %7s %s\n", "recording", "pilot", "time_s",
+              "lambda", "min_l", "maxdev_m", "coll", "fallb", "skill", "replay");
+  int failures = 0, mismatches = 0;
+  std::string json = "[\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const ScoreRow& r = rows[i];
+    if (!r.ok) {
+      ++failures;
+      std::printf("%-32s error: %s\n", r.file.c_str(), r.error.c_str());
+      continue;
+    }
+    const Score& s = r.score;
+    const char* replay = r.matches ? "exact" : "DIFFERS from recording";
+    if (!r.matches) {
+      ++mismatches;
+      std::fprintf(stderr, "%s: the replay differs from the recording: %s\n", r.file.c_str(),
+                   r.difference.c_str());
+    }
+    if (r.mode == "mixed_initiative") {
+      std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
+                  r.pilot.c_str(), s.duration_s, s.mean_lambda, s.min_lambda, s.max_deviation_m,
+                  s.collisions, static_cast<long long>(s.fallbacks), s.skill, replay);
+    } else {  // the other modes' metrics are in the JSON
+      std::printf("%-32s %-12.12s %8s %7s %7s %8s %5s %6s %7s %s\n", r.file.c_str(),
+                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay);
+    }
+    if (json.size() > 2) json += ",\n";
+    Labels labels = {{"file", r.file}, {"mode", r.mode}, {"scenario", r.scenario}};
+    if (!r.pilot.empty()) labels.emplace_back("pilot", r.pilot);
+    labels.emplace_back("replay", r.matches ? "exact" : "differs");
+    json += to_json(labels, r.metrics);
+  }
+  json += "\n]\n";
+  if (!json_path.empty()) {
+    std::string error;
+    if (!write_file(json_path, json, error)) {
+      std::fprintf(stderr, "mixpilot score: %s\n", error.c_str());
+      return kExitError;
+    }
+  }
+  if (failures > 0) return kExitError;
+  return mismatches > 0 && !allow_mismatch ? kExitReplayMismatch : kExitOk;
+}
+
+}  // namespace mixpilot::cli
