@@ -1,6 +1,7 @@
 #include "core/modes/report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace mixpilot {
@@ -37,7 +38,12 @@ std::string to_json(const Labels& labels, const Metrics& metrics, int indent) {
   }
   char buf[64];
   for (const auto& [key, value] : metrics) {
-    std::snprintf(buf, sizeof buf, "%.17g", value);
+    // JSON has no inf or nan: a value that is not finite (e.g. no obstacle to be near) is null.
+    if (std::isfinite(value)) {
+      std::snprintf(buf, sizeof buf, "%.17g", value);
+    } else {
+      std::snprintf(buf, sizeof buf, "null");
+    }
     out += sep + pad + "\"" + json_escape(key) + "\": " + buf;
     sep = ",\n";
   }

@@ -11,7 +11,8 @@ namespace mixpilot {
 using Labels = std::vector<std::pair<std::string, std::string>>;
 
 // {"label": "value", ..., "metric": number, ...}: string labels first, then the metrics with 17
-// significant digits (an exact round trip), whole numbers without a fraction.
+// significant digits (an exact round trip), whole numbers without a fraction, and null for a
+// value that is not finite (JSON has no inf or nan).
 std::string to_json(const Labels& labels, const Metrics& metrics, int indent = 2);
 
 }  // namespace mixpilot

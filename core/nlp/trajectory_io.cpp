@@ -9,6 +9,8 @@
 #include <sstream>
 #include <vector>
 
+#include "core/numerics/input_file.hpp"
+
 namespace mixpilot {
 namespace {
 
@@ -91,6 +93,7 @@ bool write_trajectory_csv(const std::string& path, const OcpTrajectory& traj, do
 }
 
 std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::string& error) {
+  if (!check_input_file(path, kMaxTrajectoryBytes, error)) return std::nullopt;
   std::ifstream in(path);
   if (!in) {
     error = path + ": cannot open: " + std::strerror(errno);

@@ -16,6 +16,10 @@
 
 namespace mixpilot {
 
+// A trajectory file larger than this is refused before it is read (a 10 min trajectory at 1 ms
+// with 17 columns is ≈ 100 MiB).
+inline constexpr long long kMaxTrajectoryBytes = 256ll << 20;
+
 struct TrajectoryFile {
   OcpTrajectory trajectory;  // x: N+1 x nx, u: N x nu
   double dt = 0.0;           // [s]

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
@@ -15,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/numerics/input_file.hpp"
 #include "core/scenario/toml_read.hpp"
 
 namespace mixpilot {
@@ -236,16 +238,16 @@ std::optional<Scenario> load_scenario(const std::string& path, std::string& erro
 }
 
 bool read_text_file(const std::string& path, std::string& text, std::string& error) {
+  if (!check_input_file(path, kMaxTextFileBytes, error)) return false;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    error = path + ": cannot open file (" + std::error_code(errno, std::generic_category()).message() +
-            ')';
+    error = path + ": cannot open file (" + std::strerror(errno) + ")";
     return false;
   }
   std::ostringstream s;
   s << in.rdbuf();
   if (in.bad()) {
-    error = path + ": read error";
+    error = path + ": read error (" + std::strerror(errno) + ")";
     return false;
   }
   text = s.str();

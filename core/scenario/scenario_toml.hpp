@@ -23,7 +23,12 @@ std::optional<Scenario> load_scenario(const std::string& path, std::string& erro
 std::optional<Scenario> parse_scenario(std::string_view text, const std::string& source_name,
                                        std::string& error);
 
-// The whole text of a file; false with "<path>: cannot open file (...)" otherwise.
+// Scenario and trajectory files are small; a larger input is refused before it is read.
+inline constexpr long long kMaxTextFileBytes = 16ll << 20;
+
+// The whole text of a regular file of at most kMaxTextFileBytes; false with
+// "<path>: cannot open file (<system's reason>)", "<path>: expected a regular file, ..." or
+// "<path>: N bytes, more than ..." otherwise.
 bool read_text_file(const std::string& path, std::string& text, std::string& error);
 
 // The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader.

@@ -91,5 +91,13 @@ printf 'name = "x"\nmode = "mixed_initiative"\nmodel = "mikrokopter"\n[controlle
 check "bad scenario fails" test $? -eq 1
 check "bad scenario names file, line and key" grep -q "bad.toml:5:5: controller.N" "$work/e5"
 
+# Special files as inputs are refused, with the reason.
+mkfifo "$work/fifo.toml"
+timeout 10 "$mixpilot" fly --scenario "$work/fifo.toml" --headless >"$work/e9" 2>&1
+check "a FIFO as scenario is refused, not read" test $? -eq 1
+check "... with the reason" grep -q "expected a regular file" "$work/e9"
+"$mixpilot" fly --scenario /dev/zero --headless >"$work/e10" 2>&1
+check "/dev/zero as scenario is refused" grep -q "expected a regular file" "$work/e10"
+
 echo "$pass passed, $fails failed"
 test "$fails" -eq 0
