@@ -10,7 +10,7 @@
 #include <Eigen/Dense>
 
 #include "core/modes/mode.hpp"
-#include "core/modes/pendubot_swingup.hpp"
+#include "core/modes/pendubot_mode.hpp"
 #include "core/nlp/trajectory_io.hpp"
 
 #ifndef MIXPILOT_SOURCE_DIR

@@ -1,7 +1,7 @@
 #include "core/modes/mode.hpp"
 
 #include "core/modes/obstacles.hpp"
-#include "core/modes/pendubot_swingup.hpp"
+#include "core/modes/pendubot_mode.hpp"
 #include "core/modes/tracking.hpp"
 
 
