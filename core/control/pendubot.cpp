@@ -90,8 +90,8 @@ PendubotLqr pendubot_lqr(const models::Pendubot& model, double dt, const Eigen::
   l.A = A;
   l.B = B;
   Eigen::MatrixXd P;
-  l.converged = solve_dare(A, B, Eigen::Matrix4d(q.asDiagonal()), Eigen::MatrixXd::Constant(1, 1, r),
-                           P);
+  const Eigen::Matrix4d Q = q.asDiagonal();
+  l.converged = solve_dare(A, B, Q, Eigen::MatrixXd::Constant(1, 1, r), P);
   if (l.converged) {
     l.P = P;
     l.K = (B.transpose() * l.P * A) / (r + B.dot(l.P * B));

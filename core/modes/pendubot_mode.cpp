@@ -33,13 +33,16 @@ SetupResult PendubotMode::check_settings() const {
   const PendubotOcpSettings& oc = sc.controller;
   const OcpTrajectory& ref = sc.reference.trajectory;
   if (ref.u.empty() || ref.x.size() != ref.u.size() + 1)
-    return SetupResult::failure("no swing-up reference (controller.reference: n + 1 states, n inputs)");
+    return SetupResult::failure(
+        "no swing-up reference (controller.reference: n + 1 states, n inputs)");
   for (const auto& x : ref.x)
     if (x.size() != 4) return SetupResult::failure("the reference's states must have 4 entries");
   for (const auto& u : ref.u)
     if (u.size() != 1) return SetupResult::failure("the reference's inputs must have 1 entry");
   if (!(oc.dt > 0.0) || !std::isfinite(sc.duration) || !(std::llround(sc.duration / oc.dt) >= 1))
     return SetupResult::failure("controller.dt must be positive and duration at least one step");
+  if (!sc.plant.initial_state.allFinite())
+    return SetupResult::failure("plant.initial_state must be finite");
   const double rate = sc.plant.rate_hz;
   if (!std::isfinite(rate) || !(std::llround(oc.dt * rate) >= 1))
     return SetupResult::failure("plant.rate_hz must give at least one substep per control step");
@@ -71,6 +74,8 @@ SetupResult PendubotMode::setup(PendubotScenario scenario) {
   step_ = steps_total_ = 0;
   problem_.reset();
   lqr_ = PendubotLqr{};
+  telemetry_ = Telemetry{};
+  telemetry_.mode = ModeKind::pendubot_swingup;
   if (SetupResult r = check_settings(); !r) return r;
   const PendubotOcpSettings& oc = scenario_.controller;
   problem_ = std::make_unique<PendubotSwingup>(oc);
@@ -111,8 +116,6 @@ SetupResult PendubotMode::setup(PendubotScenario scenario) {
   rti_us_.clear();
   rti_us_.reserve(std::size_t(steps_total_));
 
-  telemetry_ = Telemetry{};
-  telemetry_.mode = ModeKind::pendubot_swingup;
   telemetry_.x = x_;
   telemetry_.x_measured = xm_;
   telemetry_.u = Eigen::VectorXd::Zero(1);
@@ -128,9 +131,14 @@ void PendubotMode::warm_start() {
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   OcpTrajectory& traj = rti_.trajectory();
   const int N = scenario_.controller.N;
-  for (int i = 0; i <= N; ++i) traj.x[std::size_t(i)] = ref.x[std::min<std::size_t>(i, ref.x.size() - 1)];
-  for (int i = 0; i < N; ++i) {
-    traj.u[std::size_t(i)] = i < int(ref.u.size()) ? ref.u[std::size_t(i)] : Eigen::VectorXd::Zero(1);
+  const std::size_t last = ref.x.size() - 1;
+  for (std::size_t i = 0; i <= std::size_t(N); ++i) traj.x[i] = ref.x[std::min(i, last)];
+  for (std::size_t i = 0; i < std::size_t(N); ++i) {
+    if (i < ref.u.size()) {
+      traj.u[i] = ref.u[i];
+    } else {
+      traj.u[i].setZero();
+    }
   }
 }
 
