@@ -7,8 +7,8 @@
 
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/nlp/nlp_ipopt.hpp"
-#include "core/modes/pendubot_swingup.hpp"
 #include "core/control/obstacle_avoidance.hpp"
+#include "core/control/pendubot_reference.hpp"
 #include "core/nlp/trajectory_io.hpp"
 
 namespace {
@@ -134,7 +134,7 @@ int run_obstacle_reference(const Eigen::Vector3d& target, const std::string& out
   return 0;
 }
 
-// SPEC 5.1: the Pendubot swing-up reference the NMPC tracks (core/modes/pendubot_swingup.hpp).
+// SPEC 5.1: the Pendubot swing-up reference the NMPC tracks (core/control/pendubot_reference.hpp).
 int run_pendubot_swingup(const std::string& out, const IpoptOcpSettings& settings, int N) {
   PendubotReferenceSettings s;
   s.ipopt = settings;

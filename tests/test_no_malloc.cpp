@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "core/control/crazyflie_tracking.hpp"
+#include "core/control/pendubot_reference.hpp"
 #include "core/control/tracking.hpp"
+#include "core/modes/pendubot_mode.hpp"
 #include "core/modes/tracking_mode.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/nlp/rti.hpp"
@@ -109,6 +111,64 @@ TEST(NoMalloc, TrackingModeStep) {
     EXPECT_EQ(steps, mode.steps_total());
     EXPECT_EQ(allocations, 0);
     EXPECT_FALSE(mode.lost());
+  }
+}
+
+// Pendubot swing-up: every step() of each path — NMPC tracking and past the reference's end
+// (warm start re-expressed in wrapped angles), the LQR taking the arm and handing it back, exact
+// state and both encoder estimators. The reference is the energy-pumping rollout (0.6 s).
+TEST(NoMalloc, PendubotModeStep) {
+  PendubotScenario base;
+  base.name = "pendubot";
+  base.reference.dt = base.controller.dt;
+  pendubot_energy_guess(models::Pendubot{}, base.controller.dt, 300, base.controller.u_max,
+                        base.reference.trajectory);
+  struct Case {
+    const char* what;
+    void (*edit)(PendubotScenario&);
+    bool lqr_exits;
+  };
+  const Case cases[] = {
+      {"NMPC past the reference", [](PendubotScenario& s) { s.lqr.enabled = false; }, false},
+      {"encoders, observer",
+       [](PendubotScenario& s) {
+         s.sensor.quantization = true;
+         s.sensor.estimator = "observer";
+       },
+       false},
+      {"encoders, differences", [](PendubotScenario& s) { s.sensor.quantization = true; }, false},
+      {"LQR in and out",  // test_pendubot: LqrHandsBackToTheNmpcPastTheExitAngle
+       [](PendubotScenario& s) {
+         s.plant.initial_state = Eigen::Vector4d(0.05, 0.05, 0.0, 0.0);
+         s.lqr.exit_angle = 0.3;
+       },
+       true},
+  };
+  for (const Case& c : cases) {
+    PendubotScenario sc = base;
+    sc.duration = 0.8;
+    c.edit(sc);
+    PendubotMode mode;
+    const SetupResult r = mode.setup(sc);
+    ASSERT_TRUE(r.ok()) << c.what << ": " << r.reason();
+    long allocations = 0, steps = 0;
+    int switches = 0;
+    for (;;) {
+      bool stepped = false;
+      {
+        NoMalloc guard;
+        stepped = mode.step();
+        allocations += NoMalloc::count();
+      }
+      if (!stepped) break;
+      ++steps;
+      switches += (mode.telemetry().events & kEventSwitch) != 0;
+    }
+    EXPECT_EQ(steps, mode.steps_total()) << c.what;
+    EXPECT_EQ(allocations, 0) << c.what;
+    if (c.lqr_exits) {
+      EXPECT_GE(switches, 2) << c.what;  // the exit path ran
+    }
   }
 }
 

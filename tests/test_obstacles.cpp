@@ -1,7 +1,7 @@
 // Obstacle avoidance with the LCL constraint (SPEC §5.3: core/control/obstacle_avoidance.hpp,
 // core/modes/obstacle_mode.hpp): Proposition 1, the shipped scenarios in closed loop with both
 // constraint forms, converged SQP equivalence, the mode's metrics and telemetry against a replay
-// of its log, its setup failures, the mode runner and scenario diagnostics.
+// of its log, its setup failures, a flight through make_mode() and scenario diagnostics.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include "core/modes/mode.hpp"
 #include "core/modes/obstacle_mode.hpp"
 #include "core/numerics/integrator_erk4.hpp"
+#include "fly_scenario.hpp"
 #include "models/crazyflie.hpp"
 
 namespace mixpilot {
@@ -478,15 +479,11 @@ TEST(ObstacleModeSetup, FailsWithTheReasonInsteadOfRunning) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The mode runner (`mixpilot fly --headless --report`): the scenario's duration override, the
-// metric names in report order, the summary.
+// A flight through make_mode() (`mixpilot fly --headless --report`): the duration override,
+// the metric names in report order, the summary.
 
 TEST(ObstacleMode, RunnerReportsMetrics) {
-  const ModeRunner runner = find_mode_runner("obstacle_avoidance");
-  ASSERT_NE(runner, nullptr);
-  ModeOptions options;
-  options.duration = 1.2;  // past ball 1
-  const ModeResult r = runner(kBalls, options);
+  const Flown r = fly_scenario(kBalls, 1.2);  // past ball 1
   ASSERT_TRUE(r.ok) << r.error;
   std::vector<std::string> names;
   for (const auto& [name, value] : r.metrics) names.push_back(name);

@@ -13,6 +13,7 @@
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/tracking_mode.hpp"
+#include "fly_scenario.hpp"
 
 namespace mixpilot {
 namespace {
@@ -295,12 +296,10 @@ TEST(TrackingHelix, ReferenceStartsBelowHoverAndFollowsTheSpec) {
   EXPECT_EQ(ref.x[1000].segment<3>(7).norm(), 0.0);  // the held end point
 }
 
-// The shipped scenarios run headless through the mode runner and report their metrics.
+// The shipped scenarios fly headless through make_mode() and report their metrics.
 TEST(TrackingMode, ShippedScenariosFly) {
-  const ModeRunner runner = find_mode_runner("crazyflie_tracking");
-  ASSERT_NE(runner, nullptr);
   for (const std::string& path : {kStep, kHelix}) {
-    const ModeResult r = runner(path, ModeOptions{});
+    const Flown r = fly_scenario(path);
     ASSERT_TRUE(r.ok) << r.error;
     std::printf("%s\n", r.summary.c_str());
     double rms = -1, lost = -1, fallbacks = -1;

@@ -4,8 +4,10 @@
 
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/obstacle_mode.hpp"
+#include "core/modes/pendubot_mode.hpp"
 #include "core/modes/tracking_mode.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
+#include "core/scenario/pendubot_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/scenario/tracking_scenario.hpp"
 
@@ -72,9 +74,11 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
     case ModeKind::crazyflie_tracking:
       return make_solo_mode<TrackingMode>(text, source_name, request, parse_tracking_scenario,
                                           error);
-    case ModeKind::pendubot_swingup: break;
+    case ModeKind::pendubot_swingup:
+      return make_solo_mode<PendubotMode>(text, source_name, request, parse_pendubot_scenario,
+                                          error);
   }
-  error = source_name + ": mode \"" + *name + "\" cannot be stepped yet";
+  error = source_name + ": mode \"" + *name + "\" has no class";
   return nullptr;
 }
 

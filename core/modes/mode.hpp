@@ -109,18 +109,4 @@ class Mode {
   virtual std::string summary() const = 0;
 };
 
-// ---- legacy whole-run runners, removed once every mode implements Mode ----
-struct ModeOptions {
-  std::optional<double> duration;  // [s] overrides the scenario's duration
-};
-struct ModeResult {
-  bool ok = false;
-  std::string error;
-  std::string summary;
-  std::vector<std::pair<std::string, double>> metrics;
-};
-using ModeRunner = ModeResult (*)(const std::string& scenario_path, const ModeOptions& options);
-ModeRunner find_mode_runner(const std::string& mode);
-std::vector<std::string> mode_runner_names();
-
 }  // namespace mixpilot

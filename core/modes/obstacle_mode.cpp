@@ -340,23 +340,5 @@ ObstacleRunResult run_obstacle_avoidance(const ObstacleScenario& scenario,
   return r;
 }
 
-ModeResult fly_obstacle_avoidance(const std::string& scenario_path, const ModeOptions& options) {
-  ModeResult out;
-  std::optional<ObstacleScenario> sc = load_obstacle_scenario(scenario_path, out.error);
-  if (!sc) return out;
-  if (options.duration) sc->duration = *options.duration;
-  ObstacleMode mode;
-  if (SetupResult setup = mode.setup(std::move(*sc)); !setup) {
-    out.error = scenario_path + ": " + setup.reason();
-    return out;
-  }
-  while (mode.step()) {
-  }
-  out.summary = mode.summary();
-  out.metrics = mode.metrics();
-  out.ok = !mode.lost();
-  if (mode.lost()) out.error = scenario_path + ": the vehicle was lost (plant state not finite)";
-  return out;
-}
 
 }  // namespace mixpilot

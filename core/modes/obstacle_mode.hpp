@@ -142,8 +142,4 @@ struct ObstacleRunOptions {
 ObstacleRunResult run_obstacle_avoidance(const ObstacleScenario& scenario,
                                          const ObstacleRunOptions& options = {});
 
-// The legacy mode runner (core/modes/mode.hpp) over ObstacleMode: ObstacleMode::metrics() and
-// summary().
-ModeResult fly_obstacle_avoidance(const std::string& scenario_path, const ModeOptions& options);
-
 }  // namespace mixpilot

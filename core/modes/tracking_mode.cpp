@@ -385,22 +385,5 @@ TrackingResult run_tracking(const TrackingScenario& scenario, TrackingLog* log) 
   return mode.result();
 }
 
-ModeResult fly_crazyflie_tracking(const std::string& path, const ModeOptions& options) {
-  ModeResult out;
-  std::optional<TrackingScenario> sc = load_tracking_scenario(path, out.error);
-  if (!sc) return out;
-  if (options.duration) sc->duration = *options.duration;
-  TrackingMode mode;
-  if (SetupResult r = mode.setup(std::move(*sc)); !r) {
-    out.error = path + ": " + r.reason();
-    return out;
-  }
-  while (mode.step()) {
-  }
-  out.metrics = mode.metrics();
-  out.summary = mode.summary();
-  out.ok = true;
-  return out;
-}
 
 }  // namespace mixpilot

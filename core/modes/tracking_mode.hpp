@@ -169,7 +169,4 @@ struct TrackingLog {
 // Flies the scenario to its end. `log` (optional) receives one entry per control step.
 TrackingResult run_tracking(const TrackingScenario& scenario, TrackingLog* log = nullptr);
 
-// Legacy mode runner (core/modes/mode.hpp): TrackingMode's metrics and summary.
-ModeResult fly_crazyflie_tracking(const std::string& path, const ModeOptions& options);
-
 }  // namespace mixpilot

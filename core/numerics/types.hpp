@@ -169,7 +169,7 @@ inline constexpr double kSettleRadius = 0.05;
 inline constexpr double kLostRadius = 100.0;
 }  // namespace tracking_defaults
 
-// Pendubot swing-up of SPEC §5.1 (core/modes/pendubot_swingup.hpp).
+// Pendubot swing-up of SPEC §5.1 (core/control/pendubot.hpp).
 namespace pendubot_defaults {
 inline constexpr int kHorizon = 10;             // N
 inline constexpr double kDt = 0.002;            // [s]
@@ -181,7 +181,7 @@ inline constexpr double kSlackWeight = 40.0;    // ℓ2² slack weight ρ per bo
 inline constexpr double kPlantRateHz = 4000.0;
 // Success: ‖wrap(q1, q2)‖ ≤ kAngleTolerance [rad] from some time on, to the end of the run.
 inline constexpr double kAngleTolerance = 0.05;
-// LQR hand-over (core/modes/pendubot_swingup.hpp, "switch rule"): enter when ‖wrap(q)‖ ≤ kLqrEnter
+// LQR hand-over (core/modes/pendubot_mode.hpp, "switch rule"): enter when ‖wrap(q)‖ ≤ kLqrEnter
 // and ‖q̇‖ ≤ kLqrEnterVelocity and |K x| ≤ u_max; leave when ‖wrap(q)‖ > kLqrExit.
 inline constexpr double kLqrEnter = 0.25;          // [rad]
 inline constexpr double kLqrEnterVelocity = 3.0;   // [rad/s]

@@ -9,7 +9,7 @@
 
 #include <chrono>
 
-#include "core/modes/pendubot_swingup.hpp"
+#include "core/control/pendubot.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/nlp/trajectory_io.hpp"
 
