@@ -64,4 +64,27 @@ struct NoMalloc {
   }
 };
 
+struct GuardedSteps {
+  long allocations = 0;  // in all step() calls together
+  long steps = 0;        // step() calls that stepped
+};
+
+// Steps `mode` to its end, each step() alone under a NoMalloc guard; `after_step` runs
+// unguarded after every step that happened (to read telemetry).
+template <class Mode, class AfterStep>
+GuardedSteps step_to_end_without_malloc(Mode& mode, AfterStep&& after_step) {
+  GuardedSteps r;
+  for (;;) {
+    bool stepped = false;
+    {
+      NoMalloc guard;
+      stepped = mode.step();
+      r.allocations += NoMalloc::count();
+    }
+    if (!stepped) return r;
+    ++r.steps;
+    after_step();
+  }
+}
+
 }  // namespace mixpilot

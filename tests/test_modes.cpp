@@ -72,26 +72,17 @@ TEST_P(EveryMode, RunsDeterministicallyWithoutAllocatingAndShowsTheThesisBehavio
   std::vector<Eigen::VectorXd> xa, ua;
   xa.reserve(std::size_t(a->steps_total()));
   ua.reserve(std::size_t(a->steps_total()));
-  long allocations = 0;
-  std::int64_t steps = 0;
-  for (;;) {
-    bool stepped = false;
-    {
-      NoMalloc guard;
-      stepped = a->step();
-      allocations += NoMalloc::count();
-    }
-    if (!stepped) break;
-    ++steps;
+  bool telemetry_ok = true;
+  const GuardedSteps run = step_to_end_without_malloc(*a, [&] {
     const Telemetry& t = a->telemetry();
-    ASSERT_EQ(t.step, steps - 1);
-    ASSERT_EQ(t.mode, c.kind);
-    ASSERT_EQ(t.x.size(), nx);
-    ASSERT_LE(t.num_channels, Telemetry::kMaxChannels);
+    telemetry_ok = telemetry_ok && t.step == std::int64_t(xa.size()) && t.mode == c.kind &&
+                   t.x.size() == nx && t.num_channels <= Telemetry::kMaxChannels;
     xa.push_back(t.x);
     ua.push_back(t.u);
-  }
-  EXPECT_EQ(allocations, 0) << "allocations inside step()";
+  });
+  const std::int64_t steps = run.steps;
+  EXPECT_TRUE(telemetry_ok) << "step counter, mode, state size or channel count wrong";
+  EXPECT_EQ(run.allocations, 0) << "allocations inside step()";
   EXPECT_TRUE(a->finished());
   EXPECT_FALSE(a->lost());
   EXPECT_EQ(a->steps_done(), steps);

@@ -97,19 +97,9 @@ TEST(NoMalloc, TrackingModeStep) {
     TrackingMode mode;
     const SetupResult r = mode.setup(sc);
     ASSERT_TRUE(r.ok()) << r.reason();
-    long allocations = 0, steps = 0;
-    for (;;) {
-      bool stepped = false;
-      {
-        NoMalloc guard;
-        stepped = mode.step();
-        allocations += NoMalloc::count();
-      }
-      if (!stepped) break;
-      ++steps;
-    }
-    EXPECT_EQ(steps, mode.steps_total());
-    EXPECT_EQ(allocations, 0);
+    const GuardedSteps run = step_to_end_without_malloc(mode, [] {});
+    EXPECT_EQ(run.steps, mode.steps_total());
+    EXPECT_EQ(run.allocations, 0);
     EXPECT_FALSE(mode.lost());
   }
 }
@@ -151,21 +141,11 @@ TEST(NoMalloc, PendubotModeStep) {
     PendubotMode mode;
     const SetupResult r = mode.setup(sc);
     ASSERT_TRUE(r.ok()) << c.what << ": " << r.reason();
-    long allocations = 0, steps = 0;
     int switches = 0;
-    for (;;) {
-      bool stepped = false;
-      {
-        NoMalloc guard;
-        stepped = mode.step();
-        allocations += NoMalloc::count();
-      }
-      if (!stepped) break;
-      ++steps;
-      switches += (mode.telemetry().events & kEventSwitch) != 0;
-    }
-    EXPECT_EQ(steps, mode.steps_total()) << c.what;
-    EXPECT_EQ(allocations, 0) << c.what;
+    const GuardedSteps run = step_to_end_without_malloc(
+        mode, [&] { switches += (mode.telemetry().events & kEventSwitch) != 0; });
+    EXPECT_EQ(run.steps, mode.steps_total()) << c.what;
+    EXPECT_EQ(run.allocations, 0) << c.what;
     if (c.lqr_exits) {
       EXPECT_GE(switches, 2) << c.what;  // the exit path ran
     }
