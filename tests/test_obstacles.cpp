@@ -536,7 +536,7 @@ TEST(ObstacleScenarioFile, ErrorsNameFileLineAndKey) {
             file + ":7:19: controller.constraint_form: expected one of \"lcl\", \"squared\", got "
                    "the string \"cubic\"");
   EXPECT_EQ(parse_error(kHeader + "[controller]\nclearance = -0.2\n"),
-            file + ":7:13: controller.clearance: expected a positive number, got -0.2");
+            file + ":7:13: controller.clearance: value outside [0.001, 10], got -0.2");
   EXPECT_EQ(parse_error(kHeader + "[[balls]]\nposition = [1, 2, 3]\nvelocty = [0, 0, 1]\n"),
             file + ":6:1: balls[0].velocity: missing required key (expected an array of 3 "
                    "numbers)\n" +

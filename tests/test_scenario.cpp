@@ -212,11 +212,11 @@ TEST(Scenario, UnknownKey) {
 
 TEST(Scenario, OutOfRange) {
   EXPECT_EQ(error_of("[controller.ph]\nr = -0.1\n"),
-            "t.toml:6:5: controller.ph.r: expected a positive number, got -0.1");
+            "t.toml:6:5: controller.ph.r: value outside [1e-06, 1000], got -0.1");
   EXPECT_EQ(error_of("[controller.ph]\nmu1 = 1.0\n"),
-            "t.toml:6:7: controller.ph.mu1: expected a number in (0, 1), got 1.0");
+            "t.toml:6:7: controller.ph.mu1: value outside (0, 1), got 1.0");
   EXPECT_EQ(error_of("[controller]\nN = 0\n"),
-            "t.toml:6:5: controller.N: expected an integer >= 1, got 0");
+            "t.toml:6:5: controller.N: value outside [1, 500], got 0");
   EXPECT_EQ(error_of("duration = nan\n"),
             "t.toml:5:12: duration: expected a finite number, got nan");
   EXPECT_EQ(error_of("[controller]\nN = 8\n[controller.ph]\nN_b = 10\n"),
@@ -226,7 +226,7 @@ TEST(Scenario, OutOfRange) {
   EXPECT_EQ(error_of("[controller]\nN = 8\n"),
             "t.toml:5:1: controller.ph.N_b: expected at most controller.N = 8, got 10");
   EXPECT_EQ(error_of("[plant]\nrate_hz = 500\n"),
-            "t.toml:6:11: plant.rate_hz: expected a number >= 1000, got 500");
+            "t.toml:6:11: plant.rate_hz: value outside [1000, 100000], got 500");
   EXPECT_EQ(error_of("[controller]\ndt = 0.0155\n[plant]\nrate_hz = 1000.0\n"),
             "t.toml:8:11: plant.rate_hz: expected a rate giving a whole number of substeps per "
             "control step, got controller.dt * rate_hz = 15.5");
@@ -237,7 +237,7 @@ TEST(Scenario, OutOfRange) {
             "t.toml:6:10: arena.obstacles[0].center: expected a point inside the arena [-3.0, "
             "-3.0, 0.0] .. [3.0, 3.0, 3.0], got [0.0, 0.0, 9.0]");
   EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.0\n"),
-            "t.toml:7:10: arena.obstacles[0].radius: expected a positive number, got 0.0");
+            "t.toml:7:10: arena.obstacles[0].radius: value outside (0, 100], got 0.0");
   EXPECT_EQ(error_of("[reference]\nclimb_rate = 0.2\n"),
             "t.toml:5:1: reference: expected a helix inside the arena over [0, duration], but "
             "it leaves it at t = 12.503 s, at (-0.330, -0.944, 3.001)");
@@ -302,8 +302,8 @@ TEST(Scenario, DuplicateKey) {
 TEST(Scenario, AllErrorsReportedInFileOrder) {
   const std::string e = error_of("[plant]\nseed = -1\n[controller]\ndt = 0\n");
   EXPECT_EQ(e,
-            "t.toml:6:8: plant.seed: expected an integer >= 0, got -1\n"
-            "t.toml:8:6: controller.dt: expected a positive number, got 0");
+            "t.toml:6:8: plant.seed: value outside [0, 9223372036854775807], got -1\n"
+            "t.toml:8:6: controller.dt: value outside [0.001, 1], got 0");
 }
 
 TEST(Scenario, MissingFile) {

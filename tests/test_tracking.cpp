@@ -493,7 +493,7 @@ TEST(TrackingScenarioFile, ErrorsNameFileLineAndKey) {
   const std::string ref = "[reference]\nkind = \"smooth_step\"\nfile = \"" + kCsv + "\"\n";
   EXPECT_EQ(error_of(ref), "");
   EXPECT_EQ(error_of(ref + "[plant]\nrtt = -0.01\n"),
-            "t.toml:9:7: plant.rtt: expected a number >= 0, got -0.01");
+            "t.toml:9:7: plant.rtt: value outside [0, 1], got -0.01");
   EXPECT_EQ(error_of(ref + "[plant]\nrtt = 0.0605\n"),
             "t.toml:9:7: plant.rtt: expected a whole number of plant substeps (1/rate_hz), got "
             "rtt * rate_hz = 60.5");
@@ -504,7 +504,7 @@ TEST(TrackingScenarioFile, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of(ref + "[controller]\ncompensation = 1\n"),
             "t.toml:9:16: controller.compensation: expected true or false, got 1");
   EXPECT_EQ(error_of(ref + "[plant]\nmeasurement_fraction = 1.5\n"),
-            "t.toml:9:24: plant.measurement_fraction: expected a number in [0, 1], got 1.5");
+            "t.toml:9:24: plant.measurement_fraction: value outside [0, 1], got 1.5");
   EXPECT_EQ(error_of(ref + "radius = 0.3\n"),
             "t.toml:8:10: reference.radius: only for kind = \"helix\" (this reference is a smooth_step)");
   EXPECT_EQ(error_of("[reference]\nkind = \"smooth_step\"\n"),

@@ -26,19 +26,19 @@ ObstacleScenario read_obstacle_scenario(const toml::table& root, const std::stri
   std::string mode, model;
   s.choice("mode", mode, {"obstacle_avoidance"}, true);
   s.choice("model", model, {"crazyflie"}, true);  // SPEC §5.3
-  s.num("duration", sc.duration, positive);
+  const bool duration_ok = s.num("duration", sc.duration, kDuration) || !root.get("duration");
 
   ObstacleControllerSettings& c = sc.controller;
   Section ctl = s.sub("controller");
-  ctl.integer("N", c.N, int_positive);
-  const bool dt_ok = ctl.num("dt", c.dt, positive) || !ctl.table() || !ctl.table()->get("dt");
+  ctl.integer("N", c.N, kHorizon);
+  const bool dt_ok = ctl.num("dt", c.dt, kControlDt) || !ctl.table() || !ctl.table()->get("dt");
   std::string form;
   if (ctl.choice("constraint_form", form, {"lcl", "squared"}))
     c.form = form == "lcl" ? ObstacleForm::lcl : ObstacleForm::squared;
-  ctl.num("clearance", c.clearance, positive);
-  ctl.num("slack_l1_lower", c.slack_l1_lower, non_negative);
-  ctl.num("slack_l1_upper", c.slack_l1_upper, non_negative);
-  ctl.num("slack_l2", c.slack_l2, non_negative);
+  ctl.num("clearance", c.clearance, closed(1e-3, 10));
+  ctl.num("slack_l1_lower", c.slack_l1_lower, closed(0, 1e12));
+  ctl.num("slack_l1_upper", c.slack_l1_upper, closed(0, 1e12));
+  ctl.num("slack_l2", c.slack_l2, closed(0, 1e12));
   ctl.finish();
 
   Section ref = s.sub("reference");
@@ -72,6 +72,11 @@ ObstacleScenario read_obstacle_scenario(const toml::table& root, const std::stri
             "expected an array of tables ([[" + std::string(key) + "]]), got " + describe(*n));
       return;
     }
+    if (a->size() > kMaxObstacles) {
+      d.add(pos_of(n->source()), std::string(key),
+            outside("the number of obstacles", double(a->size()), closed(0, kMaxObstacles)));
+      return;
+    }
     for (std::size_t i = 0; i < a->size(); ++i) {
       const toml::node& e = *a->get(i);
       read_one(Section(d, e.as_table(), std::string(key) + '[' + std::to_string(i) + ']',
@@ -80,22 +85,22 @@ ObstacleScenario read_obstacle_scenario(const toml::table& root, const std::stri
   };
   tables("spheres", [&](Section o) {
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
-    o.vec("center", center, finite, true);
+    o.vec("center", center, kPosition, true);
     o.finish();
     sc.world.spheres.push_back(center);
   });
   tables("balls", [&](Section o) {
     ThrownBall b;
-    o.vec("position", b.position, finite, true);
-    o.vec("velocity", b.velocity, finite, true);
-    o.num("throw_time", b.throw_time, non_negative);
-    o.num("gravity", b.gravity, non_negative);
+    o.vec("position", b.position, kPosition, true);
+    o.vec("velocity", b.velocity, closed(-1e3, 1e3), true);
+    o.num("throw_time", b.throw_time, closed(0, 3600));
+    o.num("gravity", b.gravity, closed(0, 100));
     o.finish();
     sc.world.balls.push_back(b);
   });
 
   Section plant = s.sub("plant");
-  const bool rate_given = plant.num("rate_hz", sc.plant_rate_hz, at_least_1000);
+  const bool rate_given = plant.num("rate_hz", sc.plant_rate_hz, kPlantRate);
   plant.finish();
   const double substeps = c.dt * sc.plant_rate_hz;
   if (sc.plant_rate_hz >= 1000 && c.dt > 0 &&
@@ -103,6 +108,14 @@ ObstacleScenario read_obstacle_scenario(const toml::table& root, const std::stri
     d.add(rate_given ? plant.pos("rate_hz") : plant.pos(), plant.path("rate_hz"),
           "expected a rate giving a whole number of substeps per control step, got "
           "controller.dt * rate_hz = " + fmt(substeps));
+  }
+  if (sc.world.spheres.size() + sc.world.balls.size() > kMaxObstacles) {
+    d.add(s.pos("balls"), "balls",
+          outside("the number of spheres and balls", double(sc.world.size()),
+                  closed(0, kMaxObstacles)));
+  }
+  if (duration_ok && dt_ok && sc.plant_rate_hz > 0) {
+    check_run_size(d, s.pos("duration"), sc.duration, c.dt, sc.plant_rate_hz);
   }
   s.finish();
   return sc;

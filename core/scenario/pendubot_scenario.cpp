@@ -1,6 +1,7 @@
 #include "core/scenario/pendubot_scenario.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 
 #include "core/scenario/scenario_toml.hpp"
@@ -20,26 +21,26 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
   std::string mode, model;
   s.choice("mode", mode, {"pendubot_swingup"}, true);
   s.choice("model", model, {"pendubot"}, true);
-  s.num("duration", sc.duration, positive);
-  s.num("angle_tolerance", sc.angle_tolerance, positive);
+  const bool duration_ok = s.num("duration", sc.duration, kDuration) || !root.get("duration");
+  s.num("angle_tolerance", sc.angle_tolerance, left_open(0, std::numbers::pi));
 
   Section c = s.sub("controller");
   PendubotOcpSettings& oc = sc.controller;
-  c.integer("N", oc.N, int_positive);
-  c.num("dt", oc.dt, positive);
-  c.num("u_max", oc.u_max, positive);
+  c.integer("N", oc.N, kHorizon);
+  c.num("dt", oc.dt, kControlDt);
+  c.num("u_max", oc.u_max, left_open(0, 100));
   Eigen::Vector2d vb = oc.velocity_bound;
-  if (c.vec("velocity_bound", vb, positive)) oc.velocity_bound = vb;
-  c.num("slack_weight", oc.slack_weight, positive);
+  if (c.vec("velocity_bound", vb, left_open(0, 1e3))) oc.velocity_bound = vb;
+  c.num("slack_weight", oc.slack_weight, pos_weight());
   Eigen::Matrix<double, 5, 1> w = oc.weights;
-  if (c.vec("weights", w, non_negative)) oc.weights = w;
-  if (oc.weights(4) <= 0) {
+  if (c.vec("weights", w, weight())) oc.weights = w;
+  if (!pos_weight().contains(oc.weights(4))) {
     d.add(c.pos("weights"), c.path("weights") + "[4]",
-          "expected a positive input weight (the Riccati input pivots need it), got " +
-              fmt(oc.weights(4)));
+          outside("the input weight", oc.weights(4), pos_weight()) +
+              " (the Riccati input pivots need it)");
   }
   Eigen::Vector4d wn = oc.terminal_weights;
-  if (c.vec("terminal_weights", wn, non_negative)) oc.terminal_weights = wn;
+  if (c.vec("terminal_weights", wn, weight())) oc.terminal_weights = wn;
   const bool ref_given = c.string("reference", sc.reference_path, true);
   std::string qp;
   if (c.choice("qp_solver", qp, {"condensed_active_set", "condensed_dense", "riccati_ipm"})) {
@@ -52,11 +53,11 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
   Section l = s.sub("lqr");
   l.boolean("enabled", sc.lqr.enabled);
   Eigen::Vector4d lq = sc.lqr.q;
-  if (l.vec("q", lq, non_negative)) sc.lqr.q = lq;
-  l.num("r", sc.lqr.r, positive);
-  l.num("enter_angle", sc.lqr.enter_angle, positive);
-  l.num("enter_velocity", sc.lqr.enter_velocity, positive);
-  l.num("exit_angle", sc.lqr.exit_angle, positive);
+  if (l.vec("q", lq, weight())) sc.lqr.q = lq;
+  l.num("r", sc.lqr.r, pos_weight());
+  l.num("enter_angle", sc.lqr.enter_angle, left_open(0, std::numbers::pi));
+  l.num("enter_velocity", sc.lqr.enter_velocity, left_open(0, 1e3));
+  l.num("exit_angle", sc.lqr.exit_angle, left_open(0, 2 * std::numbers::pi));
   if (sc.lqr.exit_angle <= sc.lqr.enter_angle) {
     d.add(l.pos("exit_angle"), l.path("exit_angle"),
           "expected more than lqr.enter_angle = " + fmt(sc.lqr.enter_angle) +
@@ -65,9 +66,9 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
   l.finish();
 
   Section p = s.sub("plant");
-  const bool rate_given = p.num("rate_hz", sc.plant.rate_hz, at_least_1000);
+  const bool rate_given = p.num("rate_hz", sc.plant.rate_hz, kPlantRate);
   Eigen::Vector4d x0 = sc.plant.initial_state;
-  if (p.vec("initial_state", x0)) sc.plant.initial_state = x0;
+  if (p.vec("initial_state", x0, closed(-1e3, 1e3))) sc.plant.initial_state = x0;
   p.finish();
   const double substeps = oc.dt * sc.plant.rate_hz;
   if (sc.plant.rate_hz >= 1000 && oc.dt > 0 &&
@@ -79,13 +80,16 @@ PendubotScenario read_pendubot(const toml::table& root, const std::string& sourc
 
   Section e = s.sub("sensor");
   e.boolean("quantization", sc.sensor.quantization);
-  e.integer("counts_q1", sc.sensor.counts_q1, int_positive);
-  e.integer("counts_q2", sc.sensor.counts_q2, int_positive);
-  e.num("velocity_cutoff_hz", sc.sensor.velocity_cutoff_hz, non_negative);
+  e.integer("counts_q1", sc.sensor.counts_q1, IntRange{4, 1 << 24});
+  e.integer("counts_q2", sc.sensor.counts_q2, IntRange{4, 1 << 24});
+  e.num("velocity_cutoff_hz", sc.sensor.velocity_cutoff_hz, closed(0, 1e5));
   e.choice("estimator", sc.sensor.estimator, {"difference", "observer"});
-  e.num("observer_alpha", sc.sensor.observer_alpha, unit_open);
-  e.num("observer_beta", sc.sensor.observer_beta, unit_open);
+  e.num("observer_alpha", sc.sensor.observer_alpha, open_interval(0, 1));
+  e.num("observer_beta", sc.sensor.observer_beta, open_interval(0, 1));
   e.finish();
+  if (duration_ok && oc.dt > 0 && sc.plant.rate_hz > 0) {
+    check_run_size(d, s.pos("duration"), sc.duration, oc.dt, sc.plant.rate_hz);
+  }
   s.finish();
 
   // The reference file, relative to the scenario's folder; it must fit the controller.

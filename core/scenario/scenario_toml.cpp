@@ -26,33 +26,34 @@ using namespace toml_read;  // NOLINT: the reading vocabulary of this file
 
 
 void read_controller(Section s, MiControllerSettings& c, Diagnostics& d) {
-  const bool n_ok = s.integer("N", c.N, int_positive) || !s.table() || !s.table()->get("N");
-  s.num("dt", c.dt, positive);
+  const bool n_ok = s.integer("N", c.N, kHorizon) || !s.table() || !s.table()->get("N");
+  s.num("dt", c.dt, kControlDt);
   s.boolean("safety_constraints", c.safety_constraints);
   std::string form;
   if (s.choice("obstacle_form", form, {"lcl", "squared"})) {
     c.obstacle_form = form == "lcl" ? ObstacleForm::lcl : ObstacleForm::squared;
   }
-  s.integer("max_constrained_obstacles", c.max_constrained_obstacles, int_non_negative);
-  s.num("vehicle_radius", c.vehicle_radius, non_negative);
-  s.num("slack_l1", c.slack_l1, non_negative);
-  s.num("slack_l2", c.slack_l2, positive);  // keeps the slack Hessian positive definite
+  s.integer("max_constrained_obstacles", c.max_constrained_obstacles,
+            IntRange{0, std::int64_t(kMaxObstacles)});
+  s.num("vehicle_radius", c.vehicle_radius, closed(0, 10));
+  s.num("slack_l1", c.slack_l1, closed(0, 1e12));
+  s.num("slack_l2", c.slack_l2, closed(1e-6, 1e12));  // keeps the slack Hessian positive definite
 
   Section w = s.sub("weights");
-  w.vec("q_eta", c.weights.q_eta, non_negative);
-  w.num("q_nu", c.weights.q_nu, non_negative);
-  w.vec("q_e", c.weights.q_e, non_negative);
-  w.num("r", c.weights.r, positive);  // the only input weight: the Riccati input pivots need it
+  w.vec("q_eta", c.weights.q_eta, weight());
+  w.num("q_nu", c.weights.q_nu, weight());
+  w.vec("q_e", c.weights.q_e, weight());
+  w.num("r", c.weights.r, pos_weight());  // the only input weight: the Riccati input pivots need it
   w.finish();
 
   Section ph = s.sub("ph");
-  ph.num("r", c.ph.r, positive);
-  const bool nb_given = ph.integer("N_b", c.ph.N_b, int_positive);
-  ph.num("mu1", c.ph.mu1, unit_open);
-  ph.num("mu2", c.ph.mu2, unit_closed);
-  ph.num("theta2", c.ph.theta2, positive);
-  ph.num("zeta", c.ph.zeta, positive);
-  ph.num("initial_lambda", c.ph.initial_lambda, unit_closed);
+  ph.num("r", c.ph.r, closed(1e-6, 1e3));
+  const bool nb_given = ph.integer("N_b", c.ph.N_b, kHorizon);
+  ph.num("mu1", c.ph.mu1, open_interval(0, 1));
+  ph.num("mu2", c.ph.mu2, closed(0, 1));
+  ph.num("theta2", c.ph.theta2, closed(1e-6, 1e6));
+  ph.num("zeta", c.ph.zeta, left_open(0, 1));
+  ph.num("initial_lambda", c.ph.initial_lambda, closed(0, 1));
   ph.finish();
   if (n_ok && c.ph.N_b > c.N && (nb_given || !ph.table() || !ph.table()->get("N_b"))) {
     d.add(ph.pos("N_b"), ph.path("N_b"),
@@ -65,15 +66,15 @@ void read_controller(Section s, MiControllerSettings& c, Diagnostics& d) {
 PilotProfile read_pilot(Section s, const std::string& name) {
   PilotProfile p;
   p.name = name;
-  s.vec("q1", p.q1, non_negative);
-  s.vec("q2", p.q2, non_negative);
-  s.vec("q3", p.q3, non_negative);
-  s.vec("q4", p.q4, non_negative);
-  s.num("q5", p.q5, non_negative);
-  s.num("r1", p.r1, positive);
-  s.integer("N", p.N, int_positive);
-  s.num("reaction_delay", p.reaction_delay, non_negative);
-  s.num("max_tilt", p.max_tilt, tilt);
+  s.vec("q1", p.q1, weight());
+  s.vec("q2", p.q2, weight());
+  s.vec("q3", p.q3, weight());
+  s.vec("q4", p.q4, weight());
+  s.num("q5", p.q5, weight());
+  s.num("r1", p.r1, pos_weight());
+  s.integer("N", p.N, kHorizon);
+  s.num("reaction_delay", p.reaction_delay, kDelay);
+  s.num("max_tilt", p.max_tilt, open_interval(0, std::numbers::pi / 2));
   s.finish();
   return p;
 }
@@ -113,24 +114,24 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
           "expected \"mikrokopter\" for mode \"mixed_initiative\" (SPEC 5.4), got \"" + sc.model +
               '"');
   }
-  const bool duration_ok = s.num("duration", sc.duration, positive) || !root.get("duration");
+  const bool duration_ok = s.num("duration", sc.duration, kDuration) || !root.get("duration");
   const bool pilot_given = s.string("pilot", sc.default_pilot);
 
   read_controller(s.sub("controller"), sc.controller, d);
 
   Section ref = s.sub("reference");
   Eigen::Vector2d center = sc.reference.center;
-  if (ref.vec("center", center)) sc.reference.center = center;
-  ref.num("radius", sc.reference.radius, non_negative);
-  ref.num("start_height", sc.reference.start_height);
-  ref.num("climb_rate", sc.reference.climb_rate);
-  ref.num("angular_rate", sc.reference.angular_rate);
-  ref.num("phase", sc.reference.phase);
+  if (ref.vec("center", center, kPosition)) sc.reference.center = center;
+  ref.num("radius", sc.reference.radius, closed(0, 1e3));
+  ref.num("start_height", sc.reference.start_height, kPosition);
+  ref.num("climb_rate", sc.reference.climb_rate, kClimbRate);
+  ref.num("angular_rate", sc.reference.angular_rate, kAngularRate);
+  ref.num("phase", sc.reference.phase, kPhase);
   ref.finish();
 
   Section arena = s.sub("arena");
-  bool box_ok = (arena.vec("min", sc.arena.min) || !arena.table() || !arena.table()->get("min")) &
-                (arena.vec("max", sc.arena.max) || !arena.table() || !arena.table()->get("max"));
+  bool box_ok = (arena.vec("min", sc.arena.min, kPosition) || !arena.table() || !arena.table()->get("min")) &
+                (arena.vec("max", sc.arena.max, kPosition) || !arena.table() || !arena.table()->get("max"));
   if (box_ok && !(sc.arena.min.array() < sc.arena.max.array()).all()) {
     d.add(arena.pos("max"), arena.path("max"),
           "expected every component above arena.min = " + vec_text(sc.arena.min) + ", got " +
@@ -142,14 +143,17 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
     if (!a || !a->is_array_of_tables()) {
       d.add(pos_of(obs->source()), arena.path("obstacles"),
             "expected an array of tables ([[arena.obstacles]]), got " + describe(*obs));
+    } else if (a->size() > kMaxObstacles) {
+      d.add(pos_of(obs->source()), arena.path("obstacles"),
+            outside("the number of obstacles", double(a->size()), closed(0, kMaxObstacles)));
     } else {
       for (std::size_t i = 0; i < a->size(); ++i) {
         const toml::node& e = *a->get(i);
         Section o(d, e.as_table(), arena.path("obstacles") + '[' + std::to_string(i) + ']',
                   pos_of(e.source()));
         Obstacle ob;
-        const bool c_ok = o.vec("center", ob.center, finite, true);
-        o.num("radius", ob.radius, positive, true);
+        const bool c_ok = o.vec("center", ob.center, kPosition, true);
+        const bool r_ok = o.num("radius", ob.radius, left_open(0, 100), true);
         o.finish();
         if (c_ok && box_ok &&
             ((ob.center.array() < sc.arena.min.array()).any() ||
@@ -157,6 +161,13 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
           d.add(o.pos("center"), o.path("center"),
                 "expected a point inside the arena " + vec_text(sc.arena.min) + " .. " +
                     vec_text(sc.arena.max) + ", got " + vec_text(ob.center));
+        }
+        // A sphere reaching past every corner would fill the arena: nothing left to fly in.
+        const double half_diagonal = 0.5 * (sc.arena.max - sc.arena.min).norm();
+        if (r_ok && box_ok && ob.radius >= half_diagonal) {
+          d.add(o.pos("radius"), o.path("radius"),
+                outside("radius", ob.radius, open_interval(0, half_diagonal)) +
+                    " (half the arena's diagonal)");
         }
         sc.arena.obstacles.push_back(ob);
       }
@@ -199,11 +210,11 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   }
 
   Section plant = s.sub("plant");
-  const bool rate_given = plant.num("rate_hz", sc.plant.rate_hz, at_least_1000);
-  plant.num("input_delay", sc.plant.input_delay, non_negative);
-  plant.num("position_noise", sc.plant.position_noise, non_negative);
+  const bool rate_given = plant.num("rate_hz", sc.plant.rate_hz, kPlantRate);
+  plant.num("input_delay", sc.plant.input_delay, kDelay);
+  plant.num("position_noise", sc.plant.position_noise, closed(0, 10));
   std::int64_t seed = std::int64_t(sc.plant.seed);
-  if (plant.integer("seed", seed, int_non_negative)) sc.plant.seed = std::uint64_t(seed);
+  if (plant.integer("seed", seed, IntRange{0, std::numeric_limits<std::int64_t>::max()})) sc.plant.seed = std::uint64_t(seed);
   plant.finish();
   // The plant takes a whole number of RK4 substeps per control step.
   const double substeps = sc.controller.dt * sc.plant.rate_hz;
@@ -212,6 +223,10 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
     d.add(rate_given ? plant.pos("rate_hz") : plant.pos(), plant.path("rate_hz"),
           "expected a rate giving a whole number of substeps per control step, got controller.dt "
           "* rate_hz = " + fmt(substeps));
+  }
+
+  if (duration_ok && sc.controller.dt > 0 && sc.plant.rate_hz > 0) {
+    check_run_size(d, s.pos("duration"), sc.duration, sc.controller.dt, sc.plant.rate_hz);
   }
 
   s.finish();

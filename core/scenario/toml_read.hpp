@@ -9,6 +9,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <exception>
 #include <initializer_list>
 #include <limits>
 #include <numbers>
@@ -103,26 +105,83 @@ inline std::size_t edit_distance(std::string_view a, std::string_view b) {
   return row[b.size()];
 }
 
-// Range checks: nullptr when fine, else what was expected.
-using Check = const char* (*)(double);
-using IntCheck = const char* (*)(std::int64_t);
+// The documented range of a key (docs/scenario-format.md): a closed or open interval, checked
+// after the value is known to be finite. Message: `value outside (0, 3600], got 1e+300`.
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+  bool hi_open = false;
 
-inline const char* finite(double) { return nullptr; }  // non-finite values are rejected before checks
-inline const char* positive(double v) { return v > 0 ? nullptr : "expected a positive number"; }
-inline const char* non_negative(double v) { return v >= 0 ? nullptr : "expected a number >= 0"; }
-inline const char* unit_open(double v) {
-  return v > 0 && v < 1 ? nullptr : "expected a number in (0, 1)";
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string text() const {
+    return std::string(lo_open ? "(" : "[") + fmt_bound(lo) + ", " + fmt_bound(hi) +
+           (hi_open ? ")" : "]");
+  }
+  static std::string fmt_bound(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return buf;
+  }
+};
+
+struct IntRange {
+  std::int64_t lo = 0;
+  std::int64_t hi = 0;
+  bool contains(std::int64_t v) const { return v >= lo && v <= hi; }
+  std::string text() const {
+    return '[' + std::to_string(lo) + ", " + std::to_string(hi) + ']';
+  }
+};
+
+constexpr double kHugeWeight = 1e9;  // cost weights: beyond this the QPs lose all precision
+
+inline constexpr Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+inline constexpr Range left_open(double lo, double hi) { return {lo, hi, true, false}; }
+inline constexpr Range open_interval(double lo, double hi) { return {lo, hi, true, true}; }
+// A weight that may be 0, and one that must stay away from 0 (a pivot or a Hessian diagonal).
+inline constexpr Range weight() { return closed(0, kHugeWeight); }
+inline constexpr Range pos_weight() { return closed(1e-6, kHugeWeight); }
+
+// Limits shared by every scenario kind (docs/scenario-format.md, "Ranges"). They keep memory
+// and time proportionate: at most an hour simulated, 2e6 control steps (per-step buffers of a
+// few hundred MB at most), 4e7 plant substeps (minutes of RK4), horizons whose QPs stay
+// interactive, and every count far inside an int.
+constexpr Range kDuration = left_open(0, 3600);      // [s]
+constexpr Range kControlDt = closed(1e-3, 1);         // [s]
+constexpr IntRange kHorizon{1, 500};                  // stages
+constexpr Range kPlantRate = closed(1000, 1e5);       // [Hz]
+constexpr double kMaxSteps = 2e6;                     // duration / dt
+constexpr double kMaxSubsteps = 4e7;                  // duration * rate_hz
+constexpr Range kDelay = closed(0, 10);               // [s]
+constexpr Range kPosition = closed(-1e3, 1e3);        // [m], any coordinate
+constexpr Range kAngularRate = closed(-10, 10);       // [rad/s], helix references
+constexpr Range kClimbRate = closed(-100, 100);       // [m/s]
+constexpr Range kPhase = closed(-100, 100);           // [rad]
+constexpr std::size_t kMaxObstacles = 64;             // per scenario
+
+// "value outside [a, b]" for a derived (computed) quantity named in `what`.
+inline std::string outside(std::string_view what, double v, const Range& r) {
+  return std::string(what) + " = " + Range::fmt_bound(v) + ", outside " + r.text();
 }
-inline const char* unit_closed(double v) {
-  return v >= 0 && v <= 1 ? nullptr : "expected a number in [0, 1]";
-}
-inline const char* tilt(double v) {
-  return v > 0 && v < std::numbers::pi / 2 ? nullptr : "expected an angle in (0, pi/2) rad";
-}
-inline const char* at_least_1000(double v) { return v >= 1000 ? nullptr : "expected a number >= 1000"; }
-inline const char* int_positive(std::int64_t v) { return v >= 1 ? nullptr : "expected an integer >= 1"; }
-inline const char* int_non_negative(std::int64_t v) {
-  return v >= 0 ? nullptr : "expected an integer >= 0";
+
+// The size of a run: 1 .. kMaxSteps control steps (duration / dt) and at most kMaxSubsteps
+// plant substeps (duration * rate_hz). Reported at `at` (the duration, or its table).
+inline void check_run_size(Diagnostics& d, Pos at, double duration, double dt, double rate_hz) {
+  const double steps = duration / dt;
+  if (!(steps >= 1 - 1e-9 && steps <= kMaxSteps)) {
+    d.add(at, "duration",
+          outside("duration / controller.dt (control steps)", steps,
+                  closed(1, kMaxSteps)));
+  }
+  const double substeps = duration * rate_hz;
+  if (!(substeps <= kMaxSubsteps)) {
+    d.add(at, "duration",
+          outside("duration * plant.rate_hz (plant substeps)", substeps,
+                  closed(0, kMaxSubsteps)));
+  }
 }
 
 // One TOML table being read: every key asked for is "known"; finish() reports the rest.
@@ -161,12 +220,13 @@ class Section {
     return Section(d_, n ? n->as_table() : nullptr, path(key), n ? pos_of(n->source()) : pos_);
   }
 
-  bool num(std::string_view key, double& out, Check check = finite, bool required = false) {
+  bool num(std::string_view key, double& out, const Range& range, bool required = false) {
     const toml::node* n = take(key, required, "a number");
-    return n && read_num(*n, path(key), out, check);
+    return n && read_num(*n, path(key), out, range);
   }
 
-  bool integer(std::string_view key, std::int64_t& out, IntCheck check, bool required = false) {
+  bool integer(std::string_view key, std::int64_t& out, const IntRange& range,
+               bool required = false) {
     const toml::node* n = take(key, required, "an integer");
     if (!n) return false;
     if (!n->is_integer()) {
@@ -174,21 +234,19 @@ class Section {
       return false;
     }
     const std::int64_t v = n->as_integer()->get();
-    if (const char* e = check(v)) {
-      d_.add(pos_of(n->source()), path(key), std::string(e) + ", got " + std::to_string(v));
+    if (!range.contains(v)) {
+      d_.add(pos_of(n->source()), path(key),
+             "value outside " + range.text() + ", got " + std::to_string(v));
       return false;
     }
     out = v;
     return true;
   }
 
-  bool integer(std::string_view key, int& out, IntCheck check, bool required = false) {
+  // Every int range lies inside int's: the narrowing below is exact.
+  bool integer(std::string_view key, int& out, const IntRange& range, bool required = false) {
     std::int64_t v = out;
-    if (!integer(key, v, check, required)) return false;
-    if (v > std::numeric_limits<int>::max()) {
-      d_.add(pos(key), path(key), "expected an integer below 2^31, got " + std::to_string(v));
-      return false;
-    }
+    if (!integer(key, v, range, required)) return false;
     out = int(v);
     return true;
   }
@@ -234,7 +292,7 @@ class Section {
   }
 
   template <int n>
-  bool vec(std::string_view key, Eigen::Matrix<double, n, 1>& out, Check check = finite,
+  bool vec(std::string_view key, Eigen::Matrix<double, n, 1>& out, const Range& range,
            bool required = false) {
     const std::string expected = "an array of " + std::to_string(n) + " numbers";
     const toml::node* node = take(key, required, expected);
@@ -248,7 +306,7 @@ class Section {
     bool ok = true;
     for (int i = 0; i < n; ++i) {
       ok = read_num(*a->get(std::size_t(i)), path(key) + '[' + std::to_string(i) + ']', v[i],
-                    check) && ok;
+                    range) && ok;
     }
     if (ok) out = v;
     return ok;
@@ -279,7 +337,7 @@ class Section {
   }
 
  private:
-  bool read_num(const toml::node& n, const std::string& path, double& out, Check check) {
+  bool read_num(const toml::node& n, const std::string& path, double& out, const Range& range) {
     double v = 0;
     if (n.is_floating_point()) {
       v = n.as_floating_point()->get();
@@ -293,8 +351,8 @@ class Section {
       d_.add(pos_of(n.source()), path, "expected a finite number, got " + describe(n));
       return false;
     }
-    if (const char* e = check(v)) {
-      d_.add(pos_of(n.source()), path, std::string(e) + ", got " + describe(n));
+    if (!range.contains(v)) {
+      d_.add(pos_of(n.source()), path, "value outside " + range.text() + ", got " + describe(n));
       return false;
     }
     out = v;
@@ -362,6 +420,9 @@ inline bool parse_toml(std::string_view text, const std::string& source_name, Di
   } catch (const toml::parse_error& e) {
     add_syntax_error(d, e, text);
     return false;
+  } catch (const std::exception& e) {
+    d.add(Pos{1, 1}, "TOML syntax", std::string("cannot be parsed: ") + e.what());
+    return false;
   }
   return true;
 }
@@ -377,7 +438,12 @@ std::optional<T> parse_document(std::string_view text, const std::string& source
     error = d.str();
     return std::nullopt;
   }
-  T value = read(root, d);
+  T value;
+  try {
+    value = read(root, d);
+  } catch (const std::exception& e) {  // bad_alloc, filesystem_error: reported, never fatal
+    d.add(Pos{1, 1}, "scenario", std::string("cannot be loaded: ") + e.what());
+  }
   if (!d.empty()) {
     error = d.str();
     return std::nullopt;

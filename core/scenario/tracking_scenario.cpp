@@ -14,8 +14,6 @@ namespace {
 
 using namespace toml_read;  // NOLINT: the reading vocabulary of this file
 
-const char* unit_closed_check(double v) { return unit_closed(v); }
-
 // Whole number of `unit`s in v (to rounding).
 bool whole(double v) { return std::abs(v - std::round(v)) <= 1e-9 * std::max(1.0, std::abs(v)); }
 
@@ -37,23 +35,23 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
   std::string mode, model;
   s.choice("mode", mode, {"crazyflie_tracking"}, true);
   s.choice("model", model, {"crazyflie"}, true);
-  s.num("duration", sc.duration, positive);
+  const bool duration_ok = s.num("duration", sc.duration, kDuration) || !root.get("duration");
 
   Section c = s.sub("controller");
   std::string kind;
   if (c.choice("kind", kind, {"nmpc", "lqr"}))
     sc.controller.kind = kind == "lqr" ? TrackingControllerKind::lqr : TrackingControllerKind::nmpc;
-  c.integer("N", sc.controller.N, int_positive);
-  const bool dt_ok = c.num("dt", sc.controller.dt, positive) || !c.table() || !c.table()->get("dt");
+  c.integer("N", sc.controller.N, kHorizon);
+  const bool dt_ok = c.num("dt", sc.controller.dt, kControlDt) || !c.table() || !c.table()->get("dt");
   c.boolean("compensation", sc.controller.compensation);
   c.finish();
 
   Section pl = s.sub("plant");
   const bool rate_ok =
-      pl.num("rate_hz", sc.plant.rate_hz, at_least_1000) || !pl.table() || !pl.table()->get("rate_hz");
-  const bool rtt_ok = pl.num("rtt", sc.plant.rtt, non_negative) || !pl.table() || !pl.table()->get("rtt");
-  pl.num("measurement_fraction", sc.plant.measurement_fraction, unit_closed_check);
-  pl.vec("start", sc.plant.start);
+      pl.num("rate_hz", sc.plant.rate_hz, kPlantRate) || !pl.table() || !pl.table()->get("rate_hz");
+  const bool rtt_ok = pl.num("rtt", sc.plant.rtt, closed(0, 1)) || !pl.table() || !pl.table()->get("rtt");
+  pl.num("measurement_fraction", sc.plant.measurement_fraction, closed(0, 1));
+  pl.vec("start", sc.plant.start, kPosition);
   pl.finish();
   // Whole substeps per control period and per round trip (core/control/tracking.hpp, delay model).
   if (dt_ok && rate_ok && !whole(sc.controller.dt * sc.plant.rate_hz)) {
@@ -73,12 +71,12 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
   sc.reference.kind = rk == "helix" ? TrackingReferenceKind::helix : TrackingReferenceKind::smooth_step;
   const bool file_given = r.string("file", sc.reference.file);
   TrackingHelix& hx = sc.reference.helix;
-  r.num("radius", hx.radius, non_negative);
-  r.num("start_height", hx.start_height);
-  r.num("climb_rate", hx.climb_rate);
-  r.num("angular_rate", hx.angular_rate);
-  r.num("phase", hx.phase);
-  const bool length_ok = r.num("length", hx.length, positive) || !r.table() || !r.table()->get("length");
+  r.num("radius", hx.radius, closed(0, 1e3));
+  r.num("start_height", hx.start_height, kPosition);
+  r.num("climb_rate", hx.climb_rate, kClimbRate);
+  r.num("angular_rate", hx.angular_rate, kAngularRate);
+  r.num("phase", hx.phase, kPhase);
+  const bool length_ok = r.num("length", hx.length, kDuration) || !r.table() || !r.table()->get("length");
   const models::Crazyflie cf{};
   if (sc.reference.kind == TrackingReferenceKind::smooth_step) {
     for (const char* k : {"radius", "start_height", "climb_rate", "angular_rate", "phase", "length"}) {
@@ -117,6 +115,9 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
     }
   }
   r.finish();
+  if (duration_ok && dt_ok && rate_ok) {
+    check_run_size(d, s.pos("duration"), sc.duration, sc.controller.dt, sc.plant.rate_hz);
+  }
   s.finish();
   return sc;
 }

@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+"""Mutation run over the shipped scenarios (docs/scenario-format.md, "Ranges").
+
+For every key of every scenarios/*.toml (walked line by line, tables included) it writes
+variants -- the key missing, a wrong type, 0, negative, tiny, huge, nan, +-inf, integer limits;
+for an array, its first element mutated too -- and flies each one headless for a short time
+under a timeout and a memory limit. Each run is classified:
+
+  clean error  exit 1 or 2 with a message (`file:line:col: key: ...` or another clear line)
+  accepted     exit 0, and the JSON report holds only finite numbers
+  crash        a signal, abort or exit >= 128
+  hang         the timeout was reached
+  nonsense     exit 0 with inf/nan in the report, or an error exit with no message
+
+Prints `tried / clean error / accepted / crash / hang / nonsense`; exits 1 if any run crashed,
+hung or gave nonsense. --sample K flies a seeded random sample of K variants (the CTest).
+"""
+import argparse
+import json
+import math
+import os
+import random
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+VALUES = [
+    ("zero", "0"),
+    ("negative", "-1.5"),
+    ("negative_int", "-1"),
+    ("tiny", "1e-300"),
+    ("huge", "1e300"),
+    ("nan", "nan"),
+    ("inf", "inf"),
+    ("-inf", "-inf"),
+    ("int_max", "2147483647"),
+    ("int_min", "-2147483648"),
+    ("int64_max", "9223372036854775807"),
+]
+HEADER = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?")
+KEYVAL = re.compile(r"^(\s*)([A-Za-z0-9_\-]+)(\s*=\s*)(.*)$")
+LOCATED = re.compile(r":\d+:\d+: \S+: ")
+
+
+def split_value(rest):
+    """Value text and trailing comment of `rest` (the text after `key =`)."""
+    depth, quote = 0, False
+    for i, ch in enumerate(rest):
+        if ch == '"':
+            quote = not quote
+        elif not quote and ch == "[":
+            depth += 1
+        elif not quote and ch == "]":
+            depth -= 1
+        elif not quote and depth == 0 and ch == "#":
+            return rest[:i].rstrip(), rest[i:]
+    return rest.rstrip(), ""
+
+
+def variants(text):
+    """(label, mutated text) for every key and table of one scenario."""
+    lines = text.split("\n")
+    table = ""
+    out = []
+    # Whole tables missing: a header line and its body up to the next header.
+    headers = [i for i, l in enumerate(lines) if HEADER.match(l)]
+    for n, i in enumerate(headers):
+        end = headers[n + 1] if n + 1 < len(headers) else len(lines)
+        name = HEADER.match(lines[i]).group(2)
+        out.append((f"[{name}]#{i + 1}:missing", "\n".join(lines[:i] + lines[end:])))
+    for i, line in enumerate(lines):
+        h = HEADER.match(line)
+        if h:
+            table = h.group(2)
+            continue
+        m = KEYVAL.match(line)
+        if not m or line.lstrip().startswith("#"):
+            continue
+        indent, key, eq, rest = m.groups()
+        value, comment = split_value(rest)
+        path = f"{table}.{key}" if table else key
+        where = f"{path}@{i + 1}"
+
+        def put(new_value, lines=lines, i=i):
+            copy = list(lines)
+            copy[i] = f"{indent}{key}{eq}{new_value} {comment}".rstrip()
+            return "\n".join(copy)
+
+        out.append((f"{where}:missing", "\n".join(lines[:i] + lines[i + 1:])))
+        if value.startswith('"'):
+            out.append((f"{where}:wrong_type", put("1")))
+            out.append((f"{where}:empty_string", put('""')))
+            out.append((f"{where}:other_string", put('"no such thing"')))
+            continue
+        out.append((f"{where}:wrong_type", put('"text"')))
+        if value in ("true", "false"):
+            out.append((f"{where}:int", put("1")))
+            continue
+        if value.startswith("["):
+            items = [s.strip() for s in value.strip("[]").split(",") if s.strip()]
+            out.append((f"{where}:empty_array", put("[]")))
+            out.append((f"{where}:longer_array", put("[" + ", ".join(items + ["1.0"]) + "]")))
+            for label, v in VALUES:
+                out.append((f"{where}[0]:{label}", put("[" + ", ".join([v] + items[1:]) + "]")))
+            continue
+        for label, v in VALUES:
+            out.append((f"{where}:{label}", put(v)))
+    return out
+
+
+def limit_memory(limit_bytes):
+    def apply():
+        resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
+    return apply
+
+
+def finite_json(path):
+    """True when the report parses and every number in it is finite."""
+    try:
+        text = Path(path).read_text()
+    except OSError:
+        return False
+    if re.search(r"\b(nan|inf|NaN|Infinity)\b", text):
+        return False
+    try:
+        data = json.loads(text)
+    except ValueError:
+        return False
+
+    def walk(v):
+        if isinstance(v, dict):
+            return all(walk(x) for x in v.values())
+        if isinstance(v, list):
+            return all(walk(x) for x in v)
+        if isinstance(v, float):
+            return math.isfinite(v) and abs(v) < 1e100
+        return True
+    return walk(data)
+
+
+def fly(binary, scenario, workdir, duration, timeout, memory):
+    report = workdir / "report.json"
+    if report.exists():
+        report.unlink()
+    cmd = [str(binary), "fly", "--scenario", str(scenario), "--headless",
+           "--duration", str(duration), "--report", str(report)]
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace",
+                           timeout=timeout, preexec_fn=limit_memory(memory), cwd=workdir)
+    except subprocess.TimeoutExpired:
+        return "hang", ""
+    err = (p.stderr or "").strip()
+    if p.returncode < 0 or p.returncode >= 128:
+        return "crash", err[-400:]
+    if p.returncode == 0:
+        return ("accepted", "") if finite_json(report) else ("nonsense", "non-finite report")
+    if p.returncode in (1, 2, 3) and err:
+        return "clean error", err.split("\n")[0]
+    return "nonsense", f"exit {p.returncode} with message {err[:200]!r}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--mixpilot", default="build/release/app/mixpilot")
+    ap.add_argument("--scenarios", default="scenarios")
+    ap.add_argument("--duration", type=float, default=0.3)
+    ap.add_argument("--timeout", type=float, default=20)
+    ap.add_argument("--memory-gb", type=float, default=4)
+    ap.add_argument("--sample", type=int, default=0, help="fly only K random variants")
+    ap.add_argument("--seed", type=int, default=12)
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--verbose", action="store_true", help="print every run's class")
+    args = ap.parse_args()
+
+    binary = Path(args.mixpilot).resolve()
+    scen_dir = Path(args.scenarios).resolve()
+    work = Path(tempfile.mkdtemp(prefix="mutate_scenarios."))
+    (work / "references").symlink_to(scen_dir / "references")
+    cases = []
+    for f in sorted(scen_dir.glob("*.toml")):
+        for label, text in variants(f.read_text()):
+            cases.append((f.stem, label, text))
+    if args.sample and args.sample < len(cases):
+        cases = random.Random(args.seed).sample(cases, args.sample)
+
+    counts = {k: 0 for k in ("clean error", "accepted", "crash", "hang", "nonsense")}
+    bad = []
+
+    def run(idx_case):
+        idx, (stem, label, text) = idx_case
+        d = work / f"run{idx % max(1, args.jobs)}"
+        d.mkdir(exist_ok=True)
+        if not (d / "references").exists():
+            (d / "references").symlink_to(scen_dir / "references")
+        path = d / f"{stem}.toml"
+        path.write_text(text)
+        return stem, label, fly(binary, path, d, args.duration, args.timeout,
+                                int(args.memory_gb * (1 << 30)))
+
+    if args.jobs > 1:
+        # One worker directory per job slot: runs in a slot are sequential.
+        from concurrent.futures import ThreadPoolExecutor
+        slots = [[(i, c) for i, c in enumerate(cases) if i % args.jobs == j]
+                 for j in range(args.jobs)]
+        with ThreadPoolExecutor(args.jobs) as ex:
+            results = [r for rs in ex.map(lambda s: [run(c) for c in s], slots) for r in rs]
+    else:
+        results = [run(c) for c in enumerate(cases)]
+    for stem, label, (kind, why) in results:
+        counts[kind] += 1
+        if args.verbose:
+            print(f"{kind:12s} {stem}: {label}: {why}")
+        if kind in ("crash", "hang", "nonsense"):
+            bad.append(f"{kind}: {stem}: {label}: {why}")
+    shutil.rmtree(work, ignore_errors=True)
+    for b in bad:
+        print(b)
+    print(f"tried {len(results)} / clean error {counts['clean error']} / accepted "
+          f"{counts['accepted']} / crash {counts['crash']} / hang {counts['hang']} / nonsense "
+          f"{counts['nonsense']}")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
