@@ -216,7 +216,7 @@ TEST(Scenario, OutOfRange) {
   EXPECT_EQ(error_of("[controller.ph]\nmu1 = 1.0\n"),
             "t.toml:6:7: controller.ph.mu1: value outside (0, 1), got 1.0");
   EXPECT_EQ(error_of("[controller]\nN = 0\n"),
-            "t.toml:6:5: controller.N: value outside [1, 500], got 0");
+            "t.toml:6:5: controller.N: value outside [1, 200], got 0");
   EXPECT_EQ(error_of("duration = nan\n"),
             "t.toml:5:12: duration: expected a finite number, got nan");
   EXPECT_EQ(error_of("[controller]\nN = 8\n[controller.ph]\nN_b = 10\n"),

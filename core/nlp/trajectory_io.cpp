@@ -112,6 +112,12 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
     error = where(path, 1) + "expected the header to start with column \"t\"";
     return std::nullopt;
   }
+  if (header.size() > std::size_t(1 + 2 * kMaxTrajectoryColumns)) {
+    error = where(path, 1) + "expected at most " + std::to_string(kMaxTrajectoryColumns) +
+            " x and " + std::to_string(kMaxTrajectoryColumns) + " u columns, found " +
+            std::to_string(header.size()) + " columns";
+    return std::nullopt;
+  }
   for (size_t c = 1; c < header.size(); ++c) {
     const std::string name = trim(header[c]);
     std::string want_x = "x", want_u = "u";
@@ -133,6 +139,12 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
     error = where(path, 1) + "expected at least one x column and one u column";
     return std::nullopt;
   }
+  if (nx > kMaxTrajectoryColumns || nu > kMaxTrajectoryColumns) {
+    error = where(path, 1) + "expected at most " + std::to_string(kMaxTrajectoryColumns) +
+            " x and " + std::to_string(kMaxTrajectoryColumns) + " u columns, found " +
+            std::to_string(nx) + " and " + std::to_string(nu);
+    return std::nullopt;
+  }
   const int ncols = 1 + nx + nu;
 
   TrajectoryFile file;
@@ -142,6 +154,11 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
   while (std::getline(in, line)) {
     ++lineno;
     if (trim(line).empty()) continue;
+    if (t.size() >= std::size_t(kMaxTrajectoryRows)) {
+      error = where(path, lineno) + "expected at most " + std::to_string(kMaxTrajectoryRows) +
+              " rows";
+      return std::nullopt;
+    }
     if (last_seen) {
       error = where(path, lineno - 1) +
               "empty u cells are only allowed on the last row, but more rows follow";

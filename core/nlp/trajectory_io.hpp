@@ -19,6 +19,10 @@ namespace mixpilot {
 // A trajectory file larger than this is refused before it is read (a 10 min trajectory at 1 ms
 // with 17 columns is ≈ 100 MiB).
 inline constexpr long long kMaxTrajectoryBytes = 256ll << 20;
+// Row and column bounds (docs/scenario-format.md, "Reference CSVs"): as many nodes as the
+// longest run has control steps, and state/input sizes far above every model's.
+inline constexpr int kMaxTrajectoryRows = 2'000'000;
+inline constexpr int kMaxTrajectoryColumns = 64;  // each of x and u
 
 struct TrajectoryFile {
   OcpTrajectory trajectory;  // x: N+1 x nx, u: N x nu

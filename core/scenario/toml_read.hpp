@@ -151,7 +151,7 @@ inline constexpr Range pos_weight() { return closed(1e-6, kHugeWeight); }
 // interactive, and every count far inside an int.
 constexpr Range kDuration = left_open(0, 3600);      // [s]
 constexpr Range kControlDt = closed(1e-3, 1);         // [s]
-constexpr IntRange kHorizon{1, 500};                  // stages
+constexpr IntRange kHorizon{1, 200};                  // stages
 constexpr Range kPlantRate = closed(1000, 1e5);       // [Hz]
 constexpr double kMaxSteps = 2e6;                     // duration / dt
 constexpr double kMaxSubsteps = 4e7;                  // duration * rate_hz
