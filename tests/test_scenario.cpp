@@ -4,10 +4,16 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
 #include <limits>
 #include <string>
 
+#include "core/scenario/obstacle_scenario.hpp"
+#include "core/scenario/pendubot_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "core/scenario/tracking_scenario.hpp"
 
 namespace mixpilot {
 namespace {
@@ -310,6 +316,188 @@ TEST(Scenario, MissingFile) {
   std::string error;
   EXPECT_FALSE(load_scenario("no/such/scenario.toml", error));
   EXPECT_EQ(error, "no/such/scenario.toml: cannot open file (No such file or directory)");
+}
+
+// --- Ranges (docs/scenario-format.md, "Ranges"): each value below was accepted by the loaders
+// before they had ranges, and then crashed, hung or gave nonsense in flight.
+
+struct Edit {
+  std::string table, key, value;
+};
+
+// A shipped scenario with each edit's `key = value` in its [table] (replacing the key's line,
+// else added under the table's header), parsed under its own path so its reference CSV resolves.
+template <class Parse>
+std::string shipped_error(const std::string& file, const std::vector<Edit>& edits, Parse parse) {
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + file;
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  const std::regex header(R"(^\s*\[+\s*([^\]]+?)\s*\]+.*)");
+  for (const Edit& e : edits) {
+    const std::regex assignment("^\\s*" + e.key + "\\s*=.*");
+    std::string current;
+    std::size_t insert_at = e.table.empty() ? 0 : lines.size() + 1;
+    bool done = false;
+    std::smatch m;
+    for (std::size_t i = 0; i < lines.size() && !done; ++i) {
+      if (std::regex_match(lines[i], m, header)) {
+        current = m[1];
+        if (current == e.table && insert_at > lines.size()) insert_at = i + 1;
+      } else if (current == e.table && std::regex_match(lines[i], assignment)) {
+        lines[i] = e.key + " = " + e.value;
+        done = true;
+      }
+    }
+    EXPECT_TRUE(done || insert_at <= lines.size()) << e.table << " not in " << file;
+    if (!done && insert_at <= lines.size()) {
+      lines.insert(lines.begin() + std::ptrdiff_t(insert_at), e.key + " = " + e.value);
+    }
+  }
+  std::string out;
+  for (const std::string& l : lines) out += l + '\n';
+  std::string error;
+  const auto sc = parse(out, path, error);
+  EXPECT_EQ(sc.has_value(), error.empty());
+  return error;
+}
+
+std::string mi_error(const std::vector<Edit>& edits) {
+  return shipped_error("mi_helix.toml", edits,
+                       [](const std::string& t, const std::string& p, std::string& e) {
+                         return parse_scenario(t, p, e);
+                       });
+}
+std::string pendubot_error(const std::vector<Edit>& edits) {
+  return shipped_error("pendubot_swingup.toml", edits,
+                       [](const std::string& t, const std::string& p, std::string& e) {
+                         return parse_pendubot_scenario(t, p, e);
+                       });
+}
+std::string tracking_error(const std::vector<Edit>& edits) {
+  return shipped_error("tracking_helix.toml", edits,
+                       [](const std::string& t, const std::string& p, std::string& e) {
+                         return parse_tracking_scenario(t, p, e);
+                       });
+}
+std::string obstacle_error(const std::vector<Edit>& edits) {
+  return shipped_error("obstacles_thrown_balls.toml", edits,
+                       [](const std::string& t, const std::string& p, std::string& e) {
+                         return parse_obstacle_scenario(t, p, e);
+                       });
+}
+
+// `key: value outside <range>` at the key's own line and column.
+::testing::AssertionResult outside(const std::string& error, const std::string& key,
+                                   const std::string& range) {
+  const std::string want = ": " + key + ": value outside " + range;
+  if (error.find(want) != std::string::npos &&
+      std::regex_search(error, std::regex(R"(\.toml:\d+:\d+: )"))) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "expected \"" << want << "\" in \"" << error << '"';
+}
+
+TEST(ScenarioRanges, ShippedScenariosAreInsideTheRanges) {
+  EXPECT_EQ(mi_error({{"controller", "N", "50"}}), "");
+  EXPECT_EQ(pendubot_error({{"controller", "N", "10"}}), "");
+  EXPECT_EQ(tracking_error({{"controller", "N", "50"}}), "");
+  EXPECT_EQ(obstacle_error({{"controller", "clearance", "0.2"}}), "");
+}
+
+// controller.N = 2147483647 overflowed an int in the QP dimensions (std::length_error, abort);
+// N = 100000 hung. The horizon is at most 200 stages in every mode.
+TEST(ScenarioRanges, HorizonIsBounded) {
+  for (const char* n : {"2147483647", "100000", "201"}) {
+    EXPECT_TRUE(outside(mi_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
+    EXPECT_TRUE(outside(pendubot_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
+    EXPECT_TRUE(outside(tracking_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
+    EXPECT_TRUE(
+        outside(obstacle_error({{"controller", "N", n}}), "controller.N", "[1, 200]"))
+        << n;
+  }
+  EXPECT_TRUE(outside(mi_error({{"pilots.novice", "N", "2147483647"}}), "pilots.novice.N", "[1, 200]"));
+  EXPECT_TRUE(outside(mi_error({{"controller.ph", "N_b", "2147483647"}}), "controller.ph.N_b",
+                      "[1, 200]"));
+}
+
+// A huge reference.angular_rate hung the loader's arena check (its sample count overflowed).
+TEST(ScenarioRanges, HelixAngularRateIsBounded) {
+  for (const char* w : {"1e300", "1e9", "-11"}) {
+    EXPECT_TRUE(outside(mi_error({{"reference", "angular_rate", w}}), "reference.angular_rate",
+                        "[-10, 10]"))
+        << w;
+    EXPECT_TRUE(outside(tracking_error({{"reference", "angular_rate", w}}), "reference.angular_rate",
+                        "[-10, 10]"))
+        << w;
+  }
+}
+
+// A delay of 1e300 behaved like 0 (its step count overflowed).
+TEST(ScenarioRanges, DelaysAreBounded) {
+  EXPECT_TRUE(outside(mi_error({{"pilots.novice", "reaction_delay", "1e300"}}),
+                      "pilots.novice.reaction_delay", "[0, 10]"));
+  EXPECT_TRUE(outside(mi_error({{"plant", "input_delay", "1e300"}}), "plant.input_delay", "[0, 10]"));
+  EXPECT_TRUE(outside(tracking_error({{"plant", "rtt", "1e300"}}), "plant.rtt", "[0, 1]"));
+}
+
+// A huge obstacle radius made the skill score inf (and a bare `inf` in the JSON report).
+TEST(ScenarioRanges, ObstacleRadiusFitsTheArena) {
+  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "1e300"}}), "arena.obstacles[0].radius",
+                      "(0, 100]"));
+  // mi_helix's arena is 5 x 5 x 2.5 m: half its diagonal is 3.75 m.
+  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "3.75"}}), "arena.obstacles[0].radius",
+                      "(0, 3.75)"));
+  EXPECT_EQ(mi_error({{"arena.obstacles", "radius", "3.7"}}), "");
+}
+
+// A huge duration reserved gigabytes of per-step buffers; a tiny one flew no step at all.
+TEST(ScenarioRanges, RunSizeIsBounded) {
+  EXPECT_TRUE(outside(mi_error({{"", "duration", "1e9"}}), "duration", "(0, 3600]"));
+  EXPECT_TRUE(outside(pendubot_error({{"", "duration", "1e300"}}), "duration", "(0, 3600]"));
+  EXPECT_TRUE(outside(tracking_error({{"", "duration", "3601"}}), "duration", "(0, 3600]"));
+  EXPECT_TRUE(outside(obstacle_error({{"", "duration", "1e9"}}), "duration", "(0, 3600]"));
+  // 3600 s at dt = 1 ms: 3.6e6 control steps, above the 2e6 bound.
+  const std::string e = mi_error({{"", "duration", "3600.0"}, {"controller", "dt", "0.001"}});
+  EXPECT_NE(e.find("duration: duration / controller.dt (control steps) = 3600000, outside [1, "
+                   "2000000]"),
+            std::string::npos)
+      << e;
+  // Shorter than one control step: nothing would be flown.
+  const std::string tiny = pendubot_error({{"", "duration", "1e-9"}});
+  EXPECT_NE(tiny.find("duration / controller.dt (control steps) = 5e-07, outside [1, 2000000]"),
+            std::string::npos)
+      << tiny;
+  // 3600 s at 1e5 Hz: 3.6e8 plant substeps, above the 4e7 bound.
+  const std::string sub = pendubot_error({{"plant", "rate_hz", "100000.0"}, {"", "duration", "3600.0"}});
+  EXPECT_NE(sub.find("plant substeps) = 360000000, outside [0, 40000000]"), std::string::npos)
+      << sub;
+}
+
+// Non-finite numbers are refused everywhere, whatever the key's range.
+TEST(ScenarioRanges, NonFiniteNumbersAreRefused) {
+  for (const char* v : {"nan", "inf", "-inf"}) {
+    EXPECT_NE(mi_error({{"reference", "phase", v}}).find("reference.phase: expected a finite number"),
+              std::string::npos);
+    EXPECT_NE(pendubot_error({{"lqr", "r", v}}).find("lqr.r: expected a finite number"),
+              std::string::npos);
+    EXPECT_NE(obstacle_error({{"balls", "throw_time", v}}).find("expected a finite number"),
+              std::string::npos);
+  }
+}
+
+// Counts that size per-step work: obstacles (64), encoder resolutions (2^24 counts per turn).
+TEST(ScenarioRanges, CountsAreBounded) {
+  std::string many = "[arena]\nmin = [-3.0, -3.0, 0.0]\nmax = [3.0, 3.0, 3.0]\n";
+  for (int i = 0; i < 65; ++i) many += "[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.1\n";
+  EXPECT_NE(error_of(many).find("arena.obstacles: the number of obstacles = 65, outside [0, 64]"),
+            std::string::npos);
+  EXPECT_TRUE(outside(pendubot_error({{"sensor", "counts_q1", "2147483647"}}),
+                      "sensor.counts_q1", "[4, 16777216]"));
+  EXPECT_TRUE(outside(mi_error({{"controller", "max_constrained_obstacles", "2147483647"}}),
+                      "controller.max_constrained_obstacles", "[0, 64]"));
 }
 
 }  // namespace

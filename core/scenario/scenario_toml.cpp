@@ -166,8 +166,8 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
         const double half_diagonal = 0.5 * (sc.arena.max - sc.arena.min).norm();
         if (r_ok && box_ok && ob.radius >= half_diagonal) {
           d.add(o.pos("radius"), o.path("radius"),
-                outside("radius", ob.radius, open_interval(0, half_diagonal)) +
-                    " (half the arena's diagonal)");
+                "value outside " + open_interval(0, half_diagonal).text() +
+                    " (half the arena's diagonal), got " + fmt(ob.radius));
         }
         sc.arena.obstacles.push_back(ob);
       }
