@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <sstream>
-#include <limits>
 #include <string>
 
 #include "core/scenario/obstacle_scenario.hpp"
@@ -414,13 +414,12 @@ TEST(ScenarioRanges, HorizonIsBounded) {
     EXPECT_TRUE(outside(mi_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
     EXPECT_TRUE(outside(pendubot_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
     EXPECT_TRUE(outside(tracking_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
-    EXPECT_TRUE(
-        outside(obstacle_error({{"controller", "N", n}}), "controller.N", "[1, 200]"))
-        << n;
+    EXPECT_TRUE(outside(obstacle_error({{"controller", "N", n}}), "controller.N", "[1, 200]")) << n;
   }
-  EXPECT_TRUE(outside(mi_error({{"pilots.novice", "N", "2147483647"}}), "pilots.novice.N", "[1, 200]"));
-  EXPECT_TRUE(outside(mi_error({{"controller.ph", "N_b", "2147483647"}}), "controller.ph.N_b",
-                      "[1, 200]"));
+  EXPECT_TRUE(
+      outside(mi_error({{"pilots.novice", "N", "2147483647"}}), "pilots.novice.N", "[1, 200]"));
+  EXPECT_TRUE(
+      outside(mi_error({{"controller.ph", "N_b", "2147483647"}}), "controller.ph.N_b", "[1, 200]"));
 }
 
 // A huge reference.angular_rate hung the loader's arena check (its sample count overflowed).
@@ -429,8 +428,8 @@ TEST(ScenarioRanges, HelixAngularRateIsBounded) {
     EXPECT_TRUE(outside(mi_error({{"reference", "angular_rate", w}}), "reference.angular_rate",
                         "[-10, 10]"))
         << w;
-    EXPECT_TRUE(outside(tracking_error({{"reference", "angular_rate", w}}), "reference.angular_rate",
-                        "[-10, 10]"))
+    EXPECT_TRUE(outside(tracking_error({{"reference", "angular_rate", w}}),
+                        "reference.angular_rate", "[-10, 10]"))
         << w;
   }
 }
@@ -439,17 +438,18 @@ TEST(ScenarioRanges, HelixAngularRateIsBounded) {
 TEST(ScenarioRanges, DelaysAreBounded) {
   EXPECT_TRUE(outside(mi_error({{"pilots.novice", "reaction_delay", "1e300"}}),
                       "pilots.novice.reaction_delay", "[0, 10]"));
-  EXPECT_TRUE(outside(mi_error({{"plant", "input_delay", "1e300"}}), "plant.input_delay", "[0, 10]"));
+  EXPECT_TRUE(
+      outside(mi_error({{"plant", "input_delay", "1e300"}}), "plant.input_delay", "[0, 10]"));
   EXPECT_TRUE(outside(tracking_error({{"plant", "rtt", "1e300"}}), "plant.rtt", "[0, 1]"));
 }
 
 // A huge obstacle radius made the skill score inf (and a bare `inf` in the JSON report).
 TEST(ScenarioRanges, ObstacleRadiusFitsTheArena) {
-  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "1e300"}}), "arena.obstacles[0].radius",
-                      "(0, 100]"));
+  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "1e300"}}),
+                      "arena.obstacles[0].radius", "(0, 100]"));
   // mi_helix's arena is 5 x 5 x 2.5 m: half its diagonal is 3.75 m.
-  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "3.75"}}), "arena.obstacles[0].radius",
-                      "(0, 3.75)"));
+  EXPECT_TRUE(outside(mi_error({{"arena.obstacles", "radius", "3.75"}}),
+                      "arena.obstacles[0].radius", "(0, 3.75)"));
   EXPECT_EQ(mi_error({{"arena.obstacles", "radius", "3.7"}}), "");
 }
 
@@ -471,7 +471,8 @@ TEST(ScenarioRanges, RunSizeIsBounded) {
             std::string::npos)
       << tiny;
   // 3600 s at 1e5 Hz: 3.6e8 plant substeps, above the 4e7 bound.
-  const std::string sub = pendubot_error({{"plant", "rate_hz", "100000.0"}, {"", "duration", "3600.0"}});
+  const std::string sub =
+      pendubot_error({{"plant", "rate_hz", "100000.0"}, {"", "duration", "3600.0"}});
   EXPECT_NE(sub.find("plant substeps) = 360000000, outside [0, 40000000]"), std::string::npos)
       << sub;
 }
@@ -479,8 +480,9 @@ TEST(ScenarioRanges, RunSizeIsBounded) {
 // Non-finite numbers are refused everywhere, whatever the key's range.
 TEST(ScenarioRanges, NonFiniteNumbersAreRefused) {
   for (const char* v : {"nan", "inf", "-inf"}) {
-    EXPECT_NE(mi_error({{"reference", "phase", v}}).find("reference.phase: expected a finite number"),
-              std::string::npos);
+    EXPECT_NE(
+        mi_error({{"reference", "phase", v}}).find("reference.phase: expected a finite number"),
+        std::string::npos);
     EXPECT_NE(pendubot_error({{"lqr", "r", v}}).find("lqr.r: expected a finite number"),
               std::string::npos);
     EXPECT_NE(obstacle_error({{"balls", "throw_time", v}}).find("expected a finite number"),
@@ -491,11 +493,12 @@ TEST(ScenarioRanges, NonFiniteNumbersAreRefused) {
 // Counts that size per-step work: obstacles (64), encoder resolutions (2^24 counts per turn).
 TEST(ScenarioRanges, CountsAreBounded) {
   std::string many = "[arena]\nmin = [-3.0, -3.0, 0.0]\nmax = [3.0, 3.0, 3.0]\n";
-  for (int i = 0; i < 65; ++i) many += "[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.1\n";
+  for (int i = 0; i < 65; ++i)
+    many += "[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.1\n";
   EXPECT_NE(error_of(many).find("arena.obstacles: the number of obstacles = 65, outside [0, 64]"),
             std::string::npos);
-  EXPECT_TRUE(outside(pendubot_error({{"sensor", "counts_q1", "2147483647"}}),
-                      "sensor.counts_q1", "[4, 16777216]"));
+  EXPECT_TRUE(outside(pendubot_error({{"sensor", "counts_q1", "2147483647"}}), "sensor.counts_q1",
+                      "[4, 16777216]"));
   EXPECT_TRUE(outside(mi_error({{"controller", "max_constrained_obstacles", "2147483647"}}),
                       "controller.max_constrained_obstacles", "[0, 64]"));
 }

@@ -37,7 +37,8 @@ bool parse_number(const std::string& cell, double& value) {
   char* end = nullptr;
   errno = 0;
   value = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size() && errno != ERANGE && std::isfinite(value);
+  return end == s.c_str() + s.size() && errno != ERANGE && std::isfinite(value) &&
+         std::abs(value) <= kMaxTrajectoryValue;
 }
 
 std::string where(const std::string& path, int line) {
@@ -155,8 +156,8 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
     ++lineno;
     if (trim(line).empty()) continue;
     if (t.size() >= std::size_t(kMaxTrajectoryRows)) {
-      error = where(path, lineno) + "expected at most " + std::to_string(kMaxTrajectoryRows) +
-              " rows";
+      error =
+          where(path, lineno) + "expected at most " + std::to_string(kMaxTrajectoryRows) + " rows";
       return std::nullopt;
     }
     if (last_seen) {
@@ -175,8 +176,8 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
     Eigen::VectorXd x(nx), u(nu);
     for (int c = 0; c < 1 + nx; ++c) {
       if (!parse_number(cells[c], v)) {
-        error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" +
-                trim(header[c]) + "): expected a finite number, found \"" + trim(cells[c]) + "\"";
+        error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" + trim(header[c]) +
+                "): expected a number in [-1e6, 1e6], found \"" + trim(cells[c]) + "\"";
         return std::nullopt;
       }
       if (c == 0) {
@@ -194,9 +195,8 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
       for (int j = 0; j < nu; ++j) {
         const int c = 1 + nx + j;
         if (!parse_number(cells[c], v)) {
-          error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" +
-                  trim(header[c]) + "): expected a finite number, found \"" + trim(cells[c]) +
-                  "\"";
+          error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" + trim(header[c]) +
+                  "): expected a number in [-1e6, 1e6], found \"" + trim(cells[c]) + "\"";
           return std::nullopt;
         }
         u(j) = v;

@@ -23,6 +23,8 @@ inline constexpr long long kMaxTrajectoryBytes = 256ll << 20;
 // longest run has control steps, and state/input sizes far above every model's.
 inline constexpr int kMaxTrajectoryRows = 2'000'000;
 inline constexpr int kMaxTrajectoryColumns = 64;  // each of x and u
+// Every cell's magnitude (t, states, inputs): squares and sums of a run stay finite.
+inline constexpr double kMaxTrajectoryValue = 1e6;
 
 struct TrajectoryFile {
   OcpTrajectory trajectory;  // x: N+1 x nx, u: N x nu

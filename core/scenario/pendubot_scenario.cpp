@@ -1,8 +1,8 @@
 #include "core/scenario/pendubot_scenario.hpp"
 
 #include <cmath>
-#include <numbers>
 #include <filesystem>
+#include <numbers>
 
 #include "core/scenario/scenario_toml.hpp"
 #include "core/scenario/toml_read.hpp"

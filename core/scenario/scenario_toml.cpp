@@ -130,8 +130,9 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   ref.finish();
 
   Section arena = s.sub("arena");
-  bool box_ok = (arena.vec("min", sc.arena.min, kPosition) || !arena.table() || !arena.table()->get("min")) &
-                (arena.vec("max", sc.arena.max, kPosition) || !arena.table() || !arena.table()->get("max"));
+  bool box_ok =
+      (arena.vec("min", sc.arena.min, kPosition) || !arena.table() || !arena.table()->get("min")) &
+      (arena.vec("max", sc.arena.max, kPosition) || !arena.table() || !arena.table()->get("max"));
   if (box_ok && !(sc.arena.min.array() < sc.arena.max.array()).all()) {
     d.add(arena.pos("max"), arena.path("max"),
           "expected every component above arena.min = " + vec_text(sc.arena.min) + ", got " +
@@ -214,7 +215,8 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   plant.num("input_delay", sc.plant.input_delay, kDelay);
   plant.num("position_noise", sc.plant.position_noise, closed(0, 10));
   std::int64_t seed = std::int64_t(sc.plant.seed);
-  if (plant.integer("seed", seed, IntRange{0, std::numeric_limits<std::int64_t>::max()})) sc.plant.seed = std::uint64_t(seed);
+  if (plant.integer("seed", seed, IntRange{0, std::numeric_limits<std::int64_t>::max()}))
+    sc.plant.seed = std::uint64_t(seed);
   plant.finish();
   // The plant takes a whole number of RK4 substeps per control step.
   const double substeps = sc.controller.dt * sc.plant.rate_hz;

@@ -5,6 +5,9 @@
 // Debian's toml++ is the compiled shared library, built with exceptions: including TUs keep
 // them on (switching them off would select the noex ABI the library does not export) and
 // catch toml::parse_error themselves.
+#include <toml++/toml.h>
+
+#include <Eigen/Core>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -19,9 +22,6 @@
 #include <string_view>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
-#include <toml++/toml.h>
 
 namespace mixpilot::toml_read {
 
@@ -131,9 +131,7 @@ struct IntRange {
   std::int64_t lo = 0;
   std::int64_t hi = 0;
   bool contains(std::int64_t v) const { return v >= lo && v <= hi; }
-  std::string text() const {
-    return '[' + std::to_string(lo) + ", " + std::to_string(hi) + ']';
-  }
+  std::string text() const { return '[' + std::to_string(lo) + ", " + std::to_string(hi) + ']'; }
 };
 
 constexpr double kHugeWeight = 1e9;  // cost weights: beyond this the QPs lose all precision
@@ -149,18 +147,18 @@ inline constexpr Range pos_weight() { return closed(1e-6, kHugeWeight); }
 // and time proportionate: at most an hour simulated, 2e6 control steps (per-step buffers of a
 // few hundred MB at most), 4e7 plant substeps (minutes of RK4), horizons whose QPs stay
 // interactive, and every count far inside an int.
-constexpr Range kDuration = left_open(0, 3600);      // [s]
-constexpr Range kControlDt = closed(1e-3, 1);         // [s]
-constexpr IntRange kHorizon{1, 200};                  // stages
-constexpr Range kPlantRate = closed(1000, 1e5);       // [Hz]
-constexpr double kMaxSteps = 2e6;                     // duration / dt
-constexpr double kMaxSubsteps = 4e7;                  // duration * rate_hz
-constexpr Range kDelay = closed(0, 10);               // [s]
-constexpr Range kPosition = closed(-1e3, 1e3);        // [m], any coordinate
-constexpr Range kAngularRate = closed(-10, 10);       // [rad/s], helix references
-constexpr Range kClimbRate = closed(-100, 100);       // [m/s]
-constexpr Range kPhase = closed(-100, 100);           // [rad]
-constexpr std::size_t kMaxObstacles = 64;             // per scenario
+constexpr Range kDuration = left_open(0, 3600);  // [s]
+constexpr Range kControlDt = closed(1e-3, 1);    // [s]
+constexpr IntRange kHorizon{1, 200};             // stages
+constexpr Range kPlantRate = closed(1000, 1e5);  // [Hz]
+constexpr double kMaxSteps = 2e6;                // duration / dt
+constexpr double kMaxSubsteps = 4e7;             // duration * rate_hz
+constexpr Range kDelay = closed(0, 10);          // [s]
+constexpr Range kPosition = closed(-1e3, 1e3);   // [m], any coordinate
+constexpr Range kAngularRate = closed(-10, 10);  // [rad/s], helix references
+constexpr Range kClimbRate = closed(-100, 100);  // [m/s]
+constexpr Range kPhase = closed(-100, 100);      // [rad]
+constexpr std::size_t kMaxObstacles = 64;        // per scenario
 
 // "value outside [a, b]" for a derived (computed) quantity named in `what`.
 inline std::string outside(std::string_view what, double v, const Range& r) {
@@ -173,14 +171,12 @@ inline void check_run_size(Diagnostics& d, Pos at, double duration, double dt, d
   const double steps = duration / dt;
   if (!(steps >= 1 - 1e-9 && steps <= kMaxSteps)) {
     d.add(at, "duration",
-          outside("duration / controller.dt (control steps)", steps,
-                  closed(1, kMaxSteps)));
+          outside("duration / controller.dt (control steps)", steps, closed(1, kMaxSteps)));
   }
   const double substeps = duration * rate_hz;
   if (!(substeps <= kMaxSubsteps)) {
     d.add(at, "duration",
-          outside("duration * plant.rate_hz (plant substeps)", substeps,
-                  closed(0, kMaxSubsteps)));
+          outside("duration * plant.rate_hz (plant substeps)", substeps, closed(0, kMaxSubsteps)));
   }
 }
 
@@ -306,7 +302,8 @@ class Section {
     bool ok = true;
     for (int i = 0; i < n; ++i) {
       ok = read_num(*a->get(std::size_t(i)), path(key) + '[' + std::to_string(i) + ']', v[i],
-                    range) && ok;
+                    range) &&
+           ok;
     }
     if (ok) out = v;
     return ok;

@@ -42,14 +42,16 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
   if (c.choice("kind", kind, {"nmpc", "lqr"}))
     sc.controller.kind = kind == "lqr" ? TrackingControllerKind::lqr : TrackingControllerKind::nmpc;
   c.integer("N", sc.controller.N, kHorizon);
-  const bool dt_ok = c.num("dt", sc.controller.dt, kControlDt) || !c.table() || !c.table()->get("dt");
+  const bool dt_ok =
+      c.num("dt", sc.controller.dt, kControlDt) || !c.table() || !c.table()->get("dt");
   c.boolean("compensation", sc.controller.compensation);
   c.finish();
 
   Section pl = s.sub("plant");
   const bool rate_ok =
       pl.num("rate_hz", sc.plant.rate_hz, kPlantRate) || !pl.table() || !pl.table()->get("rate_hz");
-  const bool rtt_ok = pl.num("rtt", sc.plant.rtt, closed(0, 1)) || !pl.table() || !pl.table()->get("rtt");
+  const bool rtt_ok =
+      pl.num("rtt", sc.plant.rtt, closed(0, 1)) || !pl.table() || !pl.table()->get("rtt");
   pl.num("measurement_fraction", sc.plant.measurement_fraction, closed(0, 1));
   pl.vec("start", sc.plant.start, kPosition);
   pl.finish();
@@ -76,7 +78,8 @@ TrackingScenario read_tracking(const toml::table& root, const std::string& sourc
   r.num("climb_rate", hx.climb_rate, kClimbRate);
   r.num("angular_rate", hx.angular_rate, kAngularRate);
   r.num("phase", hx.phase, kPhase);
-  const bool length_ok = r.num("length", hx.length, kDuration) || !r.table() || !r.table()->get("length");
+  const bool length_ok =
+      r.num("length", hx.length, kDuration) || !r.table() || !r.table()->get("length");
   const models::Crazyflie cf{};
   if (sc.reference.kind == TrackingReferenceKind::smooth_step) {
     for (const char* k : {"radius", "start_height", "climb_rate", "angular_rate", "phase", "length"}) {
