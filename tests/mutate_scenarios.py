@@ -3,8 +3,9 @@
 
 For every key of every scenarios/*.toml (walked line by line, tables included) it writes
 variants -- the key missing, a wrong type, 0, negative, tiny, huge, nan, +-inf, integer limits;
-for an array, its first element mutated too -- and flies each one headless for a short time
-under a timeout and a memory limit. Each run is classified:
+for an array, its first element mutated too -- and, for each reference CSV, variants of its
+cells (the same values), rows, header and time grid; it flies each one headless for a short
+time under a timeout and a memory limit. Each run is classified:
 
   clean error  exit 1 or 2 with a message (`file:line:col: key: ...` or another clear line)
   accepted     exit 0, and the JSON report holds only finite numbers
@@ -112,6 +113,29 @@ def variants(text):
     return out
 
 
+CSV_REF = re.compile(r'^\s*(?:file|reference)\s*=\s*"references/([^"]+)"', re.M)
+
+
+def csv_variants(csv):
+    """(label, mutated text) of one reference CSV: cells, rows, header, time grid."""
+    lines = csv.rstrip("\n").split("\n")
+    out = [("empty", ""), ("header_only", lines[0] + "\n"),
+           ("no_header", "\n".join(lines[1:]) + "\n"),
+           ("row_dropped", "\n".join(lines[:3] + lines[4:]) + "\n"),
+           ("time_repeated", "\n".join(lines[:3] + [lines[2]] + lines[3:]) + "\n"),
+           ("extra_column", "\n".join(l + ",1" for l in lines) + "\n"),
+           ("last_row_dropped", "\n".join(lines[:-1]) + "\n")]
+    ncols = len(lines[0].split(","))
+    for col in (0, 1, ncols - 1):
+        for label, v in VALUES + [("text", "x")]:
+            copy = list(lines)
+            cells = copy[2].split(",")
+            cells[col] = v
+            copy[2] = ",".join(cells)
+            out.append((f"row2.col{col}:{label}", "\n".join(copy) + "\n"))
+    return out
+
+
 def limit_memory(limit_bytes):
     def apply():
         resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
@@ -179,11 +203,18 @@ def main():
     binary = Path(args.mixpilot).resolve()
     scen_dir = Path(args.scenarios).resolve()
     work = Path(tempfile.mkdtemp(prefix="mutate_scenarios."))
-    (work / "references").symlink_to(scen_dir / "references")
     cases = []
+    seen_csv = set()
     for f in sorted(scen_dir.glob("*.toml")):
-        for label, text in variants(f.read_text()):
-            cases.append((f.stem, label, text))
+        text = f.read_text()
+        for label, mutated in variants(text):
+            cases.append((f.stem, label, mutated, None))
+        for name in CSV_REF.findall(text):
+            if name in seen_csv:
+                continue
+            seen_csv.add(name)
+            for label, csv in csv_variants((scen_dir / "references" / name).read_text()):
+                cases.append((f.stem, f"references/{name}:{label}", text, (name, csv)))
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
 
@@ -191,11 +222,22 @@ def main():
     bad = []
 
     def run(idx_case):
-        idx, (stem, label, text) = idx_case
+        idx, (stem, label, text, csv) = idx_case
         d = work / f"run{idx % max(1, args.jobs)}"
         d.mkdir(exist_ok=True)
-        if not (d / "references").exists():
-            (d / "references").symlink_to(scen_dir / "references")
+        refs = d / "references"
+        if refs.is_symlink():
+            refs.unlink()
+        elif refs.exists():
+            shutil.rmtree(refs)
+        if csv is None:
+            refs.symlink_to(scen_dir / "references")
+        else:  # the other reference files as they are, the mutated one written
+            refs.mkdir()
+            for other in (scen_dir / "references").iterdir():
+                if other.name != csv[0]:
+                    (refs / other.name).symlink_to(other)
+            (refs / csv[0]).write_text(csv[1])
         path = d / f"{stem}.toml"
         path.write_text(text)
         return stem, label, fly(binary, path, d, args.duration, args.timeout,

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "core/nlp/trajectory_io.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 #include "core/scenario/pendubot_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
@@ -501,6 +502,34 @@ TEST(ScenarioRanges, CountsAreBounded) {
                       "[4, 16777216]"));
   EXPECT_TRUE(outside(mi_error({{"controller", "max_constrained_obstacles", "2147483647"}}),
                       "controller.max_constrained_obstacles", "[0, 64]"));
+}
+
+// Reference CSVs: bounded cell values, columns and an increasing equidistant time.
+std::string csv_error(const std::string& text) {
+  const std::string path = ::testing::TempDir() + "mixpilot_ranges.csv";
+  {
+    std::ofstream out(path, std::ios::trunc);
+    out << text;
+  }
+  std::string error;
+  const auto f = read_trajectory_csv(path, error);
+  EXPECT_EQ(f.has_value(), error.empty());
+  std::remove(path.c_str());
+  return error.empty() ? "" : error.substr(path.size());
+}
+
+TEST(ScenarioRanges, ReferenceCsvIsBounded) {
+  EXPECT_EQ(csv_error("t,x0,u0\n0,1,2\n0.1,1,2\n0.2,1,\n"), "");
+  // 1e300 in a state once made the tracking RMS inf.
+  EXPECT_EQ(csv_error("t,x0,u0\n0,1e300,2\n0.1,1,2\n0.2,1,\n"),
+            ":2: column 2 (x0): expected a number in [-1e6, 1e6], found \"1e300\"");
+  EXPECT_EQ(csv_error("t,x0,u0\n0,1,2\n0.1,1,2\n0.1,1,\n"),
+            ":4: expected t = 0.200000 (equidistant grid of dt = 0.100000)");
+  EXPECT_EQ(csv_error("t,x0,u0\n0.1,1,2\n0,1,2\n-0.1,1,\n"), ":3: expected t to increase");
+  std::string wide = "t";
+  for (int i = 0; i < 65; ++i) wide += ",x" + std::to_string(i);
+  EXPECT_EQ(csv_error(wide + ",u0\n"),
+            ":1: expected at most 64 x and 64 u columns, found 65 and 1");
 }
 
 }  // namespace
