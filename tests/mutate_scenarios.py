@@ -142,8 +142,20 @@ def limit_memory(limit_bytes):
     return apply
 
 
-def finite_json(path):
-    """True when the report parses and every number in it is finite."""
+def null_keys(path):
+    """Keys of the report whose value is null (the report's spelling of a non-finite value)."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return set()
+    return {k for k, v in data.items() if v is None} if isinstance(data, dict) else set()
+
+
+def finite_json(path, allowed_nulls=frozenset()):
+    """True when the report parses, every number in it is finite, and no value is null but
+    those null in the unmutated scenario's report (e.g. no obstacle ever near)."""
+    if null_keys(path) - allowed_nulls:
+        return False
     try:
         text = Path(path).read_text()
     except OSError:
@@ -166,7 +178,7 @@ def finite_json(path):
     return walk(data)
 
 
-def fly(binary, scenario, workdir, duration, timeout, memory):
+def fly(binary, scenario, workdir, duration, timeout, memory, allowed_nulls=frozenset()):
     report = workdir / "report.json"
     if report.exists():
         report.unlink()
@@ -181,7 +193,9 @@ def fly(binary, scenario, workdir, duration, timeout, memory):
     if p.returncode < 0 or p.returncode >= 128:
         return "crash", err[-400:]
     if p.returncode == 0:
-        return ("accepted", "") if finite_json(report) else ("nonsense", "non-finite report")
+        if finite_json(report, allowed_nulls):
+            return "accepted", ""
+        return "nonsense", f"non-finite report (null: {sorted(null_keys(report))})"
     if p.returncode in (1, 2, 3) and err:
         return "clean error", err.split("\n")[0]
     return "nonsense", f"exit {p.returncode} with message {err[:200]!r}"
@@ -215,6 +229,20 @@ def main():
             seen_csv.add(name)
             for label, csv in csv_variants((scen_dir / "references" / name).read_text()):
                 cases.append((f.stem, f"references/{name}:{label}", text, (name, csv)))
+    # Nulls the unmutated scenarios' reports have (a metric with nothing to measure).
+    baseline_nulls = {}
+    for f in sorted(scen_dir.glob("*.toml")):
+        d = work / "baseline"
+        d.mkdir(exist_ok=True)
+        if not (d / "references").exists():
+            (d / "references").symlink_to(scen_dir / "references")
+        (d / f.name).write_text(f.read_text())
+        kind, why = fly(binary, d / f.name, d, args.duration, args.timeout,
+                        int(args.memory_gb * (1 << 30)))
+        if kind not in ("accepted", "nonsense"):
+            print(f"the unmutated {f.name} does not fly: {kind}: {why}")
+            return 1
+        baseline_nulls[f.stem] = frozenset(null_keys(d / "report.json"))
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
 
@@ -241,7 +269,7 @@ def main():
         path = d / f"{stem}.toml"
         path.write_text(text)
         return stem, label, fly(binary, path, d, args.duration, args.timeout,
-                                int(args.memory_gb * (1 << 30)))
+                                int(args.memory_gb * (1 << 30)), baseline_nulls[stem])
 
     if args.jobs > 1:
         # One worker directory per job slot: runs in a slot are sequential.
