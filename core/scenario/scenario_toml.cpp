@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/numerics/input_file.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/scenario/detail/toml_read.hpp"
 
 namespace mixpilot {
 namespace {
@@ -103,6 +103,29 @@ std::string approx(double v) {
   return buf;
 }
 
+// One [[arena.obstacles]] sphere: inside the arena (when the arena itself is valid) and smaller
+// than half its diagonal (a sphere reaching past every corner leaves nothing to fly in).
+Obstacle read_obstacle(Section o, const Arena& arena, bool box_ok, Diagnostics& d) {
+  Obstacle ob;
+  const bool c_ok = o.vec("center", ob.center, kPosition, true);
+  const bool r_ok = o.num("radius", ob.radius, left_open(0, 100), true);
+  o.finish();
+  if (c_ok && box_ok &&
+      ((ob.center.array() < arena.min.array()).any() ||
+       (ob.center.array() > arena.max.array()).any())) {
+    d.add(o.pos("center"), o.path("center"),
+          "expected a point inside the arena " + vec_text(arena.min) + " .. " +
+              vec_text(arena.max) + ", got " + vec_text(ob.center));
+  }
+  const double half_diagonal = 0.5 * (arena.max - arena.min).norm();
+  if (r_ok && box_ok && ob.radius >= half_diagonal) {
+    d.add(o.pos("radius"), o.path("radius"),
+          "value outside " + open_interval(0, half_diagonal).text() +
+              " (half the arena's diagonal), got " + fmt(ob.radius));
+  }
+  return ob;
+}
+
 Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   Scenario sc;
   Section s(d, &root, "", Pos{1, 1});
@@ -150,27 +173,10 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
     } else {
       for (std::size_t i = 0; i < a->size(); ++i) {
         const toml::node& e = *a->get(i);
-        Section o(d, e.as_table(), arena.path("obstacles") + '[' + std::to_string(i) + ']',
-                  pos_of(e.source()));
-        Obstacle ob;
-        const bool c_ok = o.vec("center", ob.center, kPosition, true);
-        const bool r_ok = o.num("radius", ob.radius, left_open(0, 100), true);
-        o.finish();
-        if (c_ok && box_ok &&
-            ((ob.center.array() < sc.arena.min.array()).any() ||
-             (ob.center.array() > sc.arena.max.array()).any())) {
-          d.add(o.pos("center"), o.path("center"),
-                "expected a point inside the arena " + vec_text(sc.arena.min) + " .. " +
-                    vec_text(sc.arena.max) + ", got " + vec_text(ob.center));
-        }
-        // A sphere reaching past every corner would fill the arena: nothing left to fly in.
-        const double half_diagonal = 0.5 * (sc.arena.max - sc.arena.min).norm();
-        if (r_ok && box_ok && ob.radius >= half_diagonal) {
-          d.add(o.pos("radius"), o.path("radius"),
-                "value outside " + open_interval(0, half_diagonal).text() +
-                    " (half the arena's diagonal), got " + fmt(ob.radius));
-        }
-        sc.arena.obstacles.push_back(ob);
+        sc.arena.obstacles.push_back(read_obstacle(
+            Section(d, e.as_table(), arena.path("obstacles") + '[' + std::to_string(i) + ']',
+                    pos_of(e.source())),
+            sc.arena, box_ok, d));
       }
     }
   }
