@@ -19,6 +19,8 @@ packages=(
   cyclonedds-dev cyclonedds-tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
+  clang libclang-rt-dev
   # tooling: independent MCAP reader in the recording tests
   nodejs
 )

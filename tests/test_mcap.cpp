@@ -3,6 +3,9 @@
 // corruption) giving clean errors that name a byte offset.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -26,12 +29,30 @@ std::vector<uint8_t> slurp(const fs::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// A fresh path in the test folder: the file and any temporaries left for it
+// ("<name>.XXXXXX.tmp") by an earlier run are removed.
 fs::path temp_path(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap";
   fs::create_directories(dir);
   fs::remove(dir / name);
-  fs::remove(dir / (name + ".tmp"));
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string f = e.path().filename().string();
+    if (f.rfind(name + ".", 0) == 0 && f.size() > name.size() + 4 && f.ends_with(".tmp"))
+      fs::remove(e.path());
+  }
   return dir / name;
+}
+
+// The temporaries beside `p` ("<p>.XXXXXX.tmp").
+std::vector<fs::path> temporaries_of(const fs::path& p) {
+  std::vector<fs::path> out;
+  const std::string name = p.filename().string();
+  for (const auto& e : fs::directory_iterator(p.parent_path())) {
+    const std::string f = e.path().filename().string();
+    if (f.size() == name.size() + 11 && f.rfind(name + ".", 0) == 0 && f.ends_with(".tmp"))
+      out.push_back(e.path());
+  }
+  return out;
 }
 
 template <class T>
@@ -232,7 +253,7 @@ fs::path write_sample(const std::string& name, int messages = 5) {
   const fs::path p = temp_path(name);
   McapWriter w;
   std::string err;
-  EXPECT_TRUE(w.open(p.string(), err, "ros2", "test-lib")) << err;
+  EXPECT_TRUE(w.open(p.string(), err, {.library = "test-lib"})) << err;
   const uint16_t s1 = w.add_schema("pkg/msg/A", "ros2msg", "float64 x\n");
   const uint16_t s2 = w.add_schema("pkg/msg/B", "ros2msg", "string s\n");
   EXPECT_EQ(s1, 1);
@@ -256,7 +277,7 @@ fs::path write_sample(const std::string& name, int messages = 5) {
 TEST(Mcap, WriteReadRoundTrip) {
   const fs::path p = write_sample("roundtrip.mcap");
   EXPECT_TRUE(fs::exists(p));
-  EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+  EXPECT_TRUE(temporaries_of(p).empty());
   std::string err;
   const auto f = read_mcap(p.string(), err);
   ASSERT_TRUE(f) << err;
@@ -356,22 +377,26 @@ TEST(Mcap, EmptyFileAndHandBuiltMinimalFile) {
 
 TEST(Mcap, TmpFileUntilCloseAndKeptOnFailure) {
   const fs::path p = temp_path("crash.mcap");
+  std::string tmp;
   {
     McapWriter w;
     std::string err;
     ASSERT_TRUE(w.open(p.string(), err));
+    tmp = w.tmp_path();
+    // A unique temporary beside the target: "<target>.XXXXXX.tmp".
+    ASSERT_EQ(temporaries_of(p), std::vector<fs::path>{fs::path(tmp)});
     const auto c = w.add_channel(w.add_schema("pkg/msg/A", "ros2msg", "uint8 x\n"), "/a", "cdr");
     for (uint32_t i = 0; i < 10; ++i) ASSERT_TRUE(w.write_message(c, i, i, i, std::vector<uint8_t>{1, 2}));
-    EXPECT_TRUE(fs::exists(p.string() + ".tmp"));
     EXPECT_FALSE(fs::exists(p));
   }  // destroyed without close(): a crashed or failed session
   EXPECT_FALSE(fs::exists(p));
+  EXPECT_TRUE(fs::exists(tmp));
   std::string err;
-  EXPECT_FALSE(read_mcap(p.string() + ".tmp", err));
+  EXPECT_FALSE(read_mcap(tmp, err));
   EXPECT_NE(err.find("unexpected end of file at byte"), std::string::npos) << err;
   McapReadOptions lenient;
   lenient.allow_truncated = true;
-  const auto f = read_mcap(p.string() + ".tmp", err, lenient);
+  const auto f = read_mcap(tmp, err, lenient);
   ASSERT_TRUE(f) << err;
   EXPECT_FALSE(f->complete);
   EXPECT_EQ(f->messages.size(), 10u);  // nothing written is lost
@@ -385,7 +410,8 @@ TEST(Mcap, WriterRejectsMisuse) {
   EXPECT_EQ(w.add_channel(5, "/a", "cdr"), 0);  // unknown schema
   EXPECT_FALSE(w.close(err));
   EXPECT_NE(err.find("unknown schema id 5"), std::string::npos) << err;
-  EXPECT_TRUE(fs::exists(p.string() + ".tmp"));
+  EXPECT_NE(err.find("kept in " + w.tmp_path()), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(w.tmp_path()));
   EXPECT_FALSE(fs::exists(p));
 
   McapWriter w2;
@@ -399,7 +425,115 @@ TEST(Mcap, WriterRejectsMisuse) {
 
   McapWriter w3;
   EXPECT_FALSE(w3.open("/nonexistent-dir/x.mcap", err));
-  EXPECT_NE(err.find("x.mcap.tmp"), std::string::npos) << err;
+  EXPECT_EQ(err, "/nonexistent-dir/x.mcap: cannot create a file in /nonexistent-dir: " +
+                     std::string(std::strerror(ENOENT)));
+  EXPECT_FALSE(w3.is_open());
+}
+
+// The writer goes through OutputFile (core/recording/output_file.hpp): it never replaces a
+// device or an existing file it was not allowed to, and of two writers of one path the second
+// to finish fails and keeps its data.
+TEST(Mcap, WriterNeverClobbers) {
+  std::string err;
+  {  // the device node that `--record /dev/full` once replaced (as root)
+    McapWriter w;
+    McapWriteOptions o;
+    o.overwrite = true;
+    EXPECT_FALSE(w.open("/dev/full", err, o));
+    EXPECT_EQ(err, "/dev/full: not a regular file (a character device)");
+    EXPECT_TRUE(fs::is_character_file("/dev/full"));
+  }
+  const fs::path p = temp_path("existing.mcap");
+  { std::ofstream(p) << "precious"; }
+  {
+    McapWriter w;
+    EXPECT_FALSE(w.open(p.string(), err));
+    EXPECT_EQ(err, p.string() + ": " + std::strerror(EEXIST) + " (refusing to overwrite it)");
+    EXPECT_TRUE(temporaries_of(p).empty());
+  }
+  EXPECT_EQ(slurp(p), bytes_of("precious"));
+  {
+    McapWriter w;
+    McapWriteOptions o;
+    o.overwrite = true;
+    ASSERT_TRUE(w.open(p.string(), err, o)) << err;
+    EXPECT_EQ(slurp(p), bytes_of("precious"));  // untouched until close()
+    ASSERT_TRUE(w.close(err)) << err;
+  }
+  EXPECT_TRUE(read_mcap(p.string(), err)) << err;
+
+  const fs::path q = temp_path("race.mcap");
+  McapWriter first, second;
+  ASSERT_TRUE(first.open(q.string(), err)) << err;
+  ASSERT_TRUE(second.open(q.string(), err)) << err;
+  EXPECT_NE(first.tmp_path(), second.tmp_path());
+  const auto c1 = first.add_channel(0, "/first", "x");
+  const auto c2 = second.add_channel(0, "/second", "x");
+  ASSERT_TRUE(first.write_message(c1, 0, 1, 1, std::vector<uint8_t>{1}));
+  ASSERT_TRUE(second.write_message(c2, 0, 1, 1, std::vector<uint8_t>{2}));
+  ASSERT_TRUE(first.close(err)) << err;
+  const std::string second_tmp = second.tmp_path();
+  EXPECT_FALSE(second.close(err));
+  EXPECT_NE(err.find(q.string() + ": " + std::strerror(EEXIST)), std::string::npos) << err;
+  EXPECT_NE(err.find("kept in " + second_tmp), std::string::npos) << err;
+  const auto f = read_mcap(q.string(), err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_EQ(f->channels.at(1).topic, "/first");
+  const auto g = read_mcap(second_tmp, err);  // complete: only the final move was refused
+  ASSERT_TRUE(g) << err;
+  EXPECT_EQ(g->channels.at(1).topic, "/second");
+}
+
+// Inputs that are not regular files are refused at once (a FIFO without a writer would block
+// a plain open(); /dev/zero never ends), and so are files over the size limit.
+TEST(Mcap, ReaderRefusesSpecialFilesAndHugeFiles) {
+  std::string err;
+  EXPECT_FALSE(read_mcap("/dev/zero", err));
+  EXPECT_EQ(err, "/dev/zero: not a regular file (a character device)");
+  const fs::path dir = temp_path("a_directory.mcap");
+  fs::create_directories(dir);
+  EXPECT_FALSE(read_mcap(dir.string(), err));
+  EXPECT_EQ(err, dir.string() + ": not a regular file (a directory)");
+  const fs::path fifo = temp_path("fifo.mcap");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  EXPECT_FALSE(read_mcap(fifo.string(), err));
+  EXPECT_EQ(err, fifo.string() + ": not a regular file (a FIFO)");
+  EXPECT_FALSE(read_mcap(temp_path("absent.mcap").string(), err));
+  EXPECT_NE(err.find(std::strerror(ENOENT)), std::string::npos) << err;
+
+  const fs::path p = write_sample("limit.mcap");
+  const auto size = fs::file_size(p);
+  McapReadOptions o;
+  o.max_bytes = size;
+  EXPECT_TRUE(read_mcap(p.string(), err, o)) << err;
+  o.max_bytes = size - 1;
+  EXPECT_FALSE(read_mcap(p.string(), err, o));
+  EXPECT_EQ(err, p.string() + ": " + std::to_string(size) + " bytes, more than the " +
+                     std::to_string(size - 1) + " a recording may have");
+}
+
+// A crash can leave zeros where the file system had allocated blocks: lenient reading stops
+// there; strict reading and zeros before a real record are errors.
+TEST(Mcap, ZeroFilledTailEndsALenientRead) {
+  const auto good = slurp(write_sample("zeros.mcap"));
+  std::size_t at = 8;  // the start of the third Message record
+  for (int seen = 0; seen < 3; at += 9 + get_le<uint64_t>(good, at + 1))
+    if (good[at] == 0x05 && ++seen == 3) break;
+  std::vector<uint8_t> b(good.begin(), good.begin() + std::ptrdiff_t(at));
+  b.resize(b.size() + 4096, 0);
+  McapReadOptions lenient;
+  lenient.allow_truncated = true;
+  std::string err;
+  const auto f = parse_mcap(b, "z.mcap", err, lenient);
+  ASSERT_TRUE(f) << err;
+  EXPECT_FALSE(f->complete);
+  EXPECT_EQ(f->messages.size(), 2u);
+  EXPECT_EQ(f->parsed_bytes, at);
+  EXPECT_FALSE(parse_mcap(b, "z.mcap", err));
+  EXPECT_EQ(err, "z.mcap: invalid record opcode 0x00 at byte " + std::to_string(at));
+  b.push_back(1);  // not all zeros: corruption, not a tail
+  EXPECT_FALSE(parse_mcap(b, "z.mcap", err, lenient));
+  EXPECT_EQ(err, "z.mcap: invalid record opcode 0x00 at byte " + std::to_string(at));
 }
 
 TEST(Mcap, ReaderErrorsNameTheByteOffset) {
@@ -487,6 +621,19 @@ TEST(Mcap, TruncationAtEveryOffsetIsACleanError) {
     }
   }
   EXPECT_EQ(recovered_messages, 6u);
+  // parsed_bytes: the end of the last whole record, so the prefix up to it parses the same.
+  for (std::size_t n = 8; n < good.size(); n += 7) {
+    std::string err;
+    const std::vector<uint8_t> b(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n));
+    const auto f = parse_mcap(b, "t.mcap", err, lenient);
+    if (!f) continue;
+    ASSERT_LE(f->parsed_bytes, n);
+    const std::vector<uint8_t> head(b.begin(), b.begin() + std::ptrdiff_t(f->parsed_bytes));
+    const auto g = parse_mcap(head, "t.mcap", err, lenient);
+    ASSERT_TRUE(g) << err;
+    EXPECT_EQ(g->messages.size(), f->messages.size()) << n;
+    EXPECT_EQ(g->parsed_bytes, f->parsed_bytes) << n;
+  }
 }
 
 TEST(Mcap, RandomCorruptionNeverCrashes) {

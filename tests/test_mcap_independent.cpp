@@ -129,6 +129,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
   fs::create_directories(dir);
   const fs::path file = dir / "session.mcap";
+  fs::remove(file);  // a recording is never written over an existing file by default
 
   SessionRecorder rec;
   std::string err;
@@ -182,7 +183,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.key("profile").str("ros2").key("library").str(version()).key("dataSectionCrc").str("ok");
   j.key("statistics").begin('{');
   j.key("messageCount").num(8.0 * kSteps).key("schemaCount").num(8).key("channelCount").num(8);
-  j.key("metadataCount").num(1).key("messageStartTime").num(0);
+  j.key("metadataCount").num(2).key("messageStartTime").num(0);
   j.key("messageEndTime").num(static_cast<double>((kSteps - 1) * kPeriodNs));
   j.end('}');
   std::vector<RecordedType> types(recorded_types().begin(), recorded_types().end());
@@ -199,6 +200,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   for (const char* k :
        {"control_period_ns", "mode", "pilot", "scenario", "scenario_path", "seed", "version"})
     j.str(k);
+  j.end(']').end('}');
+  j.begin('{').key("name").str("mixpilot_end").key("keys").begin('[');
+  for (const char* k : {"dropped_steps", "interrupted", "recovered", "steps"}) j.str(k);
   j.end(']').end('}').end(']');
   j.key("last").begin('{');
   // Sorted by topic, fields in .msg order.
@@ -239,6 +243,7 @@ TEST(McapIndependentReader, ReadsAPendubotRecording) {
   const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
   fs::create_directories(dir);
   const fs::path file = dir / "pendubot.mcap";
+  fs::remove(file);
   const std::string scenario = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/pendubot_swingup.toml";
 
   std::string err, text;

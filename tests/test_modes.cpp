@@ -108,6 +108,7 @@ TEST_P(EveryMode, RecordsEveryStepAndReadsItBack) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             (std::string("mixpilot_test_modes_") + c.name + ".mcap"))
                                .string();
+  std::filesystem::remove(path);  // recordings never replace an existing file by default
   std::string error, text;
   ASSERT_TRUE(read_text_file(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + c.scenario, text,
                              error));

@@ -1,8 +1,16 @@
 // Session recordings (core/recording/recording.hpp): every message type round-trips bit-exactly, a
-// recorded session reads back in order with its metadata, a failed session keeps its .tmp,
-// and corrupt or truncated recordings give errors naming a byte offset.
+// recorded session reads back in order with its metadata and how it ended, a failed session
+// keeps its temporary, corrupt or truncated recordings give errors naming a byte offset, a
+// recording cut at any byte is recovered as a prefix of the original
+// (core/recording/recover.hpp), and output files never clobber anything
+// (core/recording/output_file.hpp).
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -10,19 +18,39 @@
 #include <limits>
 #include <random>
 
-#include "core/recording/recording.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/session.hpp"
 #include "core/numerics/version.hpp"
+#include "core/recording/output_file.hpp"
+#include "core/recording/recording.hpp"
+#include "core/recording/recover.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot {
 namespace {
 
 namespace fs = std::filesystem;
 
+// The temporaries beside `p` ("<p>.XXXXXX.tmp", core/recording/output_file.hpp).
+std::vector<fs::path> temporaries_of(const fs::path& p) {
+  std::vector<fs::path> out;
+  const std::string name = p.filename().string();
+  for (const auto& e : fs::directory_iterator(p.parent_path())) {
+    const std::string f = e.path().filename().string();
+    if (f.size() == name.size() + 11 && f.rfind(name + ".", 0) == 0 && f.ends_with(".tmp"))
+      out.push_back(e.path());
+  }
+  return out;
+}
+
+// A fresh path in the test folder: whatever an earlier run left there, temporaries included,
+// is removed.
 fs::path temp_path(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / "mixpilot_test_recording";
   fs::create_directories(dir);
-  fs::remove(dir / name);
-  fs::remove(dir / (name + ".tmp"));
+  fs::remove_all(dir / name);
+  for (const auto& t : temporaries_of(dir / name)) fs::remove(t);
   return dir / name;
 }
 
@@ -172,7 +200,7 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
   ASSERT_TRUE(rec.open(p.string(), kPeriodNs, test_info(), err)) << err;
   record_session(rec, 20);
   ASSERT_TRUE(rec.close(err)) << err;
-  EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+  EXPECT_TRUE(temporaries_of(p).empty());
 
   const auto r = read_recording(p.string(), err);
   ASSERT_TRUE(r) << err;
@@ -185,6 +213,8 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
   EXPECT_EQ(r->metadata.at("seed"), "1234567890123");
   EXPECT_EQ(r->metadata.at("pilot"), "novice");
   EXPECT_EQ(r->metadata.at("mode"), "mixed_initiative");
+  ASSERT_TRUE(r->end);  // closed normally: a complete flight
+  EXPECT_EQ(*r->end, (RecordingEnd{false, false, 20, 0}));
   for (const auto& t : recorded_types()) EXPECT_EQ(r->message_counts.at(t.topic), 20u) << t.topic;
   ASSERT_EQ(r->pilot.size(), 20u);
   for (uint64_t k = 0; k < 20; ++k) {
@@ -224,26 +254,29 @@ TEST(SessionRecorder, LargeStepsKeepExactTimes) {
 
 TEST(SessionRecorder, FailedSessionKeepsItsTmp) {
   const fs::path p = temp_path("failed.mcap");
+  std::string tmp;
   {
     SessionRecorder rec;
     std::string err;
     ASSERT_TRUE(rec.open(p.string(), kPeriodNs, test_info(), err)) << err;
+    tmp = rec.writer().tmp_path();
     record_session(rec, 5);
     // A step going back in time is refused, and the recording cannot be completed...
     EXPECT_FALSE(rec.record_lambda(2, 0.5));
     EXPECT_FALSE(rec.close(err));
     EXPECT_NE(err.find("log-time order"), std::string::npos) << err;
-    EXPECT_NE(err.find(".tmp"), std::string::npos) << err;
+    EXPECT_NE(err.find("kept in " + tmp), std::string::npos) << err;
   }
-  // ...but all that was recorded before stays in the .tmp file.
+  // ...but all that was recorded before stays in the temporary.
   EXPECT_FALSE(fs::exists(p));
   std::string err;
-  EXPECT_FALSE(read_recording(p.string() + ".tmp", err));
+  EXPECT_FALSE(read_recording(tmp, err));
   McapReadOptions lenient;
   lenient.allow_truncated = true;
-  const auto r = read_recording(p.string() + ".tmp", err, lenient);
+  const auto r = read_recording(tmp, err, lenient);
   ASSERT_TRUE(r) << err;
   EXPECT_FALSE(r->complete);
+  EXPECT_FALSE(r->end);  // the closing record is written only when the file can be completed
   EXPECT_EQ(r->pilot.size(), 5u);
   EXPECT_EQ(r->metadata.at("pilot"), "novice");
 }
@@ -256,7 +289,7 @@ TEST(SessionRecorder, CrashMidSessionLosesNothingFlushed) {
     ASSERT_TRUE(rec.open(p.string(), kPeriodNs, test_info(), err)) << err;
     record_session(rec, 7);
     ASSERT_TRUE(rec.flush());
-    const auto partial = slurp(p.string() + ".tmp");
+    const auto partial = slurp(rec.writer().tmp_path());
     McapReadOptions lenient;
     lenient.allow_truncated = true;
     auto f = parse_mcap(partial, "crashed.mcap.tmp", err, lenient);
@@ -322,6 +355,506 @@ TEST(SessionRecorder, CorruptRecordingsNeverCrash) {
   }
   EXPECT_GT(decoded, 0);  // corrupt payload values still decode (no CRC): that is expected
   EXPECT_GT(rejected, 0);
+}
+
+// ---- how a recording ended ---------------------------------------------------------------
+
+TEST(RecordingEnd, InterruptedAndDroppedStepsAreRecorded) {
+  const fs::path p = temp_path("interrupted.mcap");
+  SessionRecorder rec;
+  std::string err;
+  ASSERT_TRUE(rec.open(p.string(), kPeriodNs, test_info(), err)) << err;
+  record_session(rec, 6);
+  ASSERT_TRUE(rec.close(err, /*interrupted=*/true, /*dropped_steps=*/3)) << err;
+  const auto r = read_recording(p.string(), err);
+  ASSERT_TRUE(r) << err;
+  ASSERT_TRUE(r->end);
+  EXPECT_EQ(*r->end, (RecordingEnd{true, false, 6, 3}));
+}
+
+// Writes a recording whose "mixpilot_end" record holds `end` and whose data has `steps` states.
+std::vector<uint8_t> recording_with_end(const McapStringMap& end, uint64_t steps) {
+  const fs::path p = temp_path("end.mcap");
+  McapWriter w;
+  std::string err;
+  EXPECT_TRUE(w.open(p.string(), err)) << err;
+  const auto& state = recorded_types()[2];
+  EXPECT_EQ(std::string(state.topic), "/vehicle/state");
+  const auto c = w.add_channel(w.add_schema(state.schema_name, "ros2msg", state.schema_text),
+                               state.topic, "cdr");
+  CdrWriter cdr;
+  for (uint64_t k = 0; k < steps; ++k) {
+    cdr.reset();
+    encode(VehicleStateMsg{{}, k, {1.0}}, cdr);
+    EXPECT_TRUE(w.write_message(c, uint32_t(k), k, k, cdr.span()));
+  }
+  EXPECT_TRUE(w.write_metadata("mixpilot_end", end));
+  EXPECT_TRUE(w.close(err)) << err;
+  return slurp(p);
+}
+
+TEST(RecordingEnd, MalformedOrInconsistentEndRecordsAreErrors) {
+  std::string err;
+  auto decode_bytes = [&](const std::vector<uint8_t>& b) {
+    const auto f = parse_mcap(b, "e.mcap", err);
+    EXPECT_TRUE(f) << err;
+    return f ? decode_recording(*f, "e.mcap", err) : std::nullopt;
+  };
+  const auto good = decode_bytes(recording_with_end({{"interrupted", "false"}, {"steps", "2"}}, 2));
+  ASSERT_TRUE(good) << err;
+  EXPECT_EQ(*good->end, (RecordingEnd{false, false, 2, 0}));  // optional keys default
+
+  const std::vector<std::pair<McapStringMap, std::string>> bad = {
+      {{{"steps", "2"}}, "no 'interrupted' key"},
+      {{{"interrupted", "yes"}, {"steps", "2"}}, "interrupted is 'yes', expected true or false"},
+      {{{"interrupted", "true"}, {"steps", "-2"}}, "steps is '-2', expected a decimal count"},
+      {{{"interrupted", "true"}, {"steps", "2x"}}, "steps is '2x', expected a decimal count"},
+      {{{"interrupted", "true"}, {"steps", "99999999999999999999"}},
+       "steps is '99999999999999999999', expected a decimal count"},
+      {{{"interrupted", "true"}, {"steps", "2"}, {"recovered", ""}},
+       "recovered is '', expected true or false"},
+  };
+  for (const auto& [end, why] : bad) {
+    EXPECT_FALSE(decode_bytes(recording_with_end(end, 2))) << why;
+    EXPECT_NE(err.find("malformed mixpilot_end Metadata record (" + why + ") at byte "),
+              std::string::npos)
+        << err;
+  }
+  EXPECT_FALSE(decode_bytes(recording_with_end({{"interrupted", "false"}, {"steps", "3"}}, 2)));
+  EXPECT_NE(err.find("mixpilot_end Metadata record says 3 steps, the recording has 2 at byte "),
+            std::string::npos)
+      << err;
+}
+
+// The sink ends the file with the flight's end: interrupted or not, and the steps it holds.
+TEST(RecordingEnd, SinkMarksAnInterruptedFlight) {
+  const std::string scenario = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml";
+  std::string err, text;
+  ASSERT_TRUE(read_text_file(scenario, text, err)) << err;
+  for (const bool interrupted : {false, true}) {
+    const fs::path p = temp_path(interrupted ? "sink_interrupted.mcap" : "sink_complete.mcap");
+    ModeRequest request;
+    request.duration = 0.3;
+    auto mode = make_mode(text, scenario, std::move(request), err);
+    ASSERT_TRUE(mode) << err;
+    RecordingSink sink;
+    ASSERT_TRUE(sink.open(p.string(), *mode, {"mixed_initiative", text, scenario, 1, "novice"},
+                          err, RecordingSink::Settings{}, /*overwrite=*/false))
+        << err;
+    EXPECT_EQ(temporaries_of(p), std::vector<fs::path>{fs::path(sink.temp_path())});
+    Session session(*mode);
+    session.add_sink(&sink);
+    if (interrupted) {
+      for (int k = 0; k < 7; ++k) ASSERT_TRUE(session.step());
+    } else {
+      session.run();
+    }
+    ASSERT_TRUE(sink.close(err, interrupted)) << err;
+    const auto r = read_recording(p.string(), err);
+    ASSERT_TRUE(r) << err;
+    ASSERT_TRUE(r->end);
+    EXPECT_EQ(r->end->interrupted, interrupted);
+    EXPECT_EQ(r->end->steps, uint64_t(mode->steps_done()));
+    EXPECT_EQ(r->states.size(), uint64_t(mode->steps_done()));
+    if (interrupted) {
+      EXPECT_EQ(mode->steps_done(), 7);
+    }
+    EXPECT_EQ(r->end->dropped_steps, 0u);
+  }
+}
+
+// ---- recovery ----------------------------------------------------------------------------
+
+struct MessageKey {
+  std::string topic;
+  uint32_t sequence;
+  uint64_t log_time;
+  std::vector<uint8_t> data;
+  bool operator==(const MessageKey&) const = default;
+};
+std::vector<MessageKey> message_keys(const McapFile& f) {
+  std::vector<MessageKey> out;
+  for (const auto& m : f.messages) {
+    const auto d = f.data(m);
+    out.push_back({f.channels.at(m.channel_id).topic, m.sequence, m.log_time, {d.begin(), d.end()}});
+  }
+  return out;
+}
+
+// A recording cut at any byte — every record boundary and points inside records, header to
+// footer — is recovered as a valid recording whose messages are a prefix of the original's:
+// every message whose step was followed by another, all of them when the cut fell after the
+// closing record.
+TEST(Recovery, CutAnywhereRecoversAPrefix) {
+  const fs::path src = temp_path("original.mcap");
+  {
+    SessionRecorder rec;
+    std::string err;
+    ASSERT_TRUE(rec.open(src.string(), kPeriodNs, test_info(), err)) << err;
+    record_session(rec, 6);
+    ASSERT_TRUE(rec.close(err)) << err;
+  }
+  const auto bytes = slurp(src);
+  std::string err;
+  const auto original = parse_mcap(bytes, "original.mcap", err);
+  ASSERT_TRUE(original) << err;
+  const auto all = message_keys(*original);
+  uint64_t end_record_end = 0;  // the closing "mixpilot_end" record, whole
+  for (const auto& md : original->metadata)
+    if (md.name == "mixpilot_end") end_record_end = md.record_offset + 9 + [&] {
+      uint64_t len;
+      std::memcpy(&len, bytes.data() + md.record_offset + 1, 8);
+      return len;
+    }();
+  ASSERT_GT(end_record_end, 0u);
+
+  std::vector<std::size_t> cuts;
+  for (std::size_t at = 8; at < bytes.size() - 8;) {
+    for (std::size_t d : {0, 1, 20}) cuts.push_back(at + d);
+    uint64_t len;
+    std::memcpy(&len, bytes.data() + at + 1, 8);
+    at += 9 + len;
+  }
+  for (std::size_t d = 1; d <= 8; ++d) cuts.push_back(bytes.size() - d);  // in the magic
+  // Each recovery fsyncs its output: on a RAM file system when there is one, that costs nothing.
+  fs::path dir = fs::temp_directory_path();
+  if (::access("/dev/shm", W_OK) == 0) dir = "/dev/shm";
+  const fs::path cut = dir / ("mixpilot_cut_" + std::to_string(::getpid()) + ".mcap.Abc123.tmp");
+  const fs::path out = dir / ("mixpilot_recovered_" + std::to_string(::getpid()) + ".mcap");
+  int recovered = 0, refused = 0;
+  std::size_t last_kept = 0;
+  for (const std::size_t n : cuts) {
+    if (n >= bytes.size()) continue;
+    std::ofstream(cut, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(n));
+    const auto result = recover_recording(cut.string(), out.string(), true, err);
+    if (!result) {  // only a cut inside the magic or Header leaves nothing to recover
+      ++refused;
+      ASSERT_LT(n, original->schemas.begin()->second.record_offset) << err;
+      ASSERT_NE(err.find(" at byte "), std::string::npos) << err;
+      continue;
+    }
+    ++recovered;
+    const auto f = read_mcap(out.string(), err);  // strict: a complete file
+    ASSERT_TRUE(f) << n << ": " << err;
+    const auto r = decode_recording(*f, "recovered.mcap", err);
+    ASSERT_TRUE(r) << n << ": " << err;
+    const auto got = message_keys(*f);
+    ASSERT_LE(got.size(), all.size());
+    ASSERT_TRUE(std::equal(got.begin(), got.end(), all.begin())) << "cut at " << n;
+    // Every message of a step that another step follows within the cut is kept.
+    std::size_t whole = 0;
+    for (const auto& m : original->messages)
+      if (m.data_offset + m.data_size <= n) ++whole;
+    std::size_t expect = whole;
+    if (n < end_record_end)
+      while (expect > 0 && original->messages[expect - 1].log_time ==
+                               original->messages[whole - 1].log_time)
+        --expect;
+    ASSERT_EQ(got.size(), expect) << "cut at " << n;
+    ASSERT_GE(got.size(), last_kept);
+    last_kept = got.size();
+    EXPECT_EQ(result->messages, got.size());
+    EXPECT_EQ(result->messages_left_out, whole - expect);
+    EXPECT_EQ(result->bytes_total, n);
+    EXPECT_LE(result->bytes_used, n);
+    ASSERT_TRUE(r->end);
+    EXPECT_TRUE(r->end->recovered);
+    EXPECT_EQ(r->end->interrupted, n < end_record_end);  // after it: the original's "false"
+    EXPECT_EQ(r->end->steps, r->states.size());
+    EXPECT_EQ(r->pilot.size(), r->states.size());  // whole steps only
+    if (n > original->metadata.front().record_offset + 100) {
+      EXPECT_EQ(r->metadata.at("scenario"), test_info().scenario);
+    }
+    EXPECT_EQ(f->library, original->library);
+  }
+  fs::remove(cut);
+  fs::remove(out);
+  EXPECT_EQ(last_kept, all.size());
+  EXPECT_GT(recovered, 200);
+  EXPECT_GT(refused, 0);
+}
+
+TEST(Recovery, RefusesCompleteFilesAndExistingOutputs) {
+  const fs::path src = temp_path("whole.mcap");
+  SessionRecorder rec;
+  std::string err;
+  ASSERT_TRUE(rec.open(src.string(), kPeriodNs, test_info(), err)) << err;
+  record_session(rec, 3);
+  ASSERT_TRUE(rec.close(err)) << err;
+  EXPECT_FALSE(recover_recording(src.string(), temp_path("x.mcap").string(), false, err));
+  EXPECT_EQ(err, src.string() + ": a complete recording; nothing to recover");
+
+  auto bytes = slurp(src);
+  bytes.resize(bytes.size() / 2);
+  const fs::path cut = temp_path("half.mcap");
+  std::ofstream(cut, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                             std::streamsize(bytes.size()));
+  // In place only with permission to overwrite.
+  EXPECT_FALSE(recover_recording(cut.string(), cut.string(), false, err));
+  EXPECT_EQ(err, cut.string() + ": " + std::strerror(EEXIST) + " (refusing to overwrite it)");
+  EXPECT_EQ(slurp(cut), bytes);
+  const auto result = recover_recording(cut.string(), cut.string(), true, err);
+  ASSERT_TRUE(result) << err;
+  EXPECT_EQ(result->steps, 1u);  // steps 0 and 1 whole, step 2 cut: step 1 could be too
+  const auto r = read_recording(cut.string(), err);
+  ASSERT_TRUE(r) << err;
+  EXPECT_EQ(r->states.size(), 1u);
+  EXPECT_FALSE(recover_recording("/dev/zero", temp_path("y.mcap").string(), false, err));
+  EXPECT_EQ(err, "/dev/zero: not a regular file (a character device)");
+}
+
+TEST(Recovery, DefaultOutputPath) {
+  EXPECT_EQ(default_recovery_path("out/run.mcap.Ab12Cd.tmp"), "out/run.mcap");
+  EXPECT_EQ(default_recovery_path("run.mcap.tmp"), "run.mcap");
+  EXPECT_EQ(default_recovery_path("out/run.mcap"), "out/run.recovered.mcap");
+  EXPECT_EQ(default_recovery_path("run"), "run.recovered.mcap");
+  EXPECT_EQ(default_recovery_path(".tmp"), ".tmp.recovered.mcap");
+}
+
+// A session killed with SIGKILL mid-flight: its temporary holds everything it had handed to
+// the OS; recovery turns it into the recording at the path it was meant for.
+TEST(Recovery, AfterKill9) {
+  const fs::path p = temp_path("killed.mcap");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    SessionRecorder rec;
+    std::string err;
+    if (!rec.open(p.string(), kPeriodNs, test_info(), err)) ::_exit(3);
+    for (uint64_t k = 0; k < 40; ++k) {
+      VehicleStateMsg x{{}, k, std::vector<double>(16, double(k))};
+      PilotCommandMsg c;
+      c.step = k;
+      if (!rec.record_pilot(c) || !rec.record_state(x)) ::_exit(4);
+      if (k == 29 && !rec.flush()) ::_exit(5);
+    }
+    ::kill(::getpid(), SIGKILL);
+    ::_exit(6);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  EXPECT_FALSE(fs::exists(p));
+  const auto temps = temporaries_of(p);
+  ASSERT_EQ(temps.size(), 1u);
+  const std::string out = default_recovery_path(temps[0].string());
+  EXPECT_EQ(out, p.string());
+  std::string err;
+  const auto result = recover_recording(temps[0].string(), out, false, err);
+  ASSERT_TRUE(result) << err;
+  const auto r = read_recording(p.string(), err);
+  ASSERT_TRUE(r) << err;
+  // Steps 0..29 were flushed; the last of them may be the one left out.
+  EXPECT_GE(r->states.size(), 29u);
+  EXPECT_LE(r->states.size(), 40u);
+  for (std::size_t k = 0; k < r->states.size(); ++k) EXPECT_EQ(r->states[k].x[0], double(k));
+  EXPECT_EQ(*r->end, (RecordingEnd{true, true, r->states.size(), 0}));
+  EXPECT_EQ(r->metadata.at("pilot"), "novice");
+  fs::remove(temps[0]);
+}
+
+// ---- output files ------------------------------------------------------------------------
+
+std::string read_all(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+bool write_output(OutputFile& f, const std::string& text) {
+  return std::fwrite(text.data(), 1, text.size(), f.stream()) == text.size();
+}
+
+TEST(OutputFile, AppearsWholeOnCommit) {
+  const fs::path p = temp_path("out.txt");
+  OutputFile f;
+  std::string err;
+  ASSERT_TRUE(f.open(p.string(), false, err)) << err;
+  const std::string tmp = f.temp_path();
+  EXPECT_EQ(temporaries_of(p), std::vector<fs::path>{fs::path(tmp)});
+  ASSERT_TRUE(write_output(f, "hello"));
+  EXPECT_FALSE(fs::exists(p));
+  ASSERT_TRUE(f.commit(err)) << err;
+  EXPECT_EQ(read_all(p), "hello");
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_EQ(f.temp_path(), "");
+  // The temporary was created like any new file: the umask applies, not mkstemp's 0600.
+  const mode_t mask = ::umask(022);
+  ::umask(mask);
+  EXPECT_EQ(fs::status(p).permissions(), fs::perms(0666 & ~mask));
+}
+
+TEST(OutputFile, ExistingFilesOnlyWithOverwrite) {
+  const fs::path p = temp_path("existing.txt");
+  std::ofstream(p) << "old";
+  std::string err;
+  EXPECT_FALSE(check_output_path(p.string(), false, err));
+  EXPECT_EQ(err, p.string() + ": " + std::strerror(EEXIST) + " (refusing to overwrite it)");
+  OutputFile f;
+  EXPECT_FALSE(f.open(p.string(), false, err));
+  EXPECT_FALSE(f.is_open());
+  EXPECT_TRUE(check_output_path(p.string(), true, err)) << err;
+  ASSERT_TRUE(f.open(p.string(), true, err)) << err;
+  ASSERT_TRUE(write_output(f, "new"));
+  EXPECT_EQ(read_all(p), "old");
+  ASSERT_TRUE(f.commit(err)) << err;
+  EXPECT_EQ(read_all(p), "new");
+  EXPECT_TRUE(temporaries_of(p).empty());  // the check's probe left nothing either
+}
+
+TEST(OutputFile, NeverWritesOverWhatIsNotARegularFile) {
+  const fs::path dir = temp_path("a_dir");
+  fs::create_directories(dir);
+  const fs::path fifo = temp_path("a_fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path to_dir = temp_path("link_to_dir");
+  fs::create_directory_symlink(dir, to_dir);
+  const fs::path to_dev = temp_path("link_to_dev");
+  fs::create_symlink("/dev/null", to_dev);
+  const fs::path dangling = temp_path("dangling");
+  fs::create_symlink(temp_path("nothing_here"), dangling);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/dev/full", "/dev/full: not a regular file (a character device)"},
+      {"/dev/null", "/dev/null: not a regular file (a character device)"},
+      {dir.string(), dir.string() + ": not a regular file (a directory)"},
+      {fifo.string(), fifo.string() + ": not a regular file (a FIFO)"},
+      {to_dir.string(), to_dir.string() + ": not a regular file (a symbolic link to a directory)"},
+      {to_dev.string(),
+       to_dev.string() + ": not a regular file (a symbolic link to a character device)"},
+      {dangling.string(), dangling.string() + ": symbolic link to nothing usable: " +
+                              std::strerror(ENOENT)},
+      {dir.string() + "/", dir.string() + "/: names a directory, not a file"},
+      {"", "empty output path"},
+  };
+  for (const auto& [path, want] : cases) {
+    for (const bool overwrite : {false, true}) {
+      std::string err;
+      EXPECT_FALSE(check_output_path(path, overwrite, err)) << path;
+      EXPECT_EQ(err, want);
+      OutputFile f;
+      EXPECT_FALSE(f.open(path, overwrite, err)) << path;
+      EXPECT_EQ(err, want);
+    }
+  }
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_TRUE(fs::is_directory(dir));
+}
+
+TEST(OutputFile, UnwritableDirectoriesAreErrorsWithTheReason) {
+  std::string err;
+  const fs::path missing = temp_path("no_such_dir") / "x.mcap";
+  EXPECT_FALSE(check_output_path(missing.string(), false, err));
+  EXPECT_EQ(err, missing.string() + ": cannot create a file in " +
+                     missing.parent_path().string() + ": " + std::strerror(ENOENT));
+  const fs::path file = temp_path("plain_file");
+  std::ofstream(file) << "x";
+  const fs::path under_file = file / "x.mcap";
+  EXPECT_FALSE(check_output_path(under_file.string(), false, err));
+  EXPECT_EQ(err, under_file.string() + ": cannot check the output path: " + std::strerror(ENOTDIR));
+  if (::geteuid() != 0) {  // root may create files in a read-only (0500) directory
+    const fs::path ro = temp_path("read_only_dir");
+    fs::create_directories(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    EXPECT_FALSE(check_output_path((ro / "x").string(), false, err));
+    EXPECT_EQ(err, (ro / "x").string() + ": cannot create a file in " + ro.string() + ": " +
+                       std::strerror(EACCES));
+    fs::permissions(ro, fs::perms::owner_all);
+  }
+}
+
+TEST(OutputFile, SymbolicLinkToAFileIsWrittenThrough) {
+  const fs::path target = temp_path("real.txt");
+  std::ofstream(target) << "old";
+  const fs::path link = temp_path("link.txt");
+  fs::create_symlink(target, link);
+  OutputFile f;
+  std::string err;
+  EXPECT_FALSE(f.open(link.string(), false, err));
+  EXPECT_EQ(err, link.string() + ": " + std::strerror(EEXIST) + " (refusing to overwrite it)");
+  ASSERT_TRUE(f.open(link.string(), true, err)) << err;
+  EXPECT_EQ(fs::path(f.temp_path()).parent_path(), target.parent_path());
+  ASSERT_TRUE(write_output(f, "new"));
+  ASSERT_TRUE(f.commit(err)) << err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(read_all(target), "new");
+}
+
+// Two runs writing one path: the first to finish wins, the second fails with the reason and
+// keeps its output in its temporary.
+TEST(OutputFile, SecondWriterOfOnePathFailsAndKeepsItsData) {
+  const fs::path p = temp_path("contested.txt");
+  OutputFile a, b;
+  std::string err;
+  ASSERT_TRUE(a.open(p.string(), false, err)) << err;
+  ASSERT_TRUE(b.open(p.string(), false, err)) << err;
+  EXPECT_NE(a.temp_path(), b.temp_path());
+  ASSERT_TRUE(write_output(a, "run A"));
+  ASSERT_TRUE(write_output(b, "run B"));
+  ASSERT_TRUE(a.commit(err)) << err;
+  const std::string b_tmp = b.temp_path();
+  EXPECT_FALSE(b.commit(err));
+  EXPECT_EQ(err, p.string() + ": " + std::strerror(EEXIST) +
+                     " (it appeared while this run was writing; not replaced); the output is "
+                     "kept in " + b_tmp);
+  EXPECT_EQ(read_all(p), "run A");
+  EXPECT_EQ(read_all(b_tmp), "run B");
+  EXPECT_EQ(b.temp_path(), b_tmp);
+  b.discard();
+  EXPECT_FALSE(fs::exists(b_tmp));
+}
+
+// The fallback for file systems without RENAME_NOREPLACE behaves the same.
+TEST(OutputFile, LinkFallbackNeverReplaces) {
+  const fs::path from = temp_path("from.txt"), to = temp_path("to.txt");
+  std::ofstream(from) << "data";
+  std::string err;
+  ASSERT_TRUE(link_into_place(from.string(), to.string(), err)) << err;
+  EXPECT_FALSE(fs::exists(from));
+  EXPECT_EQ(read_all(to), "data");
+  std::ofstream(from) << "other";
+  EXPECT_FALSE(link_into_place(from.string(), to.string(), err));
+  EXPECT_NE(err.find(std::strerror(EEXIST)), std::string::npos) << err;
+  EXPECT_NE(err.find("kept in " + from.string()), std::string::npos) << err;
+  EXPECT_EQ(read_all(to), "data");
+  EXPECT_EQ(read_all(from), "other");
+}
+
+TEST(OutputFile, DiscardAndAbandon) {
+  const fs::path p = temp_path("dropped.txt");
+  std::string err, kept;
+  {
+    OutputFile f;
+    ASSERT_TRUE(f.open(p.string(), false, err)) << err;
+    ASSERT_TRUE(write_output(f, "partial"));
+    kept = f.temp_path();
+  }  // destroyed uncommitted: the data stays in the temporary
+  EXPECT_EQ(read_all(kept), "partial");
+  EXPECT_FALSE(fs::exists(p));
+  fs::remove(kept);
+  OutputFile f;
+  ASSERT_TRUE(f.open(p.string(), false, err)) << err;
+  const std::string tmp = f.temp_path();
+  f.discard();
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_FALSE(f.is_open());
+  EXPECT_FALSE(f.commit(err));
+  EXPECT_FALSE(fs::exists(p));
+}
+
+TEST(OutputFile, SameOutputPath) {
+  const fs::path dir = temp_path("same_dir");
+  fs::create_directories(dir);
+  EXPECT_TRUE(same_output_path((dir / "x.json").string(), (dir / "." / "x.json").string()));
+  EXPECT_TRUE(same_output_path((dir / "x.json").string(), (dir / "sub" / ".." / "x.json").string()));
+  EXPECT_FALSE(same_output_path((dir / "x.json").string(), (dir / "y.json").string()));
+  std::ofstream(dir / "x.json") << "{}";
+  fs::create_symlink(dir / "x.json", dir / "alias.json");
+  EXPECT_TRUE(same_output_path((dir / "x.json").string(), (dir / "alias.json").string()));
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  EXPECT_TRUE(same_output_path("x.json", (dir / "x.json").string()));
+  fs::current_path(cwd);
 }
 
 }  // namespace

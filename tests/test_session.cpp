@@ -167,6 +167,7 @@ TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
   sc.duration = 4.0;
   const std::string path =
       (std::filesystem::temp_directory_path() / "mixpilot_test_replay.mcap").string();
+  std::filesystem::remove(path);  // recordings never replace an existing file by default
 
   TraceSink original;
   Score original_score;

@@ -45,18 +45,26 @@ void mat(std::ostream& o, const Eigen::MatrixXd& m) {
 }
 
 // --- Minimal JSON reader for the subset the writer produces. ---
+// Object members are a struct declared inside Json: std::vector accepts an incomplete element
+// type, std::pair<std::string, Json> (incomplete Json) is ill-formed and clang rejects it.
 struct Json {
+  struct Member;
   enum Type { null, number, string, array, object } type = null;
   double x = 0.0;
   std::string s;
   std::vector<Json> a;
-  std::vector<std::pair<std::string, Json>> o;
-  const Json* get(const std::string& key) const {
-    for (const auto& [k, v] : o)
-      if (k == key) return &v;
-    return nullptr;
-  }
+  std::vector<Member> o;
+  const Json* get(const std::string& key) const;
 };
+struct Json::Member {
+  std::string key;
+  Json value;
+};
+const Json* Json::get(const std::string& key) const {
+  for (const auto& [k, v] : o)
+    if (k == key) return &v;
+  return nullptr;
+}
 
 struct Parser {
   const std::string& t;
@@ -99,7 +107,7 @@ struct Parser {
         ++p;
         Json child;
         if (!value(child)) return false;
-        v.o.emplace_back(std::move(key), std::move(child));
+        v.o.push_back({std::move(key), std::move(child)});
         ws();
         if (p < t.size() && t[p] == ',') {
           ++p;

@@ -1,7 +1,10 @@
 #include "core/recording/mcap.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -76,13 +79,6 @@ bool map_fits(const McapStringMap& m) {
 }
 }  // namespace
 
-McapWriter::~McapWriter() {
-  if (file_ != nullptr) {
-    std::fflush(file_);
-    std::fclose(file_);
-  }
-}
-
 bool McapWriter::fail(std::string message) {
   if (error_.empty()) error_ = std::move(message);
   return false;
@@ -109,8 +105,8 @@ bool McapWriter::emit(bool in_data_section) {
   return write_raw(record_.data(), record_.size(), in_data_section);
 }
 
-bool McapWriter::open(const std::string& path, std::string& error, std::string_view profile,
-                      std::string_view library) {
+bool McapWriter::open(const std::string& path, std::string& error,
+                      const McapWriteOptions& options) {
   if (file_ != nullptr) {
     error = path + ": writer already open on " + path_;
     return false;
@@ -126,19 +122,19 @@ bool McapWriter::open(const std::string& path, std::string& error, std::string_v
   channel_counts_.clear();
   metadata_index_.clear();
   message_count_ = first_log_time_ = last_log_time_ = 0;
-  file_ = std::fopen(tmp_path().c_str(), "wb");
-  if (file_ == nullptr) {
-    error = tmp_path() + ": cannot create: " + std::strerror(errno);
-    return false;
-  }
-  std::setvbuf(file_, nullptr, _IOFBF, 1 << 16);  // fewer write syscalls per control step
+  // The stream is fully buffered (64 KiB): few write syscalls per control step.
+  if (!out_.open(path, options.overwrite, error)) return false;
+  file_ = out_.stream();
   write_raw(mcap::kMagic, sizeof mcap::kMagic, true);
   begin(mcap::Opcode::kHeader);  // spec "Header (op=0x01)": profile, library
-  put_string(record_, profile);
-  put_string(record_, library.empty() ? std::string_view(version()) : library);
+  put_string(record_, options.profile);
+  put_string(record_,
+             options.library.empty() ? std::string_view(version()) : options.library);
   emit(true);
   if (!error_.empty()) {
     error = error_;
+    out_.discard();  // nothing worth keeping was written
+    file_ = nullptr;
     return false;
   }
   return true;
@@ -230,8 +226,7 @@ bool McapWriter::close(std::string& error) {
     return false;
   }
   auto give_up = [&] {
-    std::fflush(file_);
-    std::fclose(file_);
+    out_.abandon();
     file_ = nullptr;
     error = error_ + " (partial recording kept in " + tmp_path() + ")";
     return false;
@@ -328,19 +323,10 @@ bool McapWriter::close(std::string& error) {
   write_raw(mcap::kMagic, sizeof mcap::kMagic, false);
   if (!error_.empty()) return give_up();
 
-  // Durable before visible: flush and fsync the .tmp, then rename over the final name.
-  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
-    fail(tmp_path() + ": flush failed: " + std::strerror(errno));
-    return give_up();
-  }
-  const int rc = std::fclose(file_);
+  // Durable before visible (fsync, then the move); the temporary stays if either fails.
   file_ = nullptr;
-  if (rc != 0) {
-    error = tmp_path() + ": close failed: " + std::strerror(errno);
-    return false;
-  }
-  if (std::rename(tmp_path().c_str(), path_.c_str()) != 0) {
-    error = tmp_path() + ": cannot rename to " + path_ + ": " + std::strerror(errno);
+  if (!out_.commit(error)) {
+    fail(error);
     return false;
   }
   return true;
@@ -500,6 +486,7 @@ class Parser {
   bool truncated(uint64_t at, const std::string& what, const std::string& detail) {
     if (opt_.allow_truncated && section_ != Section::kHeader) {
       f_.complete = false;
+      f_.parsed_bytes = at;  // the records before `at` are whole
       stopped_ = true;
       return true;
     }
@@ -518,6 +505,11 @@ class Parser {
                          "9 bytes of opcode and length needed, " + std::to_string(size_ - pos) +
                              " remain");
       const uint8_t op = b_[pos];
+      // A crash can leave a zero-filled tail (blocks allocated but never written): where a
+      // record should start, nothing but zeros is the end of what was written.
+      if (op == 0 && opt_.allow_truncated && section_ != Section::kHeader &&
+          std::all_of(b_ + pos, b_ + size_, [](uint8_t v) { return v == 0; }))
+        return truncated(pos, "zero-filled tail", "");
       uint64_t len = 0;
       std::memcpy(&len, b_ + pos + 1, 8);
       if (len > size_ - pos - 9)
@@ -528,7 +520,10 @@ class Parser {
       if (!record(pos, op, len, done)) return false;
       if (stopped_) return true;
       pos += 9 + len;
-      if (done) return finish(pos);
+      if (done) {
+        f_.parsed_bytes = size_;
+        return finish(pos);
+      }
     }
   }
 
@@ -762,6 +757,13 @@ class Parser {
   }
 
   bool finish(uint64_t end) {
+    // Cut inside the trailing magic: every record is whole, the file is not complete.
+    if (opt_.allow_truncated && size_ - end < sizeof mcap::kMagic &&
+        std::memcmp(b_ + end, mcap::kMagic, size_ - end) == 0) {
+      f_.complete = false;
+      f_.parsed_bytes = end;
+      return true;
+    }
     if (size_ - end != sizeof mcap::kMagic ||
         std::memcmp(b_ + end, mcap::kMagic, sizeof mcap::kMagic) != 0)
       return error_at(end, "expected the trailing magic after the Footer",
@@ -820,19 +822,50 @@ std::optional<McapFile> parse_mcap(std::vector<uint8_t> bytes, std::string_view 
 
 std::optional<McapFile> read_mcap(const std::string& path, std::string& error,
                                   const McapReadOptions& options) {
-  std::FILE* fp = std::fopen(path.c_str(), "rb");
-  if (fp == nullptr) {
+  // O_NONBLOCK: opening a FIFO must not wait for a writer before it can be refused.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
     error = path + ": cannot open: " + std::strerror(errno);
     return std::nullopt;
   }
-  std::vector<uint8_t> bytes;
-  uint8_t buf[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, fp)) > 0) bytes.insert(bytes.end(), buf, buf + n);
-  const bool bad = std::ferror(fp) != 0;
-  std::fclose(fp);
-  if (bad) {
-    error = path + ": read failed";
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    error = path + ": cannot read: " + std::strerror(errno);
+    ::close(fd);
+    return std::nullopt;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    error = path + ": not a regular file (" +
+            (S_ISDIR(st.st_mode)    ? "a directory"
+             : S_ISCHR(st.st_mode)  ? "a character device"
+             : S_ISBLK(st.st_mode)  ? "a block device"
+             : S_ISFIFO(st.st_mode) ? "a FIFO"
+                                    : "a socket") +
+            ")";
+    ::close(fd);
+    return std::nullopt;
+  }
+  const auto size = static_cast<uint64_t>(st.st_size);
+  if (size > options.max_bytes) {
+    error = path + ": " + std::to_string(size) + " bytes, more than the " +
+            std::to_string(options.max_bytes) + " a recording may have";
+    ::close(fd);
+    return std::nullopt;
+  }
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(size));
+  std::size_t got = 0;
+  int read_errno = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) read_errno = errno;
+    if (n <= 0) break;  // an error, or a file that shrank while being read
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  if (got < bytes.size()) {
+    error = path + ": read failed after " + std::to_string(got) + " of " + std::to_string(size) +
+            " bytes: " + (read_errno != 0 ? std::strerror(read_errno) : "the file shrank");
     return std::nullopt;
   }
   return parse_mcap(std::move(bytes), path, error, options);

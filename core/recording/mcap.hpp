@@ -17,9 +17,10 @@
 // Indexed readers that seek by time therefore find no chunk index and fall back to a linear
 // scan (the TypeScript McapStreamReader, `mcap cat`), which is fine for training sessions.
 //
-// Crash safety: the writer streams to "<path>.tmp" and renames it to <path> only in close(),
-// so <path> is either absent or a complete file. A session that fails keeps its .tmp, which
-// read_mcap with allow_truncated recovers up to the last complete record.
+// Crash safety: the writer streams to a temporary beside <path>, "<path>.XXXXXX.tmp"
+// (core/recording/output_file.hpp), and moves it to <path> only in close(), so <path> is either
+// absent (or its old contents, when overwriting) or a complete file. A session that fails keeps
+// its temporary, which read_mcap with allow_truncated reads up to the last complete record.
 #include <cstdint>
 #include <cstdio>
 #include <map>
@@ -28,6 +29,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "core/recording/output_file.hpp"
 
 namespace mixpilot {
 
@@ -63,20 +66,25 @@ inline constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'}
 
 using McapStringMap = std::map<std::string, std::string>;
 
+struct McapWriteOptions {
+  bool overwrite = false;              // replace an existing regular file at the path
+  std::string_view profile = "ros2";   // the spec's well-known profile
+  std::string_view library = {};       // the writer's name; empty = version()
+};
+
 // Streaming writer. Not thread-safe; one writer per file. The first failure is kept (sticky):
 // later calls do nothing and return false/0, and close() reports it.
 class McapWriter {
  public:
   McapWriter() = default;
-  // Without close() the .tmp file is flushed and left in place (nothing recorded is lost).
-  ~McapWriter();
+  // Without close() the temporary is flushed and left in place (nothing recorded is lost).
+  ~McapWriter() = default;
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
 
-  // Creates "<path>.tmp" (truncating it) and writes the magic and the Header record.
-  // `profile` is the spec's well-known profile ("ros2"); `library` defaults to version().
-  bool open(const std::string& path, std::string& error, std::string_view profile = "ros2",
-            std::string_view library = {});
+  // Checks `path` (OutputFile::open: never a device or directory, an existing file only with
+  // options.overwrite), creates the temporary and writes the magic and the Header record.
+  bool open(const std::string& path, std::string& error, const McapWriteOptions& options = {});
 
   // Writes a Schema record; returns its id (1, 2, ...) or 0 on failure.
   uint16_t add_schema(std::string_view name, std::string_view encoding, std::string_view data);
@@ -91,14 +99,16 @@ class McapWriter {
   // Pushes buffered bytes to the OS (a crash after this loses nothing already written).
   bool flush();
 
-  // Writes DataEnd, the summary, SummaryOffsets, Footer and magic, then renames the .tmp file
-  // to the final path. On failure the .tmp file stays for inspection.
+  // Writes DataEnd, the summary, SummaryOffsets, Footer and magic, then moves the temporary to
+  // the final path. On failure the temporary stays for inspection or recovery.
   bool close(std::string& error);
 
   bool is_open() const { return file_ != nullptr; }
   const std::string& error() const { return error_; }
   const std::string& path() const { return path_; }
-  std::string tmp_path() const { return path_ + ".tmp"; }
+  // The temporary being written ("<path>.XXXXXX.tmp"); kept after a failed close(), "" after
+  // a successful one.
+  const std::string& tmp_path() const { return out_.temp_path(); }
   uint64_t bytes_written() const { return offset_; }
 
  private:
@@ -121,7 +131,8 @@ class McapWriter {
   void begin(mcap::Opcode op);
   bool write_raw(const uint8_t* data, std::size_t size, bool in_data_section);
 
-  std::FILE* file_ = nullptr;
+  OutputFile out_;
+  std::FILE* file_ = nullptr;  // out_.stream() while open
   std::string path_;
   std::string error_;
   uint64_t offset_ = 0;
@@ -187,8 +198,9 @@ struct McapFile {
   std::optional<McapStatistics> statistics;  // from the summary, when present
   uint32_t data_section_crc = 0;             // as stored in DataEnd (0 = not computed)
   // False only with allow_truncated, when the file ended before the Footer (a crashed
-  // session's .tmp); everything up to the last complete record is then returned.
+  // session's temporary); everything up to the last complete record is then returned.
   bool complete = true;
+  uint64_t parsed_bytes = 0;  // end of the last complete record read (the size when complete)
 
   std::span<const uint8_t> data(const McapMessage& m) const {
     return {bytes.data() + m.data_offset, static_cast<std::size_t>(m.data_size)};
@@ -197,6 +209,9 @@ struct McapFile {
 
 struct McapReadOptions {
   bool allow_truncated = false;  // accept a file cut short (see McapFile::complete)
+  // read_mcap refuses larger files: the whole file is held in memory, and decoding a
+  // recording takes about as much again.
+  uint64_t max_bytes = uint64_t(4) << 30;
 };
 
 // Parses and validates a whole MCAP file: magic, record framing and lengths, opcodes allowed
@@ -206,6 +221,8 @@ struct McapReadOptions {
 // `error` to "<name>: <what> at byte <offset> (...)".
 std::optional<McapFile> parse_mcap(std::vector<uint8_t> bytes, std::string_view name,
                                    std::string& error, const McapReadOptions& options = {});
+// Reads the file at `path` (a regular file of at most options.max_bytes: a device, FIFO or
+// directory is refused without blocking on it) and parses it as parse_mcap does.
 std::optional<McapFile> read_mcap(const std::string& path, std::string& error,
                                   const McapReadOptions& options = {});
 

@@ -1,6 +1,7 @@
 #include "core/recording/recording.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <iterator>
 #include <limits>
@@ -311,14 +312,16 @@ bool decode_float64(std::span<const uint8_t> d, double& v, std::string& error) {
 // ---- SessionRecorder ----------------------------------------------------------------------
 
 bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
-                           const SessionInfo& info, std::string& error) {
+                           const SessionInfo& info, std::string& error, bool overwrite) {
   if (control_period_ns == 0) {
     error = path + ": control period must be positive";
     return false;
   }
   period_ns_ = control_period_ns;
   sequence_.fill(0);
-  if (!writer_.open(path, error)) return false;
+  McapWriteOptions options;
+  options.overwrite = overwrite;
+  if (!writer_.open(path, error, options)) return false;
   for (std::size_t t = 0; t < kTopicCount; ++t) {
     const auto schema = writer_.add_schema(kTypes[t].schema_name, "ros2msg", kTypes[t].schema_text);
     channel_[t] = writer_.add_channel(schema, kTypes[t].topic, "cdr",
@@ -372,9 +375,67 @@ bool SessionRecorder::record_lambda(uint64_t step, double lambda) {
   return put_encoded(kLambda, step);
 }
 
-bool SessionRecorder::close(std::string& error) { return writer_.close(error); }
+McapStringMap to_metadata(const RecordingEnd& end) {
+  return {{"interrupted", end.interrupted ? "true" : "false"},
+          {"recovered", end.recovered ? "true" : "false"},
+          {"steps", std::to_string(end.steps)},
+          {"dropped_steps", std::to_string(end.dropped_steps)}};
+}
+
+bool SessionRecorder::close(std::string& error, bool interrupted, uint64_t dropped_steps) {
+  RecordingEnd end;
+  end.interrupted = interrupted;
+  end.steps = sequence_[kState];
+  end.dropped_steps = dropped_steps;
+  // Last record of the data section: a reader that finds it knows the flight's end was written.
+  writer_.write_metadata(kEndMetadataName, to_metadata(end));
+  return writer_.close(error);
+}
 
 // ---- reading ------------------------------------------------------------------------------
+
+namespace {
+
+bool parse_flag(const McapStringMap& m, const char* key, bool required, bool& out,
+                std::string& what) {
+  const auto it = m.find(key);
+  if (it == m.end()) {
+    if (required) what = std::string("no '") + key + "' key";
+    return !required;
+  }
+  if (it->second != "true" && it->second != "false") {
+    what = std::string(key) + " is '" + it->second + "', expected true or false";
+    return false;
+  }
+  out = it->second == "true";
+  return true;
+}
+
+bool parse_count(const McapStringMap& m, const char* key, bool required, uint64_t& out,
+                 std::string& what) {
+  const auto it = m.find(key);
+  if (it == m.end()) {
+    if (required) what = std::string("no '") + key + "' key";
+    return !required;
+  }
+  const std::string& v = it->second;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (v.empty() || ec != std::errc() || end != v.data() + v.size()) {
+    what = std::string(key) + " is '" + v + "', expected a decimal count";
+    return false;
+  }
+  return true;
+}
+
+// The "mixpilot_end" record's values; false with what is wrong.
+bool parse_end(const McapStringMap& m, RecordingEnd& end, std::string& what) {
+  return parse_flag(m, "interrupted", true, end.interrupted, what) &&
+         parse_flag(m, "recovered", false, end.recovered, what) &&
+         parse_count(m, "steps", true, end.steps, what) &&
+         parse_count(m, "dropped_steps", false, end.dropped_steps, what);
+}
+
+}  // namespace
 
 std::optional<RecordingContents> decode_recording(const McapFile& file, std::string_view name,
                                                   std::string& error) {
@@ -404,8 +465,16 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
     }
     kind[id] = k;
   }
-  for (const auto& md : file.metadata)
+  uint64_t end_at = 0;
+  for (const auto& md : file.metadata) {
     if (md.name == "mixpilot") out.metadata = md.metadata;
+    if (md.name != kEndMetadataName) continue;
+    if (out.end) return fail(md.record_offset, "second mixpilot_end Metadata record");
+    std::string what;
+    if (!parse_end(md.metadata, out.end.emplace(), what))
+      return fail(md.record_offset, "malformed mixpilot_end Metadata record (" + what + ")");
+    end_at = md.record_offset;
+  }
   if (auto it = out.metadata.find("control_period_ns"); it != out.metadata.end())
     out.control_period_ns = std::strtoull(it->second.c_str(), nullptr, 10);
 
@@ -435,6 +504,9 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
     if (!ok)
       return fail(msg.record_offset, "undecodable " + ch.topic + " message (" + why + ")");
   }
+  if (out.end && out.end->steps != out.states.size())
+    return fail(end_at, "mixpilot_end Metadata record says " + std::to_string(out.end->steps) +
+                            " steps, the recording has " + std::to_string(out.states.size()));
   return out;
 }
 

@@ -152,6 +152,19 @@ struct SessionInfo {
   std::string pilot;          // pilot source, as in PilotCommandMsg::source (mixed initiative)
 };
 
+// How a recording ended: its closing "mixpilot_end" Metadata record, written by
+// SessionRecorder::close() and by recover_recording(). A recording without one was cut short,
+// or written before the record existed.
+struct RecordingEnd {
+  bool interrupted = false;    // the flight stopped before its scheduled end (a signal, a crash)
+  bool recovered = false;      // rebuilt by recover_recording() from a cut-short file
+  uint64_t steps = 0;          // control steps recorded (messages on /vehicle/state)
+  uint64_t dropped_steps = 0;  // steps flown but not recorded (a full ring in real time)
+  bool operator==(const RecordingEnd&) const = default;
+};
+inline constexpr const char* kEndMetadataName = "mixpilot_end";
+McapStringMap to_metadata(const RecordingEnd& end);
+
 // Writes one session. Each record_* call appends one message at log time step·Δt and fills
 // the message's stamp with that time; steps must not decrease across calls (MCAP log-time
 // order). Calls after a failure do nothing; close() reports the first failure.
@@ -161,10 +174,11 @@ class SessionRecorder {
   SessionRecorder(const SessionRecorder&) = delete;
   SessionRecorder& operator=(const SessionRecorder&) = delete;
 
-  // Opens "<path>.tmp", writes the schemas, channels and the "mixpilot" Metadata record.
+  // Opens the output (McapWriter::open: a temporary beside `path`; an existing file at `path`
+  // only with `overwrite`), writes the schemas, channels and the "mixpilot" Metadata record.
   // control_period_ns > 0 is Δt in nanoseconds.
   bool open(const std::string& path, uint64_t control_period_ns, const SessionInfo& info,
-            std::string& error);
+            std::string& error, bool overwrite = false);
 
   bool record_joy(uint64_t step, const JoyMsg& m);
   bool record_pilot(const PilotCommandMsg& m);
@@ -176,8 +190,9 @@ class SessionRecorder {
   bool record_channels(const ModeChannelsMsg& m);
 
   bool flush() { return writer_.flush(); }
-  // Completes the file and renames "<path>.tmp" to <path>.
-  bool close(std::string& error);
+  // Writes the "mixpilot_end" Metadata record (steps = the /vehicle/state messages recorded),
+  // completes the file and moves it to its path.
+  bool close(std::string& error, bool interrupted = false, uint64_t dropped_steps = 0);
 
   uint64_t log_time_ns(uint64_t step) const { return step * period_ns_; }
   const McapWriter& writer() const { return writer_; }
@@ -210,12 +225,15 @@ struct RecordingContents {
   std::vector<SolverStatsMsg> solver;
   std::vector<PredictionMsg> predictions;
   std::vector<ModeChannelsMsg> channels;
-  bool complete = true;  // false: read from a cut-short .tmp (allow_truncated)
+  bool complete = true;  // false: read from a cut-short temporary (allow_truncated)
+  // The "mixpilot_end" record: absent when the file was cut short (or is older than it).
+  std::optional<RecordingEnd> end;
 };
 
 // Reads a recording: validates the MCAP file (core/recording/mcap.hpp), checks that every known topic
-// uses its expected schema name, ros2msg and cdr, and decodes all messages. Topics it does
-// not know are counted, not decoded. Errors: "<path>: <what> at byte <offset> (...)".
+// uses its expected schema name, ros2msg and cdr, decodes all messages and the "mixpilot_end"
+// record (its step count must match the recorded states). Topics it does not know are counted,
+// not decoded. Errors: "<path>: <what> at byte <offset> (...)".
 std::optional<RecordingContents> read_recording(const std::string& path, std::string& error,
                                                 const McapReadOptions& options = {});
 std::optional<RecordingContents> decode_recording(const McapFile& file, std::string_view name,

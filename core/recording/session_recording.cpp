@@ -7,13 +7,14 @@ namespace mixpilot {
 
 RecordingSink::~RecordingSink() {
   if (open_) {
+    // Never closed: the run ended some other way (an exception), so not at its scheduled end.
     std::string ignored;
-    (void)close(ignored);
+    (void)close(ignored, /*interrupted=*/true);
   }
 }
 
 bool RecordingSink::open(const std::string& path, const Mode& mode, const SessionInfo& info,
-                         std::string& error, const Settings& settings) {
+                         std::string& error, const Settings& settings, bool overwrite) {
   if (open_) {
     error = path + ": the recorder is already open";
     return false;
@@ -22,7 +23,7 @@ bool RecordingSink::open(const std::string& path, const Mode& mode, const Sessio
   mode_ = mode.kind();
   pilot_name_ = info.pilot;
   const auto period_ns = std::uint64_t(std::llround(mode.dt() * 1e9));
-  if (!recorder_.open(path, period_ns, info, error)) return false;
+  if (!recorder_.open(path, period_ns, info, error, overwrite)) return false;
   // Slots sized like the mode's telemetry: copying a step into one then allocates nothing.
   slots_.assign(std::size_t(std::max(settings.slots, 2)), mode.telemetry());
   head_ = 0;
@@ -136,7 +137,7 @@ void RecordingSink::write(const Telemetry& s) {
   recorder_.record_channels(channels_);
 }
 
-bool RecordingSink::close(std::string& error) {
+bool RecordingSink::close(std::string& error, bool interrupted) {
   if (!open_) {
     error = "the recorder is not open";
     return false;
@@ -145,7 +146,7 @@ bool RecordingSink::close(std::string& error) {
   wake_.notify_one();
   writer_.join();
   open_ = false;
-  return recorder_.close(error);
+  return recorder_.close(error, interrupted, std::uint64_t(dropped_.load()));
 }
 
 bool ReplayPilot::command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) {

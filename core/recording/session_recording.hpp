@@ -36,10 +36,12 @@ class RecordingSink final : public TelemetrySink {
   RecordingSink(const RecordingSink&) = delete;
   RecordingSink& operator=(const RecordingSink&) = delete;
 
-  // Opens `path` (written as "<path>.tmp" until close()) for a session of `mode`, whose
-  // current telemetry gives the slot sizes, and starts the writer thread.
+  // Opens `path` for a session of `mode`, whose current telemetry gives the slot sizes, and
+  // starts the writer thread. The file is written as a temporary beside `path` until close()
+  // (core/recording/output_file.hpp); an existing file at `path` is replaced only with
+  // `overwrite`, and never one that is not a regular file.
   bool open(const std::string& path, const Mode& mode, const SessionInfo& info,
-            std::string& error, const Settings& settings);
+            std::string& error, const Settings& settings, bool overwrite = false);
   bool open(const std::string& path, const Mode& mode, const SessionInfo& info,
             std::string& error) {
     return open(path, mode, info, error, Settings{});
@@ -47,9 +49,12 @@ class RecordingSink final : public TelemetrySink {
   // Hands the step to the writer. Allocates nothing; waits only when the ring is full and
   // the settings say so.
   void on_sample(const Telemetry& sample) override;
-  // Writes what is queued, stops the writer and completes the file; false with a message if
-  // anything failed on the way.
-  bool close(std::string& error);
+  // Writes what is queued, stops the writer and completes the file, ending it with the
+  // "mixpilot_end" record (RecordingEnd: `interrupted` for a flight stopped before its end, the
+  // steps recorded and dropped); false with a message if anything failed on the way.
+  bool close(std::string& error, bool interrupted = false);
+  // The temporary being written (where a failed or crashed run's data is).
+  const std::string& temp_path() const { return recorder_.writer().tmp_path(); }
 
   std::int64_t dropped() const { return dropped_.load(); }  // steps lost to a full ring
 

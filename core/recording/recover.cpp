@@ -1,0 +1,107 @@
+#include "core/recording/recover.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <map>
+
+#include "core/recording/recording.hpp"
+
+namespace mixpilot {
+
+namespace {
+
+// Messages to keep: all of them when the file's end record was written (the cut fell in the
+// summary), else all but those of the last log time, i.e. of the last step, which the cut may
+// have left incomplete.
+std::size_t whole_step_messages(const McapFile& cut, bool has_end) {
+  std::size_t keep = cut.messages.size();
+  if (has_end || keep == 0) return keep;
+  const uint64_t last = cut.messages.back().log_time;
+  while (keep > 0 && cut.messages[keep - 1].log_time == last) --keep;
+  return keep;
+}
+
+}  // namespace
+
+std::optional<RecoveryResult> recover_recording(const McapFile& cut, const std::string& name,
+                                                const std::string& out_path, bool overwrite,
+                                                std::string& error) {
+  if (cut.complete) {
+    error = name + ": a complete recording; nothing to recover";
+    return std::nullopt;
+  }
+  // Only what reads back as a recording is rewritten as one.
+  const std::optional<RecordingContents> contents = decode_recording(cut, name, error);
+  if (!contents) return std::nullopt;
+
+  RecoveryResult result;
+  result.bytes_total = cut.bytes.size();
+  result.bytes_used = cut.parsed_bytes;
+  const std::size_t keep = whole_step_messages(cut, contents->end.has_value());
+  result.messages = keep;
+  result.messages_left_out = cut.messages.size() - keep;
+
+  McapWriter w;
+  McapWriteOptions options;
+  options.overwrite = overwrite;
+  options.profile = cut.profile;
+  options.library = cut.library;
+  if (!w.open(out_path, error, options)) return std::nullopt;
+  // The writer numbers schemas and channels 1, 2, ...: map the original ids.
+  std::map<uint16_t, uint16_t> schema_id, channel_id;
+  for (const auto& [id, s] : cut.schemas) schema_id[id] = w.add_schema(s.name, s.encoding, s.data);
+  uint16_t state_channel = 0;
+  for (const auto& [id, c] : cut.channels) {
+    const uint16_t schema = c.schema_id == 0 ? 0 : schema_id.at(c.schema_id);
+    channel_id[id] = w.add_channel(schema, c.topic, c.message_encoding, c.metadata);
+    if (c.topic == "/vehicle/state") state_channel = id;
+  }
+  for (const auto& md : cut.metadata)
+    if (md.name != kEndMetadataName) w.write_metadata(md.name, md.metadata);
+  for (std::size_t i = 0; i < keep; ++i) {
+    const McapMessage& m = cut.messages[i];
+    w.write_message(channel_id.at(m.channel_id), m.sequence, m.log_time, m.publish_time,
+                    cut.data(m));
+    if (m.channel_id == state_channel) ++result.steps;
+  }
+  RecordingEnd end;
+  end.interrupted = contents->end ? contents->end->interrupted : true;
+  end.recovered = true;
+  end.steps = result.steps;
+  end.dropped_steps = contents->end ? contents->end->dropped_steps : 0;
+  result.interrupted = end.interrupted;
+  w.write_metadata(kEndMetadataName, to_metadata(end));
+  if (!w.close(error)) return std::nullopt;
+  return result;
+}
+
+std::optional<RecoveryResult> recover_recording(const std::string& in_path,
+                                                const std::string& out_path, bool overwrite,
+                                                std::string& error) {
+  McapReadOptions options;
+  options.allow_truncated = true;
+  const std::optional<McapFile> cut = read_mcap(in_path, error, options);
+  if (!cut) return std::nullopt;
+  return recover_recording(*cut, in_path, out_path, overwrite, error);
+}
+
+std::string default_recovery_path(const std::string& in_path) {
+  namespace fs = std::filesystem;
+  const std::string tmp = ".tmp";
+  if (in_path.size() > tmp.size() && in_path.ends_with(tmp)) {
+    std::string target = in_path.substr(0, in_path.size() - tmp.size());
+    // "<target>.XXXXXX": the writer's unique suffix (core/recording/output_file.cpp).
+    const std::size_t dot = target.rfind('.');
+    if (dot != std::string::npos && target.size() - dot == 7 &&
+        std::all_of(target.begin() + std::ptrdiff_t(dot) + 1, target.end(),
+                    [](unsigned char c) { return std::isalnum(c) != 0; }))
+      target.resize(dot);
+    const fs::path t(target);
+    if (!t.filename().empty() && t.filename() != "." && t.filename() != "..") return target;
+  }
+  const fs::path p(in_path);
+  return (p.parent_path() / (p.stem().string() + ".recovered.mcap")).string();
+}
+
+}  // namespace mixpilot
