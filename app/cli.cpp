@@ -9,7 +9,9 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <cstring>
+
+#include "core/recording/output_file.hpp"
 
 namespace mixpilot::cli {
 
@@ -32,20 +34,16 @@ std::optional<double> parse_seconds(std::string_view text, double max) {
   return d;
 }
 
-bool write_file(const std::string& path, const std::string& text, std::string& error) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f || !(f << text) || !f.flush()) {
-      error = path + ": cannot write";
-      return false;
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    error = path + ": cannot rename " + tmp + " into place";
+bool write_file(const std::string& path, const std::string& text, bool overwrite,
+                std::string& error) {
+  OutputFile out;
+  if (!out.open(path, overwrite, error)) return false;
+  if (std::fwrite(text.data(), 1, text.size(), out.stream()) != text.size()) {
+    error = out.temp_path() + ": write failed: " + std::strerror(errno);
+    out.discard();
     return false;
   }
-  return true;
+  return out.commit(error);
 }
 
 namespace {

@@ -23,8 +23,11 @@ bool ends_with(std::string_view s, std::string_view suffix);
 // A positive, finite number of seconds no larger than `max`, or nullopt.
 std::optional<double> parse_seconds(std::string_view text, double max);
 
-// Writes `text` to `path` through a temporary in the same directory, renamed into place.
-bool write_file(const std::string& path, const std::string& text, std::string& error);
+// Writes `text` to `path` through a unique temporary in the same directory, moved into place
+// (core/recording/output_file.hpp: never over a special file, over an existing file only with
+// `overwrite`).
+bool write_file(const std::string& path, const std::string& text, bool overwrite,
+                std::string& error);
 
 // SIGINT and SIGTERM set a flag that long loops poll (interrupted()); the handler then resets
 // itself, so a second ^C ends the process at once.

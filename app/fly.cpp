@@ -13,6 +13,7 @@
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
+#include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
@@ -46,6 +47,7 @@ constexpr const char* kFlyUsage =
     "                     every mode's telemetry, plus the pilot's commands in mixed_initiative\n"
     "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
     "                     mode's metrics as JSON, with `lost` and `lost_at_s`\n"
+    "  --force            overwrite existing --record and --report files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
     "\n"
@@ -60,6 +62,7 @@ struct FlyOptions {
   std::string record;
   std::string report;
   bool allow_mismatch = false;
+  bool force = false;
 };
 
 // The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
@@ -161,15 +164,22 @@ Labels report_labels(const Flight& f, bool was_interrupted) {
   return labels;
 }
 
-// Output paths, checked before the flight: distinct, and no existing non-regular file.
-void check_outputs(const FlyOptions& o) {
-  if (!o.record.empty() && o.record == o.report)
+// Output paths, checked before the flight: distinct, writable, and never over a special file,
+// nor over an existing file without --force. False with the reason.
+bool check_outputs(const FlyOptions& o, std::string& error) {
+  if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
     usage_error("fly", "--record and --report name the same file '" + o.record + "'");
+  for (const std::string* path : {&o.record, &o.report})
+    if (!path->empty() && !check_output_path(*path, o.force, error)) return false;
+  return true;
 }
 
 int run_fly(const FlyOptions& o) {
-  check_outputs(o);
   std::string error;
+  if (!check_outputs(o, error)) {
+    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    return kExitError;
+  }
   int status = kExitOk;
   std::optional<Flight> flight = prepare_flight(o, error, status);
   if (!flight) {
@@ -180,7 +190,8 @@ int run_fly(const FlyOptions& o) {
   Session session(mode);
   RecordingSink recorder;
   if (!o.record.empty()) {
-    if (!recorder.open(o.record, mode, session_info(*flight), error)) {
+    if (!recorder.open(o.record, mode, session_info(*flight), error, RecordingSink::Settings{},
+                       o.force)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       return kExitError;
     }
@@ -201,7 +212,7 @@ int run_fly(const FlyOptions& o) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const bool stopped = interrupted() && !mode.finished();
 
-  if (!o.record.empty() && !recorder.close(error)) {
+  if (!o.record.empty() && !recorder.close(error, stopped)) {
     std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
     status = kExitError;
   }
@@ -212,7 +223,7 @@ int run_fly(const FlyOptions& o) {
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
     const std::string json = to_json(report_labels(*flight, stopped), report_metrics(mode)) + "\n";
-    if (!write_file(o.report, json, error)) {
+    if (!write_file(o.report, json, o.force, error)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       status = kExitError;
     }
@@ -267,6 +278,8 @@ int fly_command(int argc, char** argv) {
       o.report = value();
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
+    } else if (a == "--force") {
+      o.force = true;
     } else {
       usage_error("fly", "unknown option '" + std::string(a) + "'");
     }

@@ -22,6 +22,7 @@ constexpr const char* kUsage =
     "commands:\n"
     "  fly     run a session headless as fast as possible and print a summary\n"
     "  score   replay and score recorded sessions\n"
+    "  recover rebuild a recording cut short by a crash or kill -9\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
   }
   if (cmd == "fly") return fly_command(argc, argv);
   if (cmd == "score") return score_command(argc, argv);
+  if (cmd == "recover") return recover_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

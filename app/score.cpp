@@ -15,6 +15,7 @@
 #include "core/modes/report.hpp"
 #include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
+#include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
 
 namespace mixpilot::cli {
@@ -34,6 +35,7 @@ constexpr const char* kScoreUsage =
     "  --jobs N     replay N recordings in parallel (default: the number of cores)\n"
     "  --json OUT   write a JSON array with one object per recording\n"
     "  --allow-mismatch  exit 0 even when a replay differs from its recording\n"
+    "  --force      overwrite an existing --json file\n"
     "\n"
     "exit status: 0 done, 1 a recording could not be read or replayed, 2 usage, 3 a replay\n"
     "differs from its recording\n";
@@ -101,7 +103,7 @@ int score_command(int argc, char** argv) {
   std::vector<std::string> files;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   std::string json_path;
-  bool allow_mismatch = false;
+  bool allow_mismatch = false, force = false;
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -120,6 +122,8 @@ int score_command(int argc, char** argv) {
       json_path = argv[++i];
     } else if (a == "--allow-mismatch") {
       allow_mismatch = true;
+    } else if (a == "--force") {
+      force = true;
     } else if (a.size() > 1 && a[0] == '-') {
       usage_error("score", "unknown option '" + std::string(a) + "'");
     } else {
@@ -127,6 +131,13 @@ int score_command(int argc, char** argv) {
     }
   }
   if (files.empty()) usage_error("score", "no recordings given");
+  if (!json_path.empty()) {
+    std::string error;
+    if (!check_output_path(json_path, force, error)) {
+      std::fprintf(stderr, "mixpilot score: %s\n", error.c_str());
+      return kExitError;
+    }
+  }
 
   std::vector<ScoreRow> rows(files.size());
   std::atomic<std::size_t> next{0};
@@ -187,7 +198,7 @@ int score_command(int argc, char** argv) {
   json += "\n]\n";
   if (!json_path.empty()) {
     std::string error;
-    if (!write_file(json_path, json, error)) {
+    if (!write_file(json_path, json, force, error)) {
       std::fprintf(stderr, "mixpilot score: %s\n", error.c_str());
       return kExitError;
     }

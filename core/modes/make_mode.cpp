@@ -51,6 +51,10 @@ std::unique_ptr<Mode> make_solo_mode(std::string_view text, const std::string& s
   return mode;
 }
 
+std::unique_ptr<Mode> make_kind(ModeKind kind, std::string_view text,
+                                const std::string& source_name, ModeRequest& request,
+                                std::string& error);
+
 }  // namespace
 
 std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source_name,
@@ -66,7 +70,21 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
     error = source_name + ": a pilot flies only mixed_initiative scenarios, this one is " + *name;
     return nullptr;
   }
-  switch (*kind) {
+  std::unique_ptr<Mode> mode = make_kind(*kind, text, source_name, request, error);
+  if (mode && mode->steps_total() < 1) {
+    error = source_name + ": a duration of " + std::to_string(request.duration.value_or(0.0)) +
+            " s is shorter than one control step of " + std::to_string(mode->dt()) + " s";
+    return nullptr;
+  }
+  return mode;
+}
+
+namespace {
+
+std::unique_ptr<Mode> make_kind(ModeKind kind, std::string_view text,
+                                const std::string& source_name, ModeRequest& request,
+                                std::string& error) {
+  switch (kind) {
     case ModeKind::mixed_initiative: return make_mi_mode(text, source_name, request, error);
     case ModeKind::obstacle_avoidance:
       return make_solo_mode<ObstacleMode>(text, source_name, request, parse_obstacle_scenario,
@@ -78,9 +96,11 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
       return make_solo_mode<PendubotMode>(text, source_name, request, parse_pendubot_scenario,
                                           error);
   }
-  error = source_name + ": mode \"" + *name + "\" has no class";
+  error = source_name + ": mode \"" + to_string(kind) + "\" has no class";
   return nullptr;
 }
+
+}  // namespace
 
 std::unique_ptr<Mode> load_mode(const std::string& path, ModeRequest request, std::string& error) {
   std::string text;

@@ -99,5 +99,32 @@ check "... with the reason" grep -q "expected a regular file" "$work/e9"
 "$mixpilot" fly --scenario /dev/zero --headless >"$work/e10" 2>&1
 check "/dev/zero as scenario is refused" grep -q "expected a regular file" "$work/e10"
 
+# Outputs never clobber: an existing file needs --force, a device is never replaced.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration 1 --record "$work/novice.mcap" >"$work/e11" 2>&1
+check "an existing recording is not overwritten" test $? -eq 1
+check "... and the message says so" grep -q "refusing to overwrite" "$work/e11"
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration 1 --record "$work/novice.mcap" --force >/dev/null 2>&1
+check "--force overwrites it" test $? -eq 0
+if [ -w /dev/full ]; then
+  "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration 1 --record /dev/full >"$work/e12" 2>&1
+  check "a device as recording is refused" grep -q "not a regular file" "$work/e12"
+  check "the device stays a device" test -c /dev/full
+fi
+
+# kill -9 mid-flight leaves a temporary that `recover` makes whole; it then replays exactly.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix_slow.toml" --pilot novice --headless \
+  --record "$work/killed.mcap" >/dev/null 2>&1 &
+pid=$!
+sleep 1
+kill -9 $pid
+wait $pid 2>/dev/null
+tmp=$(ls "$work"/killed.mcap.*.tmp 2>/dev/null | head -n 1)
+check "kill -9 leaves the temporary" test -n "$tmp"
+"$mixpilot" recover "$tmp" >"$work/rec.out" 2>&1
+check "recover exits 0" test $? -eq 0
+check "recover writes the target" test -f "$work/killed.mcap"
+"$mixpilot" score "$work/killed.mcap" >"$work/killed.score" 2>&1
+check "the recovered recording replays exactly" grep -q "exact" "$work/killed.score"
+
 echo "$pass passed, $fails failed"
 test "$fails" -eq 0
