@@ -21,10 +21,6 @@ void usage_error(const char* command, const std::string& message) {
   std::exit(kExitUsage);
 }
 
-bool ends_with(std::string_view s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
-}
-
 std::optional<double> parse_seconds(std::string_view text, double max) {
   const std::string v(text);
   char* end = nullptr;

@@ -18,8 +18,6 @@ enum ExitCode : int {
 
 [[noreturn]] void usage_error(const char* command, const std::string& message);
 
-bool ends_with(std::string_view s, std::string_view suffix);
-
 // A positive, finite number of seconds no larger than `max`, or nullopt.
 std::optional<double> parse_seconds(std::string_view text, double max);
 

@@ -80,19 +80,16 @@ struct Flight {
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
   Flight f;
-  if (ends_with(o.pilot, ".mcap")) {
+  if (o.pilot.ends_with(".mcap")) {
     f.recording = read_recording(o.pilot, error);
     if (!f.recording) return std::nullopt;
-    if (!f.recording->metadata.count("scenario")) {
-      error = o.pilot + ": no embedded scenario in the 'mixpilot' metadata record";
-      return std::nullopt;
-    }
+    if (!embedded_scenario(*f.recording, o.pilot, error)) return std::nullopt;
   }
   if (!o.scenario_path.empty()) {
     if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
     f.scenario_source = o.scenario_path;
     f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
-    if (f.recording && f.recording->metadata.at("scenario") != f.scenario_text &&
+    if (f.recording && *embedded_scenario(*f.recording, o.pilot, error) != f.scenario_text &&
         !o.allow_mismatch) {
       error = o.scenario_path + " differs from the scenario embedded in " + o.pilot +
               " (--allow-mismatch flies it anyway)";
@@ -100,7 +97,7 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
       return std::nullopt;
     }
   } else if (f.recording) {
-    f.scenario_text = f.recording->metadata.at("scenario");
+    f.scenario_text = *embedded_scenario(*f.recording, o.pilot, error);
     f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
     f.scenario_file = f.recording->metadata["scenario_path"];
   } else {
@@ -142,19 +139,6 @@ SessionInfo session_info(const Flight& f) {
   if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
     info.seed = mi->scenario().plant.seed;
   return info;
-}
-
-// The mode's metrics with `lost` and `lost_at_s` (every report carries them).
-Metrics report_metrics(const Mode& mode) {
-  Metrics m = mode.metrics();
-  const auto has = [&](const char* name) {
-    for (const auto& [n, v] : m)
-      if (n == name) return true;
-    return false;
-  };
-  if (!has("lost")) m.emplace_back("lost", mode.lost() ? 1.0 : 0.0);
-  if (!has("lost_at_s")) m.emplace_back("lost_at_s", mode.lost_at());
-  return m;
 }
 
 Labels report_labels(const Flight& f, bool was_interrupted) {
@@ -222,7 +206,7 @@ int run_fly(const FlyOptions& o) {
               flown / std::max(wall, 1e-9));
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
-    const std::string json = to_json(report_labels(*flight, stopped), report_metrics(mode)) + "\n";
+    const std::string json = to_json(report_labels(*flight, stopped), with_lost_fields(mode.metrics(), mode)) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       status = kExitError;

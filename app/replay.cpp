@@ -8,6 +8,14 @@
 
 namespace mixpilot::cli {
 
+const std::string* embedded_scenario(const RecordingContents& rec, const std::string& path,
+                                     std::string& error) {
+  const auto it = rec.metadata.find("scenario");
+  if (it != rec.metadata.end()) return &it->second;
+  error = path + ": no embedded scenario in the 'mixpilot' metadata record";
+  return nullptr;
+}
+
 std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path) {
   const auto it = rec.metadata.find("scenario_path");
   if (it != rec.metadata.end() && !it->second.empty() && it->second.front() == '/')

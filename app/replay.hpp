@@ -12,6 +12,11 @@
 
 namespace mixpilot::cli {
 
+// The scenario text a recording embeds; nullptr with "<path>: no embedded scenario ..." when
+// it has none.
+const std::string* embedded_scenario(const RecordingContents& rec, const std::string& path,
+                                     std::string& error);
+
 // Where a recording's embedded scenario came from: its original file (absolute, as recorded),
 // so that paths inside it (reference trajectories) resolve as they did; else a label.
 std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path);

@@ -48,8 +48,7 @@ struct ScoreRow {
   Metrics metrics;
   Score score;  // mixed initiative
   bool ok = false;
-  bool matches = false;   // every recorded step replayed bit for bit
-  std::string difference;  // what differed first
+  std::string difference;  // what differed first; empty: every step replayed bit for bit
   std::string error;
 };
 
@@ -62,13 +61,10 @@ ScoreRow score_recording(const std::string& path) {
     row.error = error;
     return row;
   }
-  const auto meta = rec->metadata.find("scenario");
-  if (meta == rec->metadata.end()) {
-    row.error = path + ": no embedded scenario in the 'mixpilot' metadata record";
-    return row;
-  }
-  std::unique_ptr<Mode> mode = replay_mode(*rec, path, meta->second,
-                                           embedded_scenario_source(*rec, path), {}, error);
+  const std::string* text = embedded_scenario(*rec, path, row.error);
+  if (!text) return row;
+  std::unique_ptr<Mode> mode =
+      replay_mode(*rec, path, *text, embedded_scenario_source(*rec, path), {}, error);
   if (!mode) {
     row.error = error;
     return row;
@@ -81,7 +77,7 @@ ScoreRow score_recording(const std::string& path) {
   ReplayCheck check(*rec);
   session.add_sink(&check);
   session.run();
-  row.metrics = mode->metrics();
+  row.metrics = with_lost_fields(mode->metrics(), *mode);
   if (const auto* mi = dynamic_cast<const MiMode*>(mode.get())) {
     // The timing fields describe the recorded flight, not this replay.
     row.score = mi->score();
@@ -89,10 +85,9 @@ ScoreRow score_recording(const std::string& path) {
     recorded_us.reserve(rec->solver.size());
     for (const auto& m : rec->solver) recorded_us.push_back(m.total_us);
     set_timing(row.score, std::move(recorded_us), mode->dt());
-    row.metrics = to_metrics(row.score);
+    row.metrics = with_lost_fields(to_metrics(row.score), *mode);
   }
   row.difference = check.first_difference(mode->steps_done());
-  row.matches = row.difference.empty();
   row.ok = true;
   return row;
 }
@@ -175,8 +170,9 @@ int score_command(int argc, char** argv) {
       continue;
     }
     const Score& s = r.score;
-    const char* replay = r.matches ? "exact" : "DIFFERS from recording";
-    if (!r.matches) {
+    const bool exact = r.difference.empty();
+    const char* replay = exact ? "exact" : "DIFFERS from recording";
+    if (!exact) {
       ++mismatches;
       std::fprintf(stderr, "%s: the replay differs from the recording: %s\n", r.file.c_str(),
                    r.difference.c_str());
@@ -192,7 +188,7 @@ int score_command(int argc, char** argv) {
     if (json.size() > 2) json += ",\n";
     Labels labels = {{"file", r.file}, {"mode", r.mode}, {"scenario", r.scenario}};
     if (!r.pilot.empty()) labels.emplace_back("pilot", r.pilot);
-    labels.emplace_back("replay", r.matches ? "exact" : "differs");
+    labels.emplace_back("replay", exact ? "exact" : "differs");
     json += to_json(labels, r.metrics);
   }
   json += "\n]\n";

@@ -10,9 +10,16 @@
 
 #include <Eigen/Core>
 
+// Under AddressSanitizer malloc is the sanitizer's: no counting (g++ and clang ≥ 15 define
+// __SANITIZE_ADDRESS__, older clang only answers __has_feature).
 #if defined(__SANITIZE_ADDRESS__)
 #define MIXPILOT_COUNT_MALLOC 0
-#else
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MIXPILOT_COUNT_MALLOC 0
+#endif
+#endif
+#ifndef MIXPILOT_COUNT_MALLOC
 #define MIXPILOT_COUNT_MALLOC 1
 #endif
 

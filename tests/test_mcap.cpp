@@ -16,44 +16,19 @@
 
 #include "core/recording/cdr.hpp"
 #include "core/recording/mcap.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot {
 namespace {
 
 namespace fs = std::filesystem;
 
+using test::slurp;
+using test::temporaries_of;
+
 std::vector<uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
 
-std::vector<uint8_t> slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// A fresh path in the test folder: the file and any temporaries left for it
-// ("<name>.XXXXXX.tmp") by an earlier run are removed.
-fs::path temp_path(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap";
-  fs::create_directories(dir);
-  fs::remove(dir / name);
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string f = e.path().filename().string();
-    if (f.rfind(name + ".", 0) == 0 && f.size() > name.size() + 4 && f.ends_with(".tmp"))
-      fs::remove(e.path());
-  }
-  return dir / name;
-}
-
-// The temporaries beside `p` ("<p>.XXXXXX.tmp").
-std::vector<fs::path> temporaries_of(const fs::path& p) {
-  std::vector<fs::path> out;
-  const std::string name = p.filename().string();
-  for (const auto& e : fs::directory_iterator(p.parent_path())) {
-    const std::string f = e.path().filename().string();
-    if (f.size() == name.size() + 11 && f.rfind(name + ".", 0) == 0 && f.ends_with(".tmp"))
-      out.push_back(e.path());
-  }
-  return out;
-}
+fs::path temp_path(const std::string& name) { return test::fresh_path("mixpilot_test_mcap", name); }
 
 template <class T>
 T get_le(const std::vector<uint8_t>& b, std::size_t at) {

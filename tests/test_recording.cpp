@@ -26,37 +26,17 @@
 #include "core/recording/recover.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot {
 namespace {
 
 namespace fs = std::filesystem;
+using test::slurp;
+using test::temporaries_of;
 
-// The temporaries beside `p` ("<p>.XXXXXX.tmp", core/recording/output_file.hpp).
-std::vector<fs::path> temporaries_of(const fs::path& p) {
-  std::vector<fs::path> out;
-  const std::string name = p.filename().string();
-  for (const auto& e : fs::directory_iterator(p.parent_path())) {
-    const std::string f = e.path().filename().string();
-    if (f.size() == name.size() + 11 && f.rfind(name + ".", 0) == 0 && f.ends_with(".tmp"))
-      out.push_back(e.path());
-  }
-  return out;
-}
-
-// A fresh path in the test folder: whatever an earlier run left there, temporaries included,
-// is removed.
 fs::path temp_path(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_recording";
-  fs::create_directories(dir);
-  fs::remove_all(dir / name);
-  for (const auto& t : temporaries_of(dir / name)) fs::remove(t);
-  return dir / name;
-}
-
-std::vector<uint8_t> slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return test::fresh_path("mixpilot_test_recording", name);
 }
 
 double nan_with_payload() {

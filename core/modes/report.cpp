@@ -51,4 +51,14 @@ std::string to_json(const Labels& labels, const Metrics& metrics, int indent) {
   return out;
 }
 
+Metrics with_lost_fields(Metrics metrics, const Mode& mode) {
+  const auto has = [&](const char* name) {
+    return std::any_of(metrics.begin(), metrics.end(),
+                       [&](const auto& m) { return m.first == name; });
+  };
+  if (!has("lost")) metrics.emplace_back("lost", mode.lost() ? 1.0 : 0.0);
+  if (!has("lost_at_s")) metrics.emplace_back("lost_at_s", mode.lost_at());
+  return metrics;
+}
+
 }  // namespace mixpilot
