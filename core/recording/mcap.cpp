@@ -691,6 +691,7 @@ class Parser {
     if (!c.get_string(m.name, "name") || !c.get_string_map(m.metadata, "metadata"))
       return malformed(at, op, c);
     m.record_offset = at;
+    metadata_at_.emplace(at, f_.metadata.size());
     f_.metadata.push_back(std::move(m));
     return true;
   }
@@ -716,17 +717,17 @@ class Parser {
     std::string name;
     if (!c.get(offset, "offset") || !c.get(length, "length") || !c.get_string(name, "name"))
       return malformed(at, op, c);
-    for (const auto& m : f_.metadata) {
-      if (m.record_offset != offset) continue;
-      uint64_t content = 0;
-      std::memcpy(&content, b_ + offset + 1, 8);
-      if (m.name != name || length != 9 + content)
-        return error_at(at, "Metadata Index record does not match its Metadata record",
-                        "'" + name + "' at " + std::to_string(offset));
-      return true;
-    }
-    return error_at(at, "Metadata Index record points to no Metadata record",
-                    "'" + name + "' at " + std::to_string(offset));
+    // Looked up by offset: a crafted file with many Metadata and index records stays linear.
+    const auto it = metadata_at_.find(offset);
+    if (it == metadata_at_.end())
+      return error_at(at, "Metadata Index record points to no Metadata record",
+                      "'" + name + "' at " + std::to_string(offset));
+    uint64_t content = 0;
+    std::memcpy(&content, b_ + offset + 1, 8);
+    if (f_.metadata[it->second].name != name || length != 9 + content)
+      return error_at(at, "Metadata Index record does not match its Metadata record",
+                      "'" + name + "' at " + std::to_string(offset));
+    return true;
   }
 
   bool footer(uint64_t at, Cursor& c, bool& done) {
@@ -807,6 +808,7 @@ class Parser {
   uint64_t statistics_at_ = 0;
   mcap::Opcode last_group_ = mcap::Opcode::kDataEnd;
   std::set<uint8_t> seen_groups_;
+  std::map<uint64_t, std::size_t> metadata_at_;  // Metadata record offset → index in f_.metadata
 };
 
 }  // namespace

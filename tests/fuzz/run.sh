@@ -11,6 +11,12 @@
 #   build/<preset>/tests/fuzz/fuzz_<target> build/<preset>/fuzz-findings/<target>-crash-...
 # New inputs that reach new code collect in build/<preset>/fuzz-corpus/<target> (not committed;
 # copy the interesting ones to tests/fuzz/corpus/<target> by hand).
+#
+# Seeds: corpus/scenario holds the shipped scenarios; corpus/recording short recordings made
+# with `mixpilot fly --headless --duration 0.045 --record` (mi_helix, tracking_helix), the same
+# with their data and summary CRCs zeroed (*_nocrc: "not computed" in the spec, so mutations
+# reach the structure checks and the CDR decoders instead of stopping at a CRC), one cut at two
+# thirds (a crashed session's temporary) and the spec's smallest file.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
