@@ -46,7 +46,8 @@ constexpr const char* kFlyUsage =
     "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md):\n"
     "                     every mode's telemetry, plus the pilot's commands in mixed_initiative\n"
     "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
-    "                     mode's metrics as JSON, with `lost` and `lost_at_s`\n"
+    "                     mode's metrics as JSON, with `lost` and `lost_at_s`; a replay's\n"
+    "                     timing fields are the recorded flight's, as in `score`\n"
     "  --force            overwrite existing --record and --report files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
@@ -111,7 +112,10 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
   std::optional<Flight> f = load_flight(o, error, status);
   if (!f) return std::nullopt;
   const auto kind_name = scenario_mode(f->scenario_text, f->scenario_source, error);
-  if (!kind_name) return std::nullopt;
+  if (!kind_name) {
+    if (f->recording && o.scenario_path.empty()) error = in_embedded_scenario(o.pilot, error);
+    return std::nullopt;
+  }
   if (*kind_name != "mixed_initiative" && !o.pilot.empty())
     usage_error("fly", "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
                            " is " + *kind_name);
@@ -206,7 +210,9 @@ int run_fly(const FlyOptions& o) {
               flown / std::max(wall, 1e-9));
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
-    const std::string json = to_json(report_labels(*flight, stopped), with_lost_fields(mode.metrics(), mode)) + "\n";
+    const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)
+                                              : with_lost_fields(mode.metrics(), mode);
+    const std::string json = to_json(report_labels(*flight, stopped), metrics) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       status = kExitError;

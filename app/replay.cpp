@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
+#include "core/modes/report.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
@@ -23,7 +25,25 @@ std::string embedded_scenario_source(const RecordingContents& rec, const std::st
   return path + " (embedded scenario)";
 }
 
-std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
+Metrics replay_metrics(const Mode& mode, const RecordingContents& rec, Score* score) {
+  const auto* mi = dynamic_cast<const MiMode*>(&mode);
+  if (!mi) return with_lost_fields(mode.metrics(), mode);
+  Score s = mi->score();
+  const std::size_t n = std::min(rec.solver.size(), std::size_t(mode.steps_done()));
+  std::vector<double> recorded_us(n);
+  for (std::size_t k = 0; k < n; ++k) recorded_us[k] = rec.solver[k].total_us;
+  set_timing(s, std::move(recorded_us), mode.dt());
+  if (score) *score = s;
+  return with_lost_fields(to_metrics(s), mode);
+}
+
+std::string in_embedded_scenario(const std::string& path, const std::string& error) {
+  return path + ": its embedded scenario: " + error;
+}
+
+namespace {
+
+std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
   const auto kind = scenario_mode(text, source, error);
@@ -45,6 +65,18 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
     shorter.duration = double(rec.states.size()) * mode->dt();
     mode = make_mode(text, source, std::move(shorter), error);
   }
+  return mode;
+}
+
+}  // namespace
+
+std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
+                                  const std::string& text, const std::string& source,
+                                  std::optional<double> duration, std::string& error) {
+  auto mode = replay_mode_of(rec, path, text, source, duration, error);
+  const auto embedded = rec.metadata.find("scenario");
+  if (!mode && embedded != rec.metadata.end() && embedded->second == text)
+    error = in_embedded_scenario(path, error);
   return mode;
 }
 

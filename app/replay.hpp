@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/modes/mode.hpp"
+#include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/recording.hpp"
 
@@ -20,6 +21,17 @@ const std::string* embedded_scenario(const RecordingContents& rec, const std::st
 // Where a recording's embedded scenario came from: its original file (absolute, as recorded),
 // so that paths inside it (reference trajectories) resolve as they did; else a label.
 std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path);
+
+// The metrics of a replay of `rec`: the mode's own, except that mixed initiative's timing fields
+// (RTI median and p99, deadline misses) describe the recorded flight's first steps_done() steps,
+// not this replay, so `fly --pilot REC` and `score REC` agree to the bit on any machine.
+// `score`, when given, receives the mixed-initiative score with those fields.
+[[nodiscard]] Metrics replay_metrics(const Mode& mode, const RecordingContents& rec,
+                                     Score* score = nullptr);
+
+// An error found in the scenario embedded in the recording at `path`, said as such: its
+// file:line:col name the file it was recorded from, which may have changed since.
+[[nodiscard]] std::string in_embedded_scenario(const std::string& path, const std::string& error);
 
 // A fresh flight of `scenario_text` for the recording: mixed initiative replays the recorded
 // pilot commands and is as long as they are; other modes fly on their own for as many steps as

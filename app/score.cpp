@@ -11,7 +11,6 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/replay.hpp"
-#include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
@@ -77,16 +76,7 @@ ScoreRow score_recording(const std::string& path) {
   ReplayCheck check(*rec);
   session.add_sink(&check);
   session.run();
-  row.metrics = with_lost_fields(mode->metrics(), *mode);
-  if (const auto* mi = dynamic_cast<const MiMode*>(mode.get())) {
-    // The timing fields describe the recorded flight, not this replay.
-    row.score = mi->score();
-    std::vector<double> recorded_us;
-    recorded_us.reserve(rec->solver.size());
-    for (const auto& m : rec->solver) recorded_us.push_back(m.total_us);
-    set_timing(row.score, std::move(recorded_us), mode->dt());
-    row.metrics = with_lost_fields(to_metrics(row.score), *mode);
-  }
+  row.metrics = replay_metrics(*mode, *rec, &row.score);
   row.difference = check.first_difference(mode->steps_done());
   row.ok = true;
   return row;

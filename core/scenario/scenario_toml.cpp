@@ -153,9 +153,12 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
   ref.finish();
 
   Section arena = s.sub("arena");
-  bool box_ok =
-      (arena.vec("min", sc.arena.min, kPosition) || !arena.table() || !arena.table()->get("min")) &
-      (arena.vec("max", sc.arena.max, kPosition) || !arena.table() || !arena.table()->get("max"));
+  // Both corners read (and reported) before they are compared.
+  const bool min_ok =
+      arena.vec("min", sc.arena.min, kPosition) || !arena.table() || !arena.table()->get("min");
+  const bool max_ok =
+      arena.vec("max", sc.arena.max, kPosition) || !arena.table() || !arena.table()->get("max");
+  bool box_ok = min_ok && max_ok;
   if (box_ok && !(sc.arena.min.array() < sc.arena.max.array()).all()) {
     d.add(arena.pos("max"), arena.path("max"),
           "expected every component above arena.min = " + vec_text(sc.arena.min) + ", got " +

@@ -186,7 +186,7 @@ inline void syrk_tile(int m, int rb, int jb, const double* Y, int ldy, double* C
     acc[0][c] = _mm256_loadu_pd(col);
     acc[1][c] = NR == 8 ? _mm256_loadu_pd(col + 4) : acc[0][c];
   }
-  nt_acc<NR, NC, false>(m, Y + rb, ldy, Y + jb, ldy, acc);
+  if (m > 0) nt_acc<NR, NC, false>(m, Y + rb, ldy, Y + jb, ldy, acc);  // Y may be empty (null)
   nt_acc<NR, NC, true>(jb, C + rb, ldc, C + jb, ldc, acc);
   for (int c = 0; c < NC; ++c) {
     double* col = C + rb + static_cast<ptrdiff_t>(jb + c) * ldc;
@@ -512,19 +512,19 @@ inline void gemm_nn_rows(int n, int k, const double* A, int lda, const double* B
     if constexpr (FULL) return _mm256_loadu_pd(p);
     else return _mm256_maskload_pd(p, m1);
   };
-  const auto ld0 = [m0](const double* p) {
+  const auto ld0 = [&](const double* p) {
     if constexpr (FULL) return _mm256_loadu_pd(p);
     else return _mm256_maskload_pd(p, m0);
   };
-  const auto ld1 = [m1](const double* p) {
+  const auto ld1 = [&](const double* p) {
     if constexpr (FULL) return _mm256_loadu_pd(p);
     else return _mm256_maskload_pd(p, m1);
   };
-  const auto st0 = [m0](double* p, __m256d v) {
+  const auto st0 = [&](double* p, __m256d v) {
     if constexpr (FULL) _mm256_storeu_pd(p, v);
     else _mm256_maskstore_pd(p, m0, v);
   };
-  const auto st1 = [m1](double* p, __m256d v) {
+  const auto st1 = [&](double* p, __m256d v) {
     if constexpr (FULL) _mm256_storeu_pd(p, v);
     else _mm256_maskstore_pd(p, m1, v);
   };
