@@ -16,5 +16,5 @@ cmake --build --preset release
 
 case "$1" in
   run)  exec ./build/release/app/mixpilot demo ;;
-  test) exec ctest --preset release ;;
+  test) exec ctest --preset release -j "$(nproc)" ;;
 esac

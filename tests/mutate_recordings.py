@@ -161,7 +161,8 @@ def main():
                     help="seconds flown for each base recording (default: 0.045)")
     ap.add_argument("--flips", type=int, default=200, help="random mutations per base recording")
     ap.add_argument("--timeout", type=float, default=20)
-    ap.add_argument("--memory-gb", type=float, default=4)
+    ap.add_argument("--memory-gb", type=float, default=4,
+                    help="address-space limit per run; 0: none (ASan builds reserve terabytes)")
     ap.add_argument("--sample", type=int, default=0, help="run only K random variants")
     ap.add_argument("--seed", type=int, default=12)
     ap.add_argument("--verbose", action="store_true", help="print every run's class")

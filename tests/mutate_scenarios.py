@@ -138,7 +138,8 @@ def csv_variants(csv):
 
 def limit_memory(limit_bytes):
     def apply():
-        resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
+        if limit_bytes > 0:
+            resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
     return apply
 
 
@@ -207,7 +208,8 @@ def main():
     ap.add_argument("--scenarios", default="scenarios")
     ap.add_argument("--duration", type=float, default=0.3)
     ap.add_argument("--timeout", type=float, default=20)
-    ap.add_argument("--memory-gb", type=float, default=4)
+    ap.add_argument("--memory-gb", type=float, default=4,
+                    help="address-space limit per run; 0: none (ASan builds reserve terabytes)")
     ap.add_argument("--sample", type=int, default=0, help="fly only K random variants")
     ap.add_argument("--seed", type=int, default=12)
     ap.add_argument("--jobs", type=int, default=1)

@@ -103,10 +103,11 @@ inline DenseQp densify(const OcpQp& qp, double inf_bound = 1e20) {
         hi = s.ubx[k - nbu];
       } else {
         const int g = k - nbu - nbx;
-        a.segment(ou, nu) = s.D.row(g);
+        // (An empty D or C is skipped: Eigen's row() of an empty matrix offsets a null pointer.)
+        if (nu > 0) a.segment(ou, nu) = s.D.row(g);
         if (i == 0)
-          a0 = s.C.row(g).dot(x0);
-        else
+          a0 = nx > 0 ? s.C.row(g).dot(x0) : 0.0;
+        else if (nx > 0)
           a.segment(ox, nx) = s.C.row(g);
         lo = s.lg[g];
         hi = s.ug[g];

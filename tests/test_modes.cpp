@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct ModeCase {
 };
 
 std::string print_case(const testing::TestParamInfo<ModeCase>& info) { return info.param.name; }
+void PrintTo(const ModeCase& c, std::ostream* os) {
+  *os << c.scenario << (c.pilot ? std::string(" pilot=") + c.pilot : std::string());
+}
 
 std::unique_ptr<Mode> make(const ModeCase& c) {
   ModeRequest request;

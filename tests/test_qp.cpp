@@ -288,6 +288,10 @@ struct L1Case {
   double l1_scale;
   unsigned seed;
 };
+void PrintTo(const L1Case& c, std::ostream* os) {
+  *os << "N=" << c.N << " nx=" << c.nx << " nu=" << c.nu << " ng=" << c.ng
+      << " l1_scale=" << c.l1_scale << " seed=" << c.seed;
+}
 class PureL1SoftQp : public ::testing::TestWithParam<L1Case> {};
 
 TEST_P(PureL1SoftQp, MatchesCertifiedDenseReference) {
