@@ -1,12 +1,15 @@
 #pragma once
-// Files of the recording tests: fresh paths in a test folder, the unique temporaries an output
+// Files of the tests: fresh paths in a folder of the test process, the unique temporaries an output
 // leaves beside its target ("<target>.XXXXXX.tmp", core/recording/output_file.hpp), contents.
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <system_error>
 #include <vector>
+
+#include <unistd.h>
 
 namespace mixpilot::test {
 
@@ -24,10 +27,25 @@ inline std::vector<fs::path> temporaries_of(const fs::path& p) {
   return out;
 }
 
-// `name` in the folder `folder` of the system's temporary directory, with whatever an earlier
-// run left there under that name (the file and its temporaries) removed.
+// This process's folder in the system's temporary directory, removed when the process exits:
+// CTest runs tests in parallel processes, which must never share a file.
+inline const fs::path& process_temp_dir() {
+  struct Dir {
+    fs::path path = fs::temp_directory_path() / ("mixpilot_test." + std::to_string(::getpid()));
+    Dir() { fs::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+// `name` in the folder `folder` of this process's temporary folder, with whatever an earlier
+// test left there under that name (the file and its temporaries) removed.
 inline fs::path fresh_path(const std::string& folder, const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / folder;
+  const fs::path dir = process_temp_dir() / folder;
   fs::create_directories(dir);
   fs::remove_all(dir / name);
   for (const auto& t : temporaries_of(dir / name)) fs::remove(t);

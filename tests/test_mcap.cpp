@@ -28,7 +28,7 @@ using test::temporaries_of;
 
 std::vector<uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
 
-fs::path temp_path(const std::string& name) { return test::fresh_path("mixpilot_test_mcap", name); }
+fs::path temp_path(const std::string& name) { return test::fresh_path("mcap", name); }
 
 template <class T>
 T get_le(const std::vector<uint8_t>& b, std::size_t at) {

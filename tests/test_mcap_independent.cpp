@@ -21,6 +21,7 @@
 #include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "temp_files.hpp"
 
 #ifndef MIXPILOT_NODE
 #define MIXPILOT_NODE ""
@@ -126,10 +127,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   ASSERT_TRUE(fs::exists(check_dir / "node_modules" / "@mcap" / "core"))
       << "run `npm ci --prefix tests/mcap_check` (CTest fixture mcap_check_npm_ci)";
 
-  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
-  fs::create_directories(dir);
-  const fs::path file = dir / "session.mcap";
-  fs::remove(file);  // a recording is never written over an existing file by default
+  const fs::path file = test::fresh_path("mcap_independent", "session.mcap");
 
   SessionRecorder rec;
   std::string err;
@@ -240,10 +238,7 @@ TEST(McapIndependentReader, ReadsAPendubotRecording) {
   const std::string node = MIXPILOT_NODE;
   if (node.empty()) GTEST_SKIP() << "node not found at configure time";
   const fs::path check_dir = fs::path(MIXPILOT_SOURCE_DIR) / "tests" / "mcap_check";
-  const fs::path dir = fs::temp_directory_path() / "mixpilot_test_mcap_independent";
-  fs::create_directories(dir);
-  const fs::path file = dir / "pendubot.mcap";
-  fs::remove(file);
+  const fs::path file = test::fresh_path("mcap_independent", "pendubot.mcap");
   const std::string scenario = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/pendubot_swingup.toml";
 
   std::string err, text;

@@ -17,6 +17,7 @@
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "no_malloc.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot {
 namespace {
@@ -109,10 +110,7 @@ TEST_P(EveryMode, RecordsEveryStepAndReadsItBack) {
   const ModeCase& c = GetParam();
   auto mode = make(c);
   ASSERT_TRUE(mode);
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            (std::string("mixpilot_test_modes_") + c.name + ".mcap"))
-                               .string();
-  std::filesystem::remove(path);  // recordings never replace an existing file by default
+  const std::string path = test::fresh_path("modes", std::string(c.name) + ".mcap").string();
   std::string error, text;
   ASSERT_TRUE(read_text_file(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + c.scenario, text,
                              error));

@@ -36,7 +36,7 @@ using test::slurp;
 using test::temporaries_of;
 
 fs::path temp_path(const std::string& name) {
-  return test::fresh_path("mixpilot_test_recording", name);
+  return test::fresh_path("recording", name);
 }
 
 double nan_with_payload() {

@@ -10,6 +10,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot::cli {
 namespace {
@@ -22,8 +23,7 @@ RecordingContents record(const std::string& scenario, double seconds, const char
   if (pilot) request.pilot_name = pilot;
   auto mode = make_mode(text, scenario, std::move(request), error);
   EXPECT_TRUE(mode) << error;
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "mixpilot_test_replay_check.mcap").string();
+  const std::string path = test::fresh_path("replay_check", "run.mcap").string();
   RecordingSink sink;
   EXPECT_TRUE(sink.open(path, *mode, {to_string(mode->kind()), text, scenario, 1, pilot ? pilot : ""},
                         error))

@@ -14,6 +14,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot {
 namespace {
@@ -165,9 +166,7 @@ Score without_timing(Score s) {
 TEST(Session, RecordThenReplayReproducesTelemetryAndScore) {
   Scenario sc = mi_helix();
   sc.duration = 4.0;
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "mixpilot_test_replay.mcap").string();
-  std::filesystem::remove(path);  // recordings never replace an existing file by default
+  const std::string path = test::fresh_path("session", "replay.mcap").string();
 
   TraceSink original;
   Score original_score;
