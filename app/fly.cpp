@@ -9,6 +9,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/replay.hpp"
+#include "app/screenshot.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
@@ -48,7 +49,11 @@ constexpr const char* kFlyUsage =
     "  --report OUT.json  write the score (mixed_initiative; fields: README, Scoring) or the\n"
     "                     mode's metrics as JSON, with `lost` and `lost_at_s`; a replay's\n"
     "                     timing fields are the recorded flight's, as in `score`\n"
-    "  --force            overwrite existing --record and --report files\n"
+    "  --screenshot T:FILE.png  write what the window would show at simulated time T (the\n"
+    "                     step with t_k <= T < t_k + dt), rendered offscreen with EGL;\n"
+    "                     repeatable\n"
+    "  --size WxH         screenshot size in pixels (default 1280x720)\n"
+    "  --force            overwrite existing --record, --report and --screenshot files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
     "\n"
@@ -64,6 +69,8 @@ struct FlyOptions {
   std::string report;
   bool allow_mismatch = false;
   bool force = false;
+  std::vector<ScreenshotRequest> screenshots;
+  int width = 1280, height = 720;  // of the screenshots
 };
 
 // The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
@@ -159,6 +166,16 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
     usage_error("fly", "--record and --report name the same file '" + o.record + "'");
   for (const std::string* path : {&o.record, &o.report})
     if (!path->empty() && !check_output_path(*path, o.force, error)) return false;
+  for (std::size_t i = 0; i < o.screenshots.size(); ++i) {
+    const std::string& shot = o.screenshots[i].path;
+    for (const std::string* other : {&o.record, &o.report})
+      if (!other->empty() && same_output_path(shot, *other))
+        usage_error("fly", "--screenshot and another output name the same file '" + shot + "'");
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_output_path(shot, o.screenshots[j].path))
+        usage_error("fly", "two --screenshot options name the same file '" + shot + "'");
+    if (!check_output_path(shot, o.force, error)) return false;
+  }
   return true;
 }
 
@@ -184,6 +201,21 @@ int run_fly(const FlyOptions& o) {
       return kExitError;
     }
     session.add_sink(&recorder);
+  }
+  std::optional<ScreenshotSink> screenshots;
+  if (!o.screenshots.empty()) {
+    for (const ScreenshotRequest& r : o.screenshots)
+      if (r.t >= double(mode.steps_total()) * mode.dt())
+        usage_error("fly", "--screenshot at t = " + std::to_string(r.t) + " s is beyond the " +
+                               "flight's end (" + std::to_string(double(mode.steps_total()) * mode.dt()) + " s)");
+    const std::string source =
+        flight->pilot.empty() ? std::string("the thesis's controller") : "pilot " + flight->pilot;
+    screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
+    if (!screenshots->open(o.width, o.height, error)) {
+      std::fprintf(stderr, "mixpilot fly: --screenshot: %s\n", error.c_str());
+      return kExitError;
+    }
+    session.add_sink(&*screenshots);
   }
   std::optional<ReplayCheck> check;
   if (flight->recording) {
@@ -217,6 +249,13 @@ int run_fly(const FlyOptions& o) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       status = kExitError;
     }
+  }
+  if (screenshots) {
+    if (!screenshots->finish(error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      status = kExitError;
+    }
+    for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
   }
   if (!o.record.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
   if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
@@ -266,6 +305,17 @@ int fly_command(int argc, char** argv) {
       o.record = value();
     } else if (a == "--report") {
       o.report = value();
+    } else if (a == "--screenshot") {
+      const std::string v = value();
+      const auto shot = parse_screenshot(v);
+      if (!shot)
+        usage_error("fly", "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, got '" +
+                               v + "'");
+      o.screenshots.push_back(*shot);
+    } else if (a == "--size") {
+      const std::string v = value();
+      if (!parse_size(v, o.width, o.height))
+        usage_error("fly", "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
     } else if (a == "--force") {

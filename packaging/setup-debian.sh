@@ -12,7 +12,8 @@ packages=(
   # scenario files
   libtomlplusplus-dev
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
-  libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev
+  libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
+  libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev xvfb xauth
   # gamepads
   libsdl2-dev
   # network peers (C API + idlc)

@@ -47,6 +47,7 @@ class MiMode final : public Mode {
 
   Score score() const { return scorer_.finish(); }
   const Scenario& scenario() const { return scenario_; }
+  const models::MikroKopter& model() const { return model_; }
   const PilotSource& pilot() const { return *pilot_; }
   const MiController& controller() const { return controller_; }
   const Eigen::VectorXd& state() const { return x_; }

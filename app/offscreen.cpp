@@ -1,0 +1,146 @@
+#include "app/offscreen.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include <epoxy/egl.h>  // EGL and GL entry points, both through libepoxy
+#include <epoxy/gl.h>
+
+#include <imgui.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <stb/stb_image_write.h>  // implemented in Debian's libstb, which ImGui links
+
+#include "ui/theme.hpp"
+
+namespace mixpilot::cli {
+namespace {
+
+const char* const kInstall =
+    " (headless rendering needs Mesa's EGL: apt-get install libegl-mesa0 libgl1-mesa-dri)";
+
+std::string egl_error(const char* what) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%s failed (EGL error 0x%04x)", what, eglGetError());
+  return buf;
+}
+
+}  // namespace
+
+Offscreen::~Offscreen() { close(); }
+
+bool Offscreen::open(int width, int height, std::string& error) {
+  width_ = width;
+  height_ = height;
+  auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+      eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  if (!get_display) {
+    error = std::string("EGL has no eglGetPlatformDisplayEXT") + kInstall;
+    return false;
+  }
+  EGLDisplay dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  EGLint major = 0, minor = 0;
+  if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) {
+    error = egl_error("opening Mesa's surfaceless EGL display") + kInstall;
+    return false;
+  }
+  display_ = dpy;
+  if (!eglBindAPI(EGL_OPENGL_API)) {
+    error = egl_error("eglBindAPI(OpenGL)") + kInstall;
+    return false;
+  }
+  const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                               EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                               EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  EGLContext ctx = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
+  if (ctx == EGL_NO_CONTEXT) {
+    error = egl_error("creating an OpenGL 3.3 core context") + kInstall;
+    return false;
+  }
+  context_ = ctx;
+  if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
+    error = egl_error("eglMakeCurrent") + kInstall;
+    return false;
+  }
+  glGenFramebuffers(1, &fbo_);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glGenRenderbuffers(1, &colour_);
+  glBindRenderbuffer(GL_RENDERBUFFER, colour_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    error = "the offscreen framebuffer of " + std::to_string(width) + "x" +
+            std::to_string(height) + " is incomplete";
+    return false;
+  }
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  imgui_ = true;
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // nothing written behind the user's back
+  io.DisplaySize = ImVec2(float(width), float(height));
+  mixpilot::ui::apply_style(1.0f);
+  font_ = mixpilot::ui::load_fonts(1.0f);
+  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
+    error = "ImGui's OpenGL3 renderer did not start";
+    return false;
+  }
+  return true;
+}
+
+void Offscreen::frame(const std::function<void()>& build, float dt) {
+  ImGuiIO& io = ImGui::GetIO();
+  io.DeltaTime = dt;
+  io.DisplaySize = ImVec2(float(width_), float(height_));
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui::NewFrame();
+  build();
+  ImGui::Render();
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, width_, height_);
+  glClearColor(0.086f, 0.098f, 0.118f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  glFinish();
+}
+
+std::vector<std::uint8_t> Offscreen::pixels() const {
+  const std::size_t row = std::size_t(width_) * 4;
+  std::vector<std::uint8_t> bottom_up(row * std::size_t(height_)), out(bottom_up.size());
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
+  for (int y = 0; y < height_; ++y)
+    std::copy_n(bottom_up.data() + row * std::size_t(height_ - 1 - y), row, out.data() + row * std::size_t(y));
+  return out;
+}
+
+std::string Offscreen::png() const {
+  const auto px = pixels();
+  std::string out;
+  stbi_write_png_to_func(
+      [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
+      },
+      &out, width_, height_, 4, px.data(), width_ * 4);
+  return out;
+}
+
+void Offscreen::close() {
+  if (imgui_) {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui::DestroyContext();
+    imgui_ = false;
+  }
+  if (fbo_) glDeleteFramebuffers(1, &fbo_);
+  if (colour_) glDeleteRenderbuffers(1, &colour_);
+  fbo_ = colour_ = 0;
+  if (display_) {
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (context_) eglDestroyContext(display_, context_);
+    eglTerminate(display_);
+  }
+  display_ = context_ = nullptr;
+}
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,148 @@
+// The UI through real rendering (EGL, Mesa's software rasterizer): each mode's screen renders,
+// and pixels that can fail are checked against the telemetry they draw.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+
+#include "app/offscreen.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/session.hpp"
+#include "ui/scene.hpp"
+#include "ui/screen.hpp"
+#include "ui/theme.hpp"
+
+namespace mixpilot {
+namespace {
+
+constexpr int kW = 1280, kH = 720;
+
+struct Rgb {
+  std::uint8_t r, g, b;
+};
+Rgb rgb_of(ImU32 c) { return {std::uint8_t(c & 0xFF), std::uint8_t((c >> 8) & 0xFF), std::uint8_t((c >> 16) & 0xFF)}; }
+
+bool near(const std::uint8_t* p, Rgb c, int tol = 6) {
+  return std::abs(p[0] - c.r) <= tol && std::abs(p[1] - c.g) <= tol && std::abs(p[2] - c.b) <= tol;
+}
+
+// A flight of `scenario` for `seconds`, its telemetry kept.
+struct Flown {
+  std::unique_ptr<Mode> mode;
+  ui::History history;
+};
+
+Flown fly(const char* scenario, double seconds, const char* pilot = nullptr) {
+  ModeRequest request;
+  request.duration = seconds;
+  if (pilot) request.pilot_name = pilot;
+  std::string error;
+  Flown f;
+  f.mode = load_mode(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + scenario, std::move(request),
+                     error);
+  EXPECT_TRUE(f.mode) << error;
+  if (!f.mode) return f;
+  struct Keep : TelemetrySink {
+    ui::History* h;
+    void on_sample(const Telemetry& s) override { h->push(s); }
+  } keep;
+  keep.h = &f.history;
+  Session session(*f.mode);
+  session.add_sink(&keep);
+  session.run();
+  return f;
+}
+
+class Ui : public testing::Test {
+ protected:
+  void SetUp() override {
+    std::string error;
+    if (!screen_.open(kW, kH, error)) GTEST_SKIP() << "no EGL device: " << error;
+  }
+  std::vector<std::uint8_t> render(const ui::Scene& scene, const ui::History& h, ui::UiState& st) {
+    ui::RunInfo run;
+    run.state = ui::RunState::flying;
+    for (int f = 0; f < 2; ++f) screen_.frame([&] { (void)ui::draw_screen(scene, h, run, st); });
+    return screen_.pixels();
+  }
+  cli::Offscreen screen_;
+};
+
+// The authority bar: the pilot's colour fills the fraction λ of the bar, the planner's the rest.
+TEST_F(Ui, AuthorityBarFillMatchesLambda) {
+  Flown f = fly("mi_helix.toml", 3.0, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  const double lambda = f.history.newest().lambda;
+  const auto px = render(scene, f.history, st);
+  // The bar's row: the first row from the top with both colours, counted left to right.
+  int best_row = -1, pilot = 0, planner = 0;
+  for (int y = 96; y < 200 && best_row < 0; ++y) {
+    int a = 0, b = 0;
+    for (int x = 0; x < kW; ++x) {
+      const std::uint8_t* p = &px[(std::size_t(y) * kW + std::size_t(x)) * 4];
+      a += near(p, rgb_of(ui::colour::kPilot)) ? 1 : 0;
+      b += near(p, rgb_of(ui::colour::kPlanner)) ? 1 : 0;
+    }
+    if (a > 100 && b > 0 && a + b > 300) {
+      best_row = y;
+      pilot = a;
+      planner = b;
+    }
+  }
+  ASSERT_GE(best_row, 0) << "no authority bar found";
+  // The needle and the 0.5 tick hide a few pixels: within 2 % of the bar's width.
+  EXPECT_NEAR(double(pilot) / double(pilot + planner), lambda, 0.02) << "row " << best_row;
+}
+
+// A frame depends only on what it draws: rendered twice, the same pixels.
+TEST_F(Ui, SameSnapshotSamePixels) {
+  Flown f = fly("mi_helix.toml", 1.0, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  EXPECT_EQ(render(scene, f.history, st), render(scene, f.history, st));
+}
+
+// Keys reach the UI: '3' switches to the top camera, and the arena looks different.
+TEST_F(Ui, KeyThreeSwitchesToTopCamera) {
+  Flown f = fly("mi_helix.toml", 1.0, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  const auto chase = render(scene, f.history, st);
+  ASSERT_EQ(st.camera, ui::Camera::chase);
+  ImGui::GetIO().KeysDown['3'] = true;
+  ui::RunInfo run;
+  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+  ImGui::GetIO().KeysDown['3'] = false;
+  EXPECT_EQ(st.camera, ui::Camera::top);
+  EXPECT_NE(render(scene, f.history, st), chase);
+}
+
+// Every mode renders, and its view is not empty: many pixels differ from the background.
+TEST_F(Ui, EveryModeRenders) {
+  for (const char* scenario : {"mi_helix.toml", "pendubot_swingup.toml", "tracking_helix.toml",
+                               "obstacles_thrown_balls.toml"}) {
+    Flown f = fly(scenario, 1.0);
+    ASSERT_TRUE(f.mode) << scenario;
+    const ui::Scene scene = ui::scene_of(*f.mode, "test");
+    ui::UiState st;
+    const auto px = render(scene, f.history, st);
+    const Rgb bg = rgb_of(ui::colour::kBackground);
+    int drawn = 0;
+    for (int y = 120; y < kH; ++y)
+      for (int x = 0; x < kW / 2; ++x)
+        drawn += near(&px[(std::size_t(y) * kW + std::size_t(x)) * 4], bg, 2) ? 0 : 1;
+    EXPECT_GT(drawn, 2000) << scenario << ": the view is (almost) empty";
+  }
+}
+
+}  // namespace
+}  // namespace mixpilot

@@ -1,0 +1,23 @@
+#pragma once
+// The panels of the screen (ui/screen.hpp), each drawing into the current ImGui window's
+// region [min, max) from the scene and the history.
+#include <imgui.h>
+
+#include "ui/scene.hpp"
+#include "ui/screen.hpp"
+
+namespace mixpilot::ui {
+
+// 3D arena of the quadrotor modes; the mouse orbits and zooms when over it.
+void draw_arena(const Scene& scene, const History& history, UiState& ui, ImVec2 min, ImVec2 max);
+// 2D side view of the Pendubot.
+void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec2 max);
+// The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour.
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max);
+// Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
+// The thrust stick is centred on the hover rotor speed `hover`.
+void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
+// Rolling plots of the mode's channels.
+void draw_plots(const Scene& scene, const History& history, UiState& ui);
+
+}  // namespace mixpilot::ui

@@ -1,0 +1,67 @@
+#pragma once
+// What the UI draws from (SPEC §8): the flight's fixed description (Scene) and a rolling copy of
+// its telemetry (History). Both belong to the UI thread; the simulation never sees them.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/modes/mode.hpp"
+
+namespace mixpilot::ui {
+
+struct SceneSphere {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // [m]
+  double radius = 0.1;                               // [m]
+};
+
+// What does not change during a flight.
+struct Scene {
+  ModeKind mode = ModeKind::mixed_initiative;
+  std::string title;         // the scenario's name
+  std::string input_source;  // the pilot source, or the controller for the other modes
+  double dt = 0.01;          // [s] control period
+  double duration = 0.0;     // [s] of the whole run
+  Eigen::Vector3d arena_min{-3.0, -3.0, 0.0};  // [m] quadrotor modes: the flight volume
+  Eigen::Vector3d arena_max{3.0, 3.0, 3.0};    // [m]
+  std::vector<SceneSphere> spheres;            // static obstacles
+  // Moving obstacles: their centres at time t (the obstacle mode's thrown balls).
+  std::function<void(double t, std::vector<Eigen::Vector3d>& centers)> moving;
+  double moving_radius = 0.1;   // [m]
+  Eigen::Matrix3Xd reference;   // 3 x M: the whole reference path, for drawing
+  double ball_radius = 0.0;     // [m] r of the ball B (mixed initiative), 0: none
+  double hover_rotor_speed = 1.0;  // Ω at hover (mixed initiative; the thrust stick's centre)
+  double link1 = 0.1483, link2 = 0.1804;  // [m] Pendubot links
+};
+
+// The value of the channel called `name` in `s`, or `fallback` when it has none.
+double channel_value(const Telemetry& s, std::string_view name, double fallback = 0.0);
+
+// The scene of a mode, read through its const accessors (no effect on the flight).
+Scene scene_of(const Mode& mode, const std::string& input_source);
+
+// The newest telemetry values, oldest first, at most `capacity` of them.
+class History {
+ public:
+  explicit History(std::size_t capacity = 4096) : capacity_(capacity) {}
+  void push(const Telemetry& s);
+  void clear() { size_ = 0; head_ = 0; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  // i = 0 is the oldest kept, size() − 1 the newest.
+  const Telemetry& operator[](std::size_t i) const {
+    return ring_[(head_ + capacity_ - size_ + i) % capacity_];
+  }
+  const Telemetry& newest() const { return (*this)[size_ - 1]; }
+
+ private:
+  std::size_t capacity_;
+  std::vector<Telemetry> ring_;
+  std::size_t head_ = 0;  // where the next value goes
+  std::size_t size_ = 0;
+};
+
+}  // namespace mixpilot::ui

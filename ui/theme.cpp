@@ -1,0 +1,75 @@
+#include "ui/theme.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fontconfig/fontconfig.h>
+
+namespace mixpilot::ui {
+namespace {
+
+ImFont* g_mono = nullptr;
+
+// The file fontconfig matches for `pattern` ("DejaVu Sans"), or "" when it is not DejaVu.
+std::string find_font(const char* family) {
+  std::string path;
+  if (!FcInit()) return path;
+  FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(family));
+  FcConfigSubstitute(nullptr, pat, FcMatchPattern);
+  FcDefaultSubstitute(pat);
+  FcResult result = FcResultNoMatch;
+  if (FcPattern* match = FcFontMatch(nullptr, pat, &result)) {
+    FcChar8* file = nullptr;
+    FcChar8* name = nullptr;
+    if (FcPatternGetString(match, FC_FILE, 0, &file) == FcResultMatch &&
+        FcPatternGetString(match, FC_FAMILY, 0, &name) == FcResultMatch &&
+        std::string(reinterpret_cast<const char*>(name)).rfind(family, 0) == 0)
+      path = reinterpret_cast<const char*>(file);
+    FcPatternDestroy(match);
+  }
+  FcPatternDestroy(pat);
+  return path;
+}
+
+}  // namespace
+
+ImU32 authority_colour(double lambda) {
+  const double l = std::clamp(lambda, 0.0, 1.0);
+  const ImVec4 a = ImGui::ColorConvertU32ToFloat4(colour::kPlanner);
+  const ImVec4 b = ImGui::ColorConvertU32ToFloat4(colour::kPilot);
+  const auto mix = [l](float x, float y) { return float((1.0 - l) * x + l * y); };
+  return ImGui::ColorConvertFloat4ToU32(ImVec4(mix(a.x, b.x), mix(a.y, b.y), mix(a.z, b.z), 1.0f));
+}
+
+void apply_style(float scale) {
+  ImGui::StyleColorsDark();
+  ImGuiStyle& st = ImGui::GetStyle();
+  st.WindowRounding = 4.0f;
+  st.FrameRounding = 3.0f;
+  st.WindowBorderSize = 0.0f;
+  st.Colors[ImGuiCol_WindowBg] = ImVec4(0.10f, 0.11f, 0.13f, 0.92f);
+  st.Colors[ImGuiCol_TitleBgActive] = ImVec4(0.16f, 0.18f, 0.21f, 1.0f);
+  st.Colors[ImGuiCol_Button] = ImVec4(0.22f, 0.25f, 0.30f, 1.0f);
+  st.Colors[ImGuiCol_ButtonHovered] = ImVec4(0.30f, 0.34f, 0.40f, 1.0f);
+  st.ScaleAllSizes(scale);
+}
+
+std::string load_fonts(float scale) {
+  ImGuiIO& io = ImGui::GetIO();
+  io.Fonts->Clear();
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x2212, 0};
+  const float px = std::round(15.0f * scale);
+  const std::string sans = find_font("DejaVu Sans");
+  const std::string mono = find_font("DejaVu Sans Mono");
+  ImFont* main = nullptr;
+  if (!sans.empty()) main = io.Fonts->AddFontFromFileTTF(sans.c_str(), px, nullptr, ranges);
+  if (!main) io.Fonts->AddFontDefault();
+  g_mono = nullptr;
+  if (main && !mono.empty())
+    g_mono = io.Fonts->AddFontFromFileTTF(mono.c_str(), px, nullptr, ranges);
+  return main ? sans : std::string();
+}
+
+ImFont* mono_font() { return g_mono ? g_mono : ImGui::GetFont(); }
+
+}  // namespace mixpilot::ui

@@ -1,0 +1,41 @@
+#pragma once
+// One colour scheme everywhere (Okabe–Ito, UI.md §9): the pilot and the planner keep their
+// colours in the authority bar, the trail, the plots and the sticks.
+#include <string>
+
+#include <imgui.h>
+
+namespace mixpilot::ui {
+
+namespace colour {
+inline constexpr ImU32 rgb(unsigned r, unsigned g, unsigned b, unsigned a = 255) {
+  return (ImU32(a) << 24) | (ImU32(b) << 16) | (ImU32(g) << 8) | ImU32(r);
+}
+inline constexpr ImU32 kPilot = rgb(0x56, 0xB4, 0xE9);    // sky blue
+inline constexpr ImU32 kPlanner = rgb(0xE6, 0x9F, 0x00);  // orange
+inline constexpr ImU32 kMpc = rgb(0x00, 0x9E, 0x73);      // bluish green: what was applied
+inline constexpr ImU32 kCaution = rgb(0xF0, 0xE4, 0x42);  // yellow
+inline constexpr ImU32 kCritical = rgb(0xD5, 0x5E, 0x00); // vermilion
+inline constexpr ImU32 kReference = rgb(0xEE, 0xEE, 0xEE, 200);
+inline constexpr ImU32 kGrid = rgb(0x60, 0x66, 0x70, 160);
+inline constexpr ImU32 kWall = rgb(0x90, 0x98, 0xA8, 200);
+inline constexpr ImU32 kObstacle = rgb(0xCC, 0x79, 0xA7);  // reddish purple
+inline constexpr ImU32 kBackground = rgb(0x16, 0x19, 0x1E);
+inline constexpr ImU32 kText = rgb(0xE8, 0xE8, 0xE8);
+}  // namespace colour
+
+// The colour of authority λ ∈ [0, 1]: planner (0) … pilot (1), through grey.
+ImU32 authority_colour(double lambda);
+
+// Dark style, sizes scaled by `scale` (the monitor's content scale).
+void apply_style(float scale);
+
+// Loads DejaVu Sans (and Sans Mono) found through fontconfig at round(15·scale) px, with the
+// Greek glyphs (λ, φ, θ, Ω); ImGui's built-in font when none is found. Returns the file used,
+// or "" for the built-in.
+std::string load_fonts(float scale);
+
+// The monospace font for numbers (the default font when none was loaded).
+ImFont* mono_font();
+
+}  // namespace mixpilot::ui
