@@ -1,5 +1,6 @@
 // mixpilot fly / demo: one session of any mode, as fast as possible.
 #include <chrono>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -10,6 +11,8 @@
 #include "app/commands.hpp"
 #include "app/replay.hpp"
 #include "app/screenshot.hpp"
+#include "app/window.hpp"
+#include "core/runtime/realtime_runner.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
@@ -30,7 +33,7 @@ namespace {
 constexpr double kMaxDuration = 3600.0;  // [s] --duration: memory and time stay proportionate
 
 constexpr const char* kFlyUsage =
-    "usage: mixpilot fly --scenario FILE --pilot PILOT --headless [options]\n"
+    "usage: mixpilot fly --scenario FILE --pilot PILOT [--headless] [options]\n"
     "\n"
     "Runs one session of the scenario as fast as possible and prints a short summary. ^C ends\n"
     "the flight at the next step: the recording and report then hold what was flown.\n"
@@ -41,7 +44,10 @@ constexpr const char* kFlyUsage =
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
     "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
     "                     against the recording); default: the scenario's (mixed_initiative only)\n"
-    "  --headless         run without a window (required: this build has no GUI yet)\n"
+    "  --headless         run without a window, as fast as possible (default: a window,\n"
+    "                     in real time, where a display exists)\n"
+    "  --realtime         with --headless: paced by the wall clock, deadline misses counted\n"
+    "  --exit-at-end      window: start at once and close the window when the run ends\n"
     "  --duration S       fly S seconds (at most 3600) instead of the scenario's duration, or\n"
     "                     instead of the recording's length\n"
     "  --record OUT.mcap  record the session (MCAP, ros2 profile; docs/recording-format.md):\n"
@@ -70,7 +76,9 @@ struct FlyOptions {
   bool allow_mismatch = false;
   bool force = false;
   std::vector<ScreenshotRequest> screenshots;
-  int width = 1280, height = 720;  // of the screenshots
+  int width = 1280, height = 720;  // of the screenshots and the window
+  bool realtime = false;           // headless, paced by the wall clock
+  bool exit_at_end = false;        // window: start at once, close when the run is over
 };
 
 // The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
@@ -195,21 +203,24 @@ int run_fly(const FlyOptions& o) {
   Session session(mode);
   RecordingSink recorder;
   if (!o.record.empty()) {
-    if (!recorder.open(o.record, mode, session_info(*flight), error, RecordingSink::Settings{},
-                       o.force)) {
+    // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
+    RecordingSink::Settings rs;
+    if (!o.headless || o.realtime) rs.when_full = RecordingSink::FullRing::drop;
+    if (!recorder.open(o.record, mode, session_info(*flight), error, rs, o.force)) {
       std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
       return kExitError;
     }
     session.add_sink(&recorder);
   }
+  for (const ScreenshotRequest& r : o.screenshots)
+    if (r.t >= double(mode.steps_total()) * mode.dt())
+      usage_error("fly", "--screenshot at t = " + std::to_string(r.t) + " s is beyond the " +
+                             "flight's end (" +
+                             std::to_string(double(mode.steps_total()) * mode.dt()) + " s)");
+  const std::string source =
+      flight->pilot.empty() ? std::string("the thesis's controller") : "pilot " + flight->pilot;
   std::optional<ScreenshotSink> screenshots;
-  if (!o.screenshots.empty()) {
-    for (const ScreenshotRequest& r : o.screenshots)
-      if (r.t >= double(mode.steps_total()) * mode.dt())
-        usage_error("fly", "--screenshot at t = " + std::to_string(r.t) + " s is beyond the " +
-                               "flight's end (" + std::to_string(double(mode.steps_total()) * mode.dt()) + " s)");
-    const std::string source =
-        flight->pilot.empty() ? std::string("the thesis's controller") : "pilot " + flight->pilot;
+  if (!o.screenshots.empty() && o.headless) {
     screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
     if (!screenshots->open(o.width, o.height, error)) {
       std::fprintf(stderr, "mixpilot fly: --screenshot: %s\n", error.c_str());
@@ -225,7 +236,32 @@ int run_fly(const FlyOptions& o) {
 
   catch_interrupts();
   const auto t0 = std::chrono::steady_clock::now();
-  {
+  std::optional<RealtimeStats> realtime;
+  std::vector<std::string> window_shots;
+  if (!o.headless) {
+    WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force};
+    WindowResult wr;
+    if (!fly_window(session, ui::scene_of(mode, source), wo, wr, error)) {
+      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      status = kExitError;
+    }
+    realtime = RealtimeStats{mode.steps_done(), wr.deadline_misses, wr.worst_lateness_us,
+                             wr.worst_step_us};
+    window_shots = wr.screenshots;
+  } else if (o.realtime) {
+    RealtimeRunner runner(session, 64);
+    runner.start();
+    Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
+    Telemetry drained = mode.telemetry();
+    while (runner.running() && !interrupted()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      while (runner.telemetry().pop(drained)) {
+      }
+      progress.update(mode.steps_done());
+    }
+    runner.stop();
+    realtime = runner.stats();
+  } else {
     Progress progress("fly " + mode.scenario_name(), mode.steps_total());
     while (!interrupted() && session.step()) progress.update(mode.steps_done());
   }
@@ -240,6 +276,12 @@ int run_fly(const FlyOptions& o) {
   const double flown = double(mode.steps_done()) * mode.dt();
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
+  if (realtime)
+    std::printf("  real time: %lld deadline misses; worst start lateness %.0f us, longest step "
+                "%.0f us (dt %.0f us)\n",
+                static_cast<long long>(realtime->deadline_misses), realtime->worst_lateness_us,
+                realtime->worst_step_us, 1e6 * mode.dt());
+  for (const std::string& path : window_shots) std::printf("  screenshot %s\n", path.c_str());
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
     const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)
@@ -316,6 +358,10 @@ int fly_command(int argc, char** argv) {
       const std::string v = value();
       if (!parse_size(v, o.width, o.height))
         usage_error("fly", "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+    } else if (a == "--realtime") {
+      o.realtime = true;
+    } else if (a == "--exit-at-end") {
+      o.exit_at_end = true;
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
     } else if (a == "--force") {
@@ -324,7 +370,8 @@ int fly_command(int argc, char** argv) {
       usage_error("fly", "unknown option '" + std::string(a) + "'");
     }
   }
-  if (!o.headless) usage_error("fly", "this build has no GUI yet: pass --headless");
+  if (o.realtime && !o.headless) usage_error("fly", "--realtime is for --headless runs (a window is always real time)");
+  if (o.exit_at_end && o.headless) usage_error("fly", "--exit-at-end is for the window");
   return run_fly(o);
 }
 

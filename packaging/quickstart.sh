@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's two commands. Both install missing Debian packages, configure and build the
 # release preset, then:
-#   run   runs the main job (the headless demo)
+#   run   runs the main job: the window (mixed initiative, emulated novice) where a display
+#         exists, else the headless demo
 #   test  runs the whole test suite through CTest
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,6 +16,11 @@ cmake --preset release >/dev/null
 cmake --build --preset release
 
 case "$1" in
-  run)  exec ./build/release/app/mixpilot demo ;;
+  run)
+    # The window where a display exists, else the headless demo.
+    if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
+      exec ./build/release/app/mixpilot fly --scenario scenarios/mi_helix.toml --pilot novice
+    fi
+    exec ./build/release/app/mixpilot demo ;;
   test) exec ctest --preset release -j "$(nproc)" ;;
 esac

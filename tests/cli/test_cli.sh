@@ -90,8 +90,32 @@ check "interrupted recording replays exactly" grep -q "exact" "$work/int.score"
 check "one path for two outputs is a usage error" test $? -eq 2
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration 1e9 >"$work/e8" 2>&1
 check "a huge duration is a usage error" test $? -eq 2
-"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice >"$work/e1" 2>&1
-check "fly without --headless is a usage error" test $? -eq 2
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --realtime >"$work/e1" 2>&1
+check "--realtime without --headless is a usage error" test $? -eq 2
+
+# Paced by the wall clock: the summary reports the real-time figures.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --realtime \
+  --duration 0.5 >"$work/rt.out" 2>&1
+check "fly --headless --realtime exits 0" test $? -eq 0
+check "... and reports deadline misses" grep -q "real time: [0-9]* deadline misses" "$work/rt.out"
+
+# Headless screenshots (EGL): a PNG at the requested time; a time beyond the flight is refused.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --duration 1 \
+  --screenshot 0.5:"$work/shot.png" --size 320x200 >"$work/shot.out" 2>&1
+check "--screenshot writes a PNG" sh -c "head -c 8 '$work/shot.png' | od -c | grep -q 'P   N   G'"
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --duration 1 \
+  --screenshot 5:"$work/late.png" >"$work/late.out" 2>&1
+check "--screenshot beyond the flight is a usage error" test $? -eq 2
+check "... and nothing is written" test ! -e "$work/late.png"
+
+# The window, under Xvfb where it is installed: flies, closes itself, and its frame shows the UI.
+if command -v xvfb-run >/dev/null 2>&1; then
+  xvfb-run -a -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
+    --pilot novice --duration 2 --exit-at-end --screenshot 1.5:"$work/window.png" >"$work/win.out" 2>&1
+  check "the window flies and closes itself" test $? -eq 0
+  check "... with a frame of it" test -s "$work/window.png"
+  check "... and the real-time summary" grep -q "real time:" "$work/win.out"
+fi
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration -3 >"$work/e2" 2>&1
 check "negative duration is a usage error" test $? -eq 2
 check "negative duration message" grep -q "positive number" "$work/e2"

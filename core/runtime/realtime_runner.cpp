@@ -1,0 +1,60 @@
+#include "core/runtime/realtime_runner.hpp"
+
+#include <algorithm>
+
+namespace mixpilot {
+
+RealtimeRunner::RealtimeRunner(Session& session, std::size_t ring_capacity) : session_(&session) {
+  ring_.setup(ring_capacity, session.mode().telemetry());
+}
+
+RealtimeRunner::~RealtimeRunner() { stop(); }
+
+void RealtimeRunner::start() {
+  if (thread_.joinable()) return;
+  stop_.store(false);
+  running_.store(true);
+  thread_ = std::thread([this] { loop(); });
+}
+
+void RealtimeRunner::stop() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+RealtimeStats RealtimeRunner::stats() const {
+  return {steps_.load(), misses_.load(), worst_lateness_us_.load(), worst_step_us_.load()};
+}
+
+void RealtimeRunner::loop() {
+  using clock = std::chrono::steady_clock;
+  const double dt = session_->mode().dt();
+  auto next = clock::now();
+  while (!stop_.load(std::memory_order_relaxed)) {
+    if (paused_.load(std::memory_order_relaxed)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      next = clock::now();  // resume without catching up
+      continue;
+    }
+    std::this_thread::sleep_until(next);
+    const auto started = clock::now();
+    const double late_us = std::chrono::duration<double, std::micro>(started - next).count();
+    const bool stepped = session_->step();
+    const auto ended = clock::now();
+    if (!stepped) break;
+    ring_.push(session_->mode().telemetry());
+    const double step_us = std::chrono::duration<double, std::micro>(ended - started).count();
+    const double period_us = 1e6 * dt / std::max(1e-3, speed_.load(std::memory_order_relaxed));
+    if (late_us > 0.1 * 1e6 * dt || step_us > 1e6 * dt) misses_.fetch_add(1);
+    if (late_us > worst_lateness_us_.load()) worst_lateness_us_.store(late_us);
+    if (step_us > worst_step_us_.load()) worst_step_us_.store(step_us);
+    steps_.fetch_add(1);
+    const auto period =
+        std::chrono::duration_cast<clock::duration>(std::chrono::duration<double, std::micro>(period_us));
+    // A late step restarts the schedule from its own start: no burst of catch-up steps.
+    next = (late_us > 0.1 * 1e6 * dt ? started : next) + period;
+  }
+  running_.store(false);
+}
+
+}  // namespace mixpilot

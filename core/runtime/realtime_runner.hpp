@@ -1,0 +1,60 @@
+#pragma once
+// The real-time runner (SPEC §8 "Threads"): its own thread steps a session once per control
+// period Δt of the mode, paced by the wall clock (slowed down by `speed`), and hands each step's
+// telemetry to the UI through a ring that never blocks it. Pause, resume, speed and stop come
+// from any thread through atomics; the control thread never waits on them.
+//
+// Deadline misses: a step that starts later than its scheduled time by more than 10 % of Δt,
+// or whose step time exceeds Δt, counts one miss. After a late start the schedule restarts
+// from now (no burst of catch-up steps).
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <thread>
+
+#include "core/modes/session.hpp"
+#include "core/runtime/spsc_ring.hpp"
+
+namespace mixpilot {
+
+struct RealtimeStats {
+  std::int64_t steps = 0;
+  std::int64_t deadline_misses = 0;
+  double worst_lateness_us = 0.0;  // the latest start after its schedule
+  double worst_step_us = 0.0;      // the longest step
+};
+
+class RealtimeRunner {
+ public:
+  // The session and its mode must outlive the runner. `ring_capacity` telemetry slots for the
+  // UI (sized here with a copy of the mode's current telemetry).
+  RealtimeRunner(Session& session, std::size_t ring_capacity);
+  ~RealtimeRunner();
+  RealtimeRunner(const RealtimeRunner&) = delete;
+  RealtimeRunner& operator=(const RealtimeRunner&) = delete;
+
+  void start();   // starts the thread (paused runs wait for resume())
+  void stop();    // ends the run at the next step and joins the thread
+  void set_paused(bool paused) { paused_.store(paused); }
+  bool paused() const { return paused_.load(); }
+  void set_speed(double speed) { speed_.store(speed); }  // 1: real time; 0.5: half speed
+  double speed() const { return speed_.load(); }
+  bool running() const { return running_.load(); }  // false once the mode's run is over
+
+  // The UI's side: telemetry of the steps flown since the last call, oldest first.
+  SpscRing<Telemetry>& telemetry() { return ring_; }
+  RealtimeStats stats() const;
+
+ private:
+  void loop();
+
+  Session* session_;
+  SpscRing<Telemetry> ring_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false}, paused_{false}, running_{false};
+  std::atomic<double> speed_{1.0};
+  std::atomic<std::int64_t> steps_{0}, misses_{0};
+  std::atomic<double> worst_lateness_us_{0.0}, worst_step_us_{0.0};
+};
+
+}  // namespace mixpilot
