@@ -109,9 +109,15 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
   dl->AddRectFilled(min, max, colour::rgb(0x12, 0x14, 0x18));
   if (h.empty()) return;
   const double t1 = h.newest().t, t0 = t1 - window;
+  // The first sample in the window (times increase along the history).
+  std::size_t first = 0, last = h.size();
+  while (first < last) {
+    const std::size_t mid = (first + last) / 2;
+    if (h[mid].t < t0) first = mid + 1;
+    else last = mid;
+  }
   double lo = 1e300, hi = -1e300;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    if (h[i].t < t0) continue;
+  for (std::size_t i = first; i < h.size(); ++i) {
     for (int k = 0; k < count; ++k) {
       const Indexed& s = series[k];
       if (s.channel >= h[i].num_channels) continue;
@@ -131,17 +137,37 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
     return ImVec2(float(min.x + (t - t0) / window * (max.x - min.x)),
                   float(max.y - (v - lo) / (hi - lo) * (max.y - min.y)));
   };
+  // One polyline per series through each pixel column's extremes, in the order they occur:
+  // thousands of samples cost a few hundred points, and no spike is lost.
   for (int k = 0; k < count; ++k) {
     const Indexed& s = series[k];
-    bool have = false;
-    ImVec2 prev;
-    for (std::size_t i = 0; i < h.size(); ++i) {
-      if (h[i].t < t0 || s.channel >= h[i].num_channels) continue;
+    int column = -1;
+    float y_lo = 0, y_hi = 0;
+    bool lo_first = true;
+    const auto flush = [&] {
+      if (column < 0) return;
+      const float a = lo_first ? y_lo : y_hi, b = lo_first ? y_hi : y_lo;
+      dl->PathLineTo(ImVec2(float(column), a));
+      if (b != a) dl->PathLineTo(ImVec2(float(column), b));
+    };
+    for (std::size_t i = first; i < h.size(); ++i) {
+      if (s.channel >= h[i].num_channels) continue;
       const ImVec2 p = to_px(h[i].t, h[i].channels[std::size_t(s.channel)].value);
-      if (have) dl->AddLine(prev, p, s.colour, 1.5f);
-      prev = p;
-      have = true;
+      const int c = int(p.x);
+      if (c != column) {
+        flush();
+        column = c;
+        y_lo = y_hi = p.y;
+        lo_first = true;
+      } else if (p.y < y_lo) {
+        y_lo = p.y;
+        lo_first = false;
+      } else if (p.y > y_hi) {
+        y_hi = p.y;
+      }
     }
+    flush();
+    dl->PathStroke(s.colour, 0, 1.5f);
   }
   char buf[96];
   std::snprintf(buf, sizeof buf, "%.3g", hi - pad);
