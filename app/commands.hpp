@@ -4,6 +4,7 @@
 namespace mixpilot::cli {
 
 int fly_command(int argc, char** argv);
+int replay_command(int argc, char** argv);
 int demo_command();
 int score_command(int argc, char** argv);
 int recover_command(int argc, char** argv);

@@ -79,6 +79,8 @@ struct FlyOptions {
   int width = 1280, height = 720;  // of the screenshots and the window
   bool realtime = false;           // headless, paced by the wall clock
   bool exit_at_end = false;        // window: start at once, close when the run is over
+  bool replay = false;             // `mixpilot replay`: a recording of any mode flown again
+  const char* command = "fly";     // for messages
 };
 
 // The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
@@ -117,7 +119,7 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
     f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
     f.scenario_file = f.recording->metadata["scenario_path"];
   } else {
-    usage_error("fly", "--scenario FILE is required");
+    usage_error(o.command, "--scenario FILE is required");
   }
   return f;
 }
@@ -131,8 +133,8 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     if (f->recording && o.scenario_path.empty()) error = in_embedded_scenario(o.pilot, error);
     return std::nullopt;
   }
-  if (*kind_name != "mixed_initiative" && !o.pilot.empty())
-    usage_error("fly", "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
+  if (*kind_name != "mixed_initiative" && !o.pilot.empty() && !o.replay)
+    usage_error(o.command, "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
                            " is " + *kind_name);
   if (f->recording) {
     f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
@@ -171,32 +173,38 @@ Labels report_labels(const Flight& f, bool was_interrupted) {
 // nor over an existing file without --force. False with the reason.
 bool check_outputs(const FlyOptions& o, std::string& error) {
   if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
-    usage_error("fly", "--record and --report name the same file '" + o.record + "'");
+    usage_error(o.command, "--record and --report name the same file '" + o.record + "'");
   for (const std::string* path : {&o.record, &o.report})
     if (!path->empty() && !check_output_path(*path, o.force, error)) return false;
   for (std::size_t i = 0; i < o.screenshots.size(); ++i) {
     const std::string& shot = o.screenshots[i].path;
     for (const std::string* other : {&o.record, &o.report})
       if (!other->empty() && same_output_path(shot, *other))
-        usage_error("fly", "--screenshot and another output name the same file '" + shot + "'");
+        usage_error(o.command, "--screenshot and another output name the same file '" + shot + "'");
     for (std::size_t j = 0; j < i; ++j)
       if (same_output_path(shot, o.screenshots[j].path))
-        usage_error("fly", "two --screenshot options name the same file '" + shot + "'");
+        usage_error(o.command, "two --screenshot options name the same file '" + shot + "'");
     if (!check_output_path(shot, o.force, error)) return false;
   }
   return true;
 }
 
+std::string seconds_text(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", t);
+  return buf;
+}
+
 int run_fly(const FlyOptions& o) {
   std::string error;
   if (!check_outputs(o, error)) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return kExitError;
   }
   int status = kExitOk;
   std::optional<Flight> flight = prepare_flight(o, error, status);
   if (!flight) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return status;
   }
   Mode& mode = *flight->mode;
@@ -207,23 +215,23 @@ int run_fly(const FlyOptions& o) {
     RecordingSink::Settings rs;
     if (!o.headless || o.realtime) rs.when_full = RecordingSink::FullRing::drop;
     if (!recorder.open(o.record, mode, session_info(*flight), error, rs, o.force)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       return kExitError;
     }
     session.add_sink(&recorder);
   }
   for (const ScreenshotRequest& r : o.screenshots)
     if (r.t >= double(mode.steps_total()) * mode.dt())
-      usage_error("fly", "--screenshot at t = " + std::to_string(r.t) + " s is beyond the " +
-                             "flight's end (" +
-                             std::to_string(double(mode.steps_total()) * mode.dt()) + " s)");
+      usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
+                                 " s is beyond the flight's end (" +
+                                 seconds_text(double(mode.steps_total()) * mode.dt()) + " s)");
   const std::string source =
       flight->pilot.empty() ? std::string("the thesis's controller") : "pilot " + flight->pilot;
   std::optional<ScreenshotSink> screenshots;
   if (!o.screenshots.empty() && o.headless) {
     screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
     if (!screenshots->open(o.width, o.height, error)) {
-      std::fprintf(stderr, "mixpilot fly: --screenshot: %s\n", error.c_str());
+      std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
     session.add_sink(&*screenshots);
@@ -242,7 +250,7 @@ int run_fly(const FlyOptions& o) {
     WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force};
     WindowResult wr;
     if (!fly_window(session, ui::scene_of(mode, source), wo, wr, error)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
     }
     realtime = RealtimeStats{mode.steps_done(), wr.deadline_misses, wr.worst_lateness_us,
@@ -269,7 +277,7 @@ int run_fly(const FlyOptions& o) {
   const bool stopped = interrupted() && !mode.finished();
 
   if (!o.record.empty() && !recorder.close(error, stopped)) {
-    std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     status = kExitError;
   }
   std::fputs(mode.summary().c_str(), stdout);
@@ -288,13 +296,13 @@ int run_fly(const FlyOptions& o) {
                                               : with_lost_fields(mode.metrics(), mode);
     const std::string json = to_json(report_labels(*flight, stopped), metrics) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
     }
   }
   if (screenshots) {
     if (!screenshots->finish(error)) {
-      std::fprintf(stderr, "mixpilot fly: %s\n", error.c_str());
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
     }
     for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
@@ -308,7 +316,7 @@ int run_fly(const FlyOptions& o) {
   if (check && status == kExitOk) {
     const std::string diff = check->first_difference(mode.steps_done());
     if (!diff.empty()) {
-      std::fprintf(stderr, "mixpilot fly: the replay of %s differs from the recording: %s\n",
+      std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n", o.command,
                    o.pilot.c_str(), diff.c_str());
       if (!o.allow_mismatch) return kExitReplayMismatch;
     } else {
@@ -325,7 +333,7 @@ int fly_command(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
     const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("fly", std::string(a) + " needs a value");
+      if (i + 1 >= argc) usage_error(o.command, std::string(a) + " needs a value");
       return argv[++i];
     };
     if (a == "-h" || a == "--help") {
@@ -341,7 +349,7 @@ int fly_command(int argc, char** argv) {
       const std::string v = value();
       o.duration = parse_seconds(v, kMaxDuration);
       if (!o.duration)
-        usage_error("fly", "--duration expects a positive number of seconds up to 3600, got '" +
+        usage_error(o.command, "--duration expects a positive number of seconds up to 3600, got '" +
                                v + "'");
     } else if (a == "--record") {
       o.record = value();
@@ -351,13 +359,13 @@ int fly_command(int argc, char** argv) {
       const std::string v = value();
       const auto shot = parse_screenshot(v);
       if (!shot)
-        usage_error("fly", "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, got '" +
+        usage_error(o.command, "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, got '" +
                                v + "'");
       o.screenshots.push_back(*shot);
     } else if (a == "--size") {
       const std::string v = value();
       if (!parse_size(v, o.width, o.height))
-        usage_error("fly", "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+        usage_error(o.command, "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
     } else if (a == "--realtime") {
       o.realtime = true;
     } else if (a == "--exit-at-end") {
@@ -367,11 +375,73 @@ int fly_command(int argc, char** argv) {
     } else if (a == "--force") {
       o.force = true;
     } else {
-      usage_error("fly", "unknown option '" + std::string(a) + "'");
+      usage_error(o.command, "unknown option '" + std::string(a) + "'");
     }
   }
-  if (o.realtime && !o.headless) usage_error("fly", "--realtime is for --headless runs (a window is always real time)");
-  if (o.exit_at_end && o.headless) usage_error("fly", "--exit-at-end is for the window");
+  if (o.realtime && !o.headless) usage_error(o.command, "--realtime is for --headless runs (a window is always real time)");
+  if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
+  return run_fly(o);
+}
+
+constexpr const char* kReplayUsage =
+    "usage: mixpilot replay FILE.mcap [--headless] [options]\n"
+    "\n"
+    "Shows a recording of any mode: its session is flown again from the embedded scenario with\n"
+    "the recorded pilot commands, which reproduces every recorded step bit for bit (checked;\n"
+    "a difference exits 3), in the window in real time or headless as fast as possible.\n"
+    "\n"
+    "  --headless         no window (with --screenshot: what the window shows at time T)\n"
+    "  --screenshot T:FILE.png  as for fly; repeatable\n"
+    "  --size WxH         screenshot or window size (default 1280x720)\n"
+    "  --exit-at-end      window: start at once and close the window at the end\n"
+    "  --force            overwrite existing screenshot files\n"
+    "  -h, --help         show this help\n"
+    "\n"
+    "exit status: 0 done, 1 unreadable recording, 2 usage, 3 the replay differs, 130 interrupted\n";
+
+int replay_command(int argc, char** argv) {
+  FlyOptions o;
+  o.replay = true;
+  o.command = "replay";
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error("replay", std::string(a) + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kReplayUsage, stdout);
+      return kExitOk;
+    } else if (a == "--headless") {
+      o.headless = true;
+    } else if (a == "--screenshot") {
+      const std::string v = value();
+      const auto shot = parse_screenshot(v);
+      if (!shot)
+        usage_error("replay", "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, "
+                              "got '" + v + "'");
+      o.screenshots.push_back(*shot);
+    } else if (a == "--size") {
+      const std::string v = value();
+      if (!parse_size(v, o.width, o.height))
+        usage_error("replay", "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+    } else if (a == "--exit-at-end") {
+      o.exit_at_end = true;
+    } else if (a == "--force") {
+      o.force = true;
+    } else if (!a.empty() && a[0] == '-') {
+      usage_error("replay", "unknown option '" + std::string(a) + "'");
+    } else if (o.pilot.empty()) {
+      o.pilot = std::string(a);
+    } else {
+      usage_error("replay", "one recording at a time (got '" + o.pilot + "' and '" +
+                                std::string(a) + "')");
+    }
+  }
+  if (o.pilot.empty()) usage_error("replay", "which recording? (mixpilot replay FILE.mcap)");
+  if (!o.pilot.ends_with(".mcap"))
+    usage_error("replay", "'" + o.pilot + "' is not a recording (FILE.mcap)");
+  if (o.exit_at_end && o.headless) usage_error("replay", "--exit-at-end is for the window");
   return run_fly(o);
 }
 

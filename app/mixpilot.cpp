@@ -20,7 +20,8 @@ constexpr const char* kUsage =
     "usage: mixpilot <command> [options]\n"
     "\n"
     "commands:\n"
-    "  fly     run a session headless as fast as possible and print a summary\n"
+    "  fly     fly a session in the window (real time), or headless as fast as possible\n"
+    "  replay  show a recording (any mode) in the window, or headless screenshots of it\n"
     "  score   replay and score recorded sessions\n"
     "  recover rebuild a recording cut short by a crash or kill -9\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (cmd == "fly") return fly_command(argc, argv);
+  if (cmd == "replay") return replay_command(argc, argv);
   if (cmd == "score") return score_command(argc, argv);
   if (cmd == "recover") return recover_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {

@@ -60,10 +60,11 @@ std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::st
     return make_mode(text, source, std::move(request), error);
   }
   auto mode = make_mode(text, source, std::move(request), error);
-  if (mode && !duration && std::int64_t(rec.states.size()) < mode->steps_total()) {
-    ModeRequest shorter;  // an interrupted run: as many steps as were recorded
-    shorter.duration = double(rec.states.size()) * mode->dt();
-    mode = make_mode(text, source, std::move(shorter), error);
+  if (mode && !duration && std::int64_t(rec.states.size()) != mode->steps_total()) {
+    // As many steps as were recorded: an interrupted run, or one flown with --duration.
+    ModeRequest same;
+    same.duration = double(rec.states.size()) * mode->dt();
+    mode = make_mode(text, source, std::move(same), error);
   }
   return mode;
 }

@@ -108,6 +108,18 @@ check "--screenshot writes a PNG" sh -c "head -c 8 '$work/shot.png' | od -c | gr
 check "--screenshot beyond the flight is a usage error" test $? -eq 2
 check "... and nothing is written" test ! -e "$work/late.png"
 
+# A recording flown longer than its scenario (--duration) replays at its own length, and
+# `replay` shows a recording of any mode headless.
+"$mixpilot" fly --scenario "$src/scenarios/obstacles_thrown_balls.toml" --headless --duration 4 \
+  --record "$work/ob.mcap" >/dev/null 2>&1
+"$mixpilot" score "$work/ob.mcap" >"$work/ob.score" 2>&1
+check "a recording longer than its scenario replays exactly" grep -q "exact" "$work/ob.score"
+"$mixpilot" replay "$work/ob.mcap" --headless --screenshot 3.5:"$work/ob.png" >"$work/ob.out" 2>&1
+check "replay --headless --screenshot exits 0" test $? -eq 0
+check "... writes the frame" test -s "$work/ob.png"
+"$mixpilot" replay "$work/nothing.txt" >"$work/r2" 2>&1
+check "replay of a non-recording is a usage error" test $? -eq 2
+
 # The window, under Xvfb where it is installed: flies, closes itself, and its frame shows the UI.
 if command -v xvfb-run >/dev/null 2>&1; then
   xvfb-run -a -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
