@@ -80,6 +80,7 @@ bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o
     started = true;
   }
   Telemetry sample = session.mode().telemetry();  // sized once; the ring copies into it
+  Metrics metrics;
   while (!glfwWindowShouldClose(window)) {
     glfwPollEvents();
     while (runner.telemetry().pop(sample)) history.push(sample);
@@ -92,6 +93,9 @@ bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o
                 : !runner.running() ? ui::RunState::finished
                 : runner.paused() ? ui::RunState::paused
                                   : ui::RunState::flying;
+    // The score card once the run is over (the runner's thread has ended: the mode is ours).
+    if (started && !runner.running() && metrics.empty()) metrics = session.mode().metrics();
+    run.metrics = metrics;
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include "app/offscreen.hpp"
 #include "core/modes/make_mode.hpp"
@@ -124,6 +125,29 @@ TEST_F(Ui, KeyThreeSwitchesToTopCamera) {
   ImGui::GetIO().KeysDown['3'] = false;
   EXPECT_EQ(st.camera, ui::Camera::top);
   EXPECT_NE(render(scene, f.history, st), chase);
+}
+
+// At the end of a flight the score card opens with every score field; not before.
+TEST_F(Ui, ScoreCardAtTheEnd) {
+  Flown f = fly("mi_helix.toml", 0.5, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  ui::RunInfo run;
+  run.state = ui::RunState::flying;
+  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+  const ImGuiWindow* card = ImGui::FindWindowByName("Score card");
+  EXPECT_TRUE(card == nullptr || !card->Active);
+  run.state = ui::RunState::finished;
+  run.metrics = f.mode->metrics();
+  ASSERT_FALSE(run.metrics.empty());
+  bool active = false;
+  screen_.frame([&] {
+    (void)ui::draw_screen(scene, f.history, run, st);
+    card = ImGui::FindWindowByName("Score card");
+    active = card && card->Active;
+  });
+  EXPECT_TRUE(active);
 }
 
 // Every mode renders, and its view is not empty: many pixels differ from the background.

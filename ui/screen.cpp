@@ -115,11 +115,63 @@ void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVe
   const double dev = s ? channel_value(*s, "deviation") : 0.0;
   ImGui::PushFont(mono_font());
   if (sc.mode == ModeKind::mixed_initiative)
-    ImGui::Text("deviation %.3f m (r %.2f)   in B %5.1f %%", dev, sc.ball_radius,
-                n ? 100.0 * double(in_ball) / double(n) : 100.0);
+    ImGui::Text("deviation %.3f m (r %.2f)   in B %5.1f %% of the last %.0f s", dev,
+                sc.ball_radius,
+                n ? 100.0 * double(in_ball) / double(n) : 100.0,
+                n ? h.newest().t - h[0].t + sc.dt : 0.0);
   ImGui::Text("RTI %5.0f us   fallbacks %lld   deadline misses %lld", s ? s->stats.total_us : 0.0,
               static_cast<long long>(fallbacks), static_cast<long long>(run.deadline_misses));
   ImGui::PopFont();
+  ImGui::End();
+}
+
+// What each score field means (README, Scoring), for the score card.
+const char* meaning(const std::string& key) {
+  static const std::pair<const char*, const char*> kMeanings[] = {
+      {"duration_s", "time flown [s]"},
+      {"progress", "share of the reference flown"},
+      {"time_in_ball", "share of the time inside the ball B"},
+      {"max_deviation_m", "largest distance from the reference [m]"},
+      {"rms_deviation_m", "RMS distance from the reference [m]"},
+      {"mean_lambda", "mean authority of the pilot (1: all pilot)"},
+      {"min_lambda", "least authority of the pilot"},
+      {"collisions", "contacts with obstacles, walls or floor"},
+      {"min_clearance_m", "closest approach to an obstacle [m]"},
+      {"override_rms", "RMS of what the MPC changed in the pilot's tilt [rad]"},
+      {"stick_smoothness", "RMS change of the pilot's command per step [rad]"},
+      {"rti_median_us", "median RTI time per step [us]"},
+      {"rti_p99_us", "99th percentile RTI time [us]"},
+      {"deadline_misses", "steps whose RTI time exceeded the control period"},
+      {"fallbacks", "steps that applied the previous solution's input"},
+      {"skill", "the score: progress x quality / (1 + collisions), 0-100"},
+      {"lost", "1: the vehicle was lost"},
+      {"lost_at_s", "when it was lost [s]"},
+  };
+  for (const auto& [k, v] : kMeanings)
+    if (key == k) return v;
+  return "";
+}
+
+void score_card(const RunInfo& run, ImVec2 display) {
+  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  ImGui::Begin("Score card", nullptr,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
+  if (ImGui::BeginTable("##score", 3, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    for (const auto& [key, value] : run.metrics) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(key.c_str());
+      ImGui::TableNextColumn();
+      ImGui::PushFont(mono_font());
+      ImGui::Text("%10.4g", value);
+      ImGui::PopFont();
+      ImGui::TableNextColumn();
+      ImGui::TextDisabled("%s", meaning(key));
+    }
+    ImGui::EndTable();
+  }
   ImGui::End();
 }
 
@@ -169,6 +221,7 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   ImGui::Begin("##plots", nullptr, kPane);
   draw_plots(sc, h, ui);
   ImGui::End();
+  if (!run.metrics.empty()) score_card(run, d);
   keys(ui, req, run);
   return req;
 }

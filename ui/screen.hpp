@@ -20,6 +20,7 @@ struct RunInfo {
   std::int64_t deadline_misses = 0;
   bool recording = false;
   std::string message;           // a line for the status area ("" none)
+  Metrics metrics;               // the score card at the end of a flight (empty: none yet)
 };
 
 // The UI's own state: kept by the app between frames, changed only by the UI.
