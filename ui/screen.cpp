@@ -82,8 +82,10 @@ void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiRequest& r
       req.toggle_pause = true;
   }
   ImGui::SameLine();
-  if (ImGui::Button("Restart (R)")) req.restart = true;
-  ImGui::SameLine();
+  if (run.can_restart) {
+    if (ImGui::Button("Restart (R)")) req.restart = true;
+    ImGui::SameLine();
+  }
   for (double sp : {0.25, 0.5, 1.0}) {
     char label[16];
     std::snprintf(label, sizeof label, "%gx", sp);
@@ -179,7 +181,7 @@ void keys(UiState& ui, UiRequest& req, const RunInfo& run) {
   if (ImGui::GetIO().WantCaptureKeyboard) return;
   if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Space)))
     (run.state == RunState::ready ? req.start : req.toggle_pause) = true;
-  if (ImGui::IsKeyPressed('R')) req.restart = true;
+  if (ImGui::IsKeyPressed('R') && run.can_restart) req.restart = true;
   if (ImGui::IsKeyPressed('1')) ui.camera = Camera::chase;
   if (ImGui::IsKeyPressed('2')) ui.camera = Camera::orbit;
   if (ImGui::IsKeyPressed('3')) ui.camera = Camera::top;

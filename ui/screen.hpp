@@ -19,6 +19,7 @@ struct RunInfo {
   double speed = 1.0;            // real-time factor (slow motion < 1)
   std::int64_t deadline_misses = 0;
   bool recording = false;
+  bool can_restart = false;      // the app can start the flight again (Restart, R)
   std::string message;           // a line for the status area ("" none)
   Metrics metrics;               // the score card at the end of a flight (empty: none yet)
 };
