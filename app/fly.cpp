@@ -35,7 +35,8 @@ constexpr double kMaxDuration = 3600.0;  // [s] --duration: memory and time stay
 constexpr const char* kFlyUsage =
     "usage: mixpilot fly --scenario FILE --pilot PILOT [--headless] [options]\n"
     "\n"
-    "Runs one session of the scenario as fast as possible and prints a short summary. ^C ends\n"
+    "Flies one session of the scenario in a window, in real time, or with --headless as fast\n"
+    "as possible (or paced by the clock with --realtime), and prints a short summary. ^C ends\n"
     "the flight at the next step: the recording and report then hold what was flown.\n"
     "\n"
     "  --scenario FILE    scenario file (TOML, docs/scenario-format.md); optional when PILOT is\n"
@@ -58,7 +59,7 @@ constexpr const char* kFlyUsage =
     "  --screenshot T:FILE.png  write what the window would show at simulated time T (the\n"
     "                     step with t_k <= T < t_k + dt), rendered offscreen with EGL;\n"
     "                     repeatable\n"
-    "  --size WxH         screenshot size in pixels (default 1280x720)\n"
+    "  --size WxH         screenshot and window size in pixels (default 1280x720)\n"
     "  --force            overwrite existing --record, --report and --screenshot files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
@@ -197,6 +198,10 @@ std::string seconds_text(double t) {
 
 int run_fly(const FlyOptions& o) {
   std::string error;
+  if (!o.headless && !window_available(error)) {  // before any output is opened
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
   if (!check_outputs(o, error)) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return kExitError;

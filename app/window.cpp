@@ -42,6 +42,15 @@ std::string frame_png(int w, int h) {
 
 }  // namespace
 
+bool window_available(std::string& error) {
+  if (!glfwInit()) {
+    error = "cannot open a window (" + glfw_error() + "); use --headless";
+    return false;
+  }
+  glfwTerminate();
+  return true;
+}
+
 bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o,
                 WindowResult& result, std::string& error) {
   if (!glfwInit()) {
@@ -81,7 +90,7 @@ bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o
   }
   Telemetry sample = session.mode().telemetry();  // sized once; the ring copies into it
   Metrics metrics;
-  while (!glfwWindowShouldClose(window)) {
+  while (!glfwWindowShouldClose(window) && !interrupted()) {  // ^C ends the flight as headless
     glfwPollEvents();
     while (runner.telemetry().pop(sample)) history.push(sample);
     const RealtimeStats st = runner.stats();

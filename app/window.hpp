@@ -27,6 +27,9 @@ struct WindowResult {
   std::vector<std::string> screenshots;  // written
 };
 
+// Whether a window can be opened here (a display and GLFW); false with the reason.
+[[nodiscard]] bool window_available(std::string& error);
+
 // Flies `session` in a window until the run ends (with exit_at_end) or the window is closed.
 // False with the reason when no window can be opened (no display) or a screenshot fails.
 [[nodiscard]] bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o,

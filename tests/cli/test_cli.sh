@@ -120,6 +120,13 @@ check "... writes the frame" test -s "$work/ob.png"
 "$mixpilot" replay "$work/nothing.txt" >"$work/r2" 2>&1
 check "replay of a non-recording is a usage error" test $? -eq 2
 
+# No display: the window's absence is said before anything is written.
+env -u DISPLAY -u WAYLAND_DISPLAY "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
+  --pilot novice --record "$work/nodisplay.mcap" >"$work/nd.out" 2>&1
+check "no display: fly without --headless exits 1" test $? -eq 1
+check "... says to use --headless" grep -q "use --headless" "$work/nd.out"
+check "... and writes nothing" test -z "$(ls "$work" | grep nodisplay)"
+
 # The window, under Xvfb where it is installed: flies, closes itself, and its frame shows the UI.
 if command -v xvfb-run >/dev/null 2>&1; then
   xvfb-run -a -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
