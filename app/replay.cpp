@@ -43,6 +43,14 @@ std::string in_embedded_scenario(const std::string& path, const std::string& err
 
 namespace {
 
+// The steps whose RTI solve overran its deadline in the recorded (real-time) flight.
+std::vector<std::int64_t> recorded_overruns(const RecordingContents& rec) {
+  std::vector<std::int64_t> steps;
+  for (std::size_t j = 0; j < rec.channels.size(); ++j)
+    if (rec.channels[j].events & kEventOverrun) steps.push_back(std::int64_t(j));
+  return steps;
+}
+
 std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
@@ -75,6 +83,8 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
   auto mode = replay_mode_of(rec, path, text, source, duration, error);
+  // What depended on the wall clock is replayed as recorded: the overruns' fallbacks.
+  if (mode) mode->force_overruns(recorded_overruns(rec));
   const auto embedded = rec.metadata.find("scenario");
   if (!mode && embedded != rec.metadata.end() && embedded->second == text)
     error = in_embedded_scenario(path, error);

@@ -15,7 +15,8 @@
 namespace mixpilot::cli {
 namespace {
 
-RecordingContents record(const std::string& scenario, double seconds, const char* pilot) {
+RecordingContents record(const std::string& scenario, double seconds, const char* pilot,
+                         std::vector<std::int64_t> overruns = {}) {
   std::string error, text;
   EXPECT_TRUE(read_text_file(scenario, text, error)) << error;
   ModeRequest request;
@@ -28,6 +29,8 @@ RecordingContents record(const std::string& scenario, double seconds, const char
   EXPECT_TRUE(sink.open(path, *mode, {to_string(mode->kind()), text, scenario, 1, pilot ? pilot : ""},
                         error))
       << error;
+  // Overruns as a real-time run would have them where the clock said so (SPEC §4).
+  mode->force_overruns(std::move(overruns));
   Session session(*mode);
   session.add_sink(&sink);
   session.run();
@@ -75,6 +78,33 @@ TEST(ReplayCheck, AMissingStepIsCaught) {
   RecordingContents rec = record(kMi, 1.5, "novice");
   rec.states.pop_back();
   EXPECT_NE(replay(rec, kMi), "");
+}
+
+// A step whose solve overran (SPEC §4) applies the previous solution's next input and is
+// recorded as such; the replay reproduces it, so the recording replays bit for bit — and
+// would not if the replay ignored the recorded overruns.
+TEST(ReplayCheck, RecordedOverrunsAreReplayed) {
+  for (const std::string& scenario :
+       {kMi, std::string(MIXPILOT_SOURCE_DIR "/scenarios/obstacles_cluttered.toml"),
+        std::string(MIXPILOT_SOURCE_DIR "/scenarios/tracking_helix.toml"),
+        std::string(MIXPILOT_SOURCE_DIR "/scenarios/pendubot_swingup.toml")}) {
+    const bool mi = scenario == kMi;
+    const RecordingContents rec = record(scenario, 0.6, mi ? "novice" : nullptr, {5, 6, 17});
+    int overruns = 0;
+    for (std::size_t j = 0; j < rec.channels.size(); ++j) {
+      const bool overrun = (rec.channels[j].events & kEventOverrun) != 0;
+      overruns += overrun ? 1 : 0;
+      if (overrun) {
+        EXPECT_TRUE(rec.channels[j].events & kEventFallback) << scenario << " step " << j;
+      }
+    }
+    EXPECT_EQ(overruns, 3) << scenario;
+    EXPECT_EQ(replay(rec, scenario), "") << scenario;
+    // Without the recorded overruns the replay departs from the recording.
+    RecordingContents stripped = rec;
+    for (auto& c : stripped.channels) c.events &= ~std::uint32_t(kEventOverrun);
+    EXPECT_NE(replay(stripped, scenario), "") << scenario;
+  }
 }
 
 TEST(ReplayCheck, OtherModesReplayToo) {

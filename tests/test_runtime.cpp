@@ -57,6 +57,26 @@ std::unique_ptr<Mode> short_flight(double seconds) {
   return mode;
 }
 
+// A deadline no solve can meet: every step is an overrun, handled as a fallback (SPEC §4);
+// without a deadline (as-fast-as-possible runs) none is.
+TEST(RealtimeRunner, ASolveOverItsDeadlineFallsBack) {
+  for (const double deadline_us : {0.0, 1e-6}) {
+    auto mode = short_flight(0.15);
+    ASSERT_TRUE(mode);
+    mode->set_deadline_us(deadline_us);
+    int overruns = 0, steps = 0;
+    while (mode->step()) {
+      ++steps;
+      const std::uint32_t e = mode->telemetry().events;
+      overruns += (e & kEventOverrun) ? 1 : 0;
+      if (e & kEventOverrun) {
+        EXPECT_TRUE(e & kEventFallback);
+      }
+    }
+    EXPECT_EQ(overruns, deadline_us > 0 ? steps : 0) << "deadline " << deadline_us << " us";
+  }
+}
+
 // A real-time run flies every step of the mode and hands each one over, in order.
 TEST(RealtimeRunner, FliesEveryStepAndHandsEachOver) {
   auto mode = short_flight(0.3);

@@ -55,6 +55,7 @@ class MiController {
   const Eigen::Matrix3Xd& predicted_positions() const { return predicted_; }
   const Eigen::Matrix3Xd& reference_positions() const { return reference_; }
   const RtiSolver& rti() const { return rti_; }
+  RtiSolver& rti() { return rti_; }
   const models::MikroKopter& model() const { return model_; }
   const MiControllerSettings& settings() const { return settings_; }
   int constrained_obstacles() const { return num_obstacles_; }

@@ -139,6 +139,7 @@ bool MiMode::step() {
   const JoyInput* joy = pilot_->joy();
   s.has_joy = joy != nullptr;
   if (joy) s.joy = *joy;
+  if (forced_overrun(step_)) controller_.rti().force_overrun_next();
   controller_.step(t, s.x_measured, s.pilot);
   s.solved = true;
   s.lambda = controller_.lambda();
@@ -153,6 +154,7 @@ bool MiMode::step() {
   u_delay_[std::size_t(step_) % n] = controller_.control();
   s.u = u_delay_[std::size_t(step_ + 1) % n];
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
+  if (s.stats.overrun) s.events |= kEventOverrun;
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();
 

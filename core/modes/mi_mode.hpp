@@ -42,6 +42,7 @@ class MiMode final : public Mode {
   bool lost() const override { return lost_; }
   double lost_at() const override { return lost_at_; }
   const Telemetry& telemetry() const override { return telemetry_; }
+  void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
   Metrics metrics() const override { return to_metrics(score()); }
   std::string summary() const override;
 

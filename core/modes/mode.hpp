@@ -33,6 +33,7 @@ enum ModeEvent : std::uint32_t {
   kEventViolation = 1u << 2,  // a constraint of the mode was violated (clearance, velocity bound)
   kEventSwitch = 1u << 3,     // the active controller changed (Pendubot NMPC ↔ LQR)
   kEventLost = 1u << 4,       // the vehicle was lost (non-finite or far away): the run ends
+  kEventOverrun = 1u << 5,    // the RTI solve overran its deadline: handled as a fallback
 };
 
 // A named scalar of one step, for plots that do not know the mode. Names and units are string
@@ -107,6 +108,29 @@ class Mode {
   virtual Metrics metrics() const = 0;
   // A few human-readable lines about the run so far, for the terminal.
   virtual std::string summary() const = 0;
+
+  // Real-time runs (SPEC §4): a control step whose RTI solve takes longer than `deadline_us`
+  // of wall time is discarded as a fallback and raises kEventOverrun. 0 (the default): no
+  // deadline, so runs not paced by a clock stay deterministic.
+  virtual void set_deadline_us(double deadline_us) = 0;
+  // A replay: the RTI solves of steps `steps` (ascending step indices) are overruns, as they
+  // were in the recorded flight, so it is reproduced bit for bit.
+  void force_overruns(std::vector<std::int64_t> steps) {
+    forced_overruns_ = std::move(steps);
+    next_forced_ = 0;
+  }
+
+ protected:
+  // Whether step k's solve is a recorded overrun (asked with increasing k).
+  bool forced_overrun(std::int64_t k) {
+    while (next_forced_ < forced_overruns_.size() && forced_overruns_[next_forced_] < k)
+      ++next_forced_;
+    return next_forced_ < forced_overruns_.size() && forced_overruns_[next_forced_] == k;
+  }
+
+ private:
+  std::vector<std::int64_t> forced_overruns_;
+  std::size_t next_forced_ = 0;
 };
 
 }  // namespace mixpilot

@@ -128,6 +128,7 @@ bool ObstacleMode::step() {
   problem_->set_reference(rti_.data(), ref, k);
   problem_->set_obstacles(rti_.data(), scenario_.world, t);
   rti_.prepare();
+  if (forced_overrun(step_)) rti_.force_overrun_next();
   rti_.feedback(x_);
   const RtiStats& st = rti_.stats();
   rti_us_.push_back(st.total_us);
@@ -153,6 +154,7 @@ bool ObstacleMode::step() {
   check_control_instant(t + settings_.dt);
   ++step_;
   s.events = st.status == RtiStatus::fallback ? kEventFallback : 0u;
+  if (st.overrun) s.events |= kEventOverrun;
   if (violated) s.events |= kEventViolation;
   set_channels(distance, std::sqrt(sq_error));
   if (!x_.allFinite()) {  // never hand a non-finite state to anyone

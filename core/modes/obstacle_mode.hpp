@@ -77,6 +77,7 @@ class ObstacleMode final : public Mode {
   bool lost() const override { return lost_; }
   double lost_at() const override { return lost_at_; }
   const Telemetry& telemetry() const override { return telemetry_; }
+  void set_deadline_us(double d) override { rti_.set_deadline_us(d); }
   // min_distance_m, min_margin_m, min_distance_control_m, clearance_m, violations,
   // tracking_rms_m, final_error_m, rti_median_us, rti_p99_us, fallbacks, form (0 lcl,
   // 1 squared), steps.

@@ -228,6 +228,7 @@ double PendubotMode::nmpc() {
   }
   problem_->set_reference(rti_.data(), ref, k);
   rti_.prepare();
+  if (forced_overrun(step_)) rti_.force_overrun_next();
   rti_.feedback(x0_);
   const double u = rti_.control()(0);
   rti_.shift();
@@ -305,6 +306,7 @@ void PendubotMode::set_telemetry(double u, bool switched, double worst_violation
   if (switched) s.events |= kEventSwitch;
   if (worst_violation > 0) s.events |= kEventViolation;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
+  if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
   set_channels();
 }
 

@@ -151,6 +151,7 @@ void TrackingMode::control() {
     RtiSolver& rti = *rti_;
     problem_->set_reference(rti.data(), ref, int(k));
     rti.prepare();
+    if (forced_overrun(step_)) rti.force_overrun_next();
     rti.feedback(x0_);
     u_ = rti.control();
     s.solved = true;
@@ -265,6 +266,7 @@ void TrackingMode::set_telemetry() {
   for (int i = 0; i < 3; ++i) s.reference(i) = xr(i);
   s.events = 0;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
+  if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
   if (lost_) s.events |= kEventLost;
 }
 

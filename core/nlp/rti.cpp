@@ -260,7 +260,10 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
                                  : QpWarmStart::cold;
     stats_.qp_status = qp_solver().solve(qp_, qp_sol_, warm);
     stats_.qp_iterations = qp_sol_.iterations;
-    if (stats_.qp_status == QpStatus::success) {
+    const double elapsed_us =
+        stats_.integration_us + stats_.linearization_us + micros_since(t0);
+    stats_.overrun = force_overrun_ || (deadline_us_ > 0.0 && elapsed_us > deadline_us_);
+    if (stats_.qp_status == QpStatus::success && !stats_.overrun) {
       for (int i = 0; i <= ocp_->N; ++i) traj_.x[i] += qp_sol_.x[i];
       for (int i = 0; i < ocp_->N; ++i) traj_.u[i] += qp_sol_.u[i];
       have_qp_solution_ = true;
@@ -268,7 +271,9 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
     }
   } else {
     stats_.qp_status = QpStatus::invalid_data;
+    stats_.overrun = false;
   }
+  force_overrun_ = false;
   if (status == RtiStatus::fallback) {
     ++stats_.fallbacks;
     have_qp_solution_ = false;

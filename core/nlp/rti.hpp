@@ -65,6 +65,9 @@ struct RtiStats {
   double qp_us = 0.0;             // QP solve
   double total_us = 0.0;          // prepare + feedback
   std::int64_t fallbacks = 0;     // running count since setup()
+  // The solve overran its deadline (or was told to): its step was discarded and the previous
+  // solution's next input applied (status fallback, SPEC §4).
+  bool overrun = false;
 };
 
 struct SqpResult {
@@ -110,6 +113,12 @@ class RtiSolver {
   RtiStatus feedback(const Eigen::Ref<const Eigen::VectorXd>& x0);
   void shift();
 
+  // SPEC §4: a control step whose prepare + feedback time exceeds `deadline_us` (0: none, the
+  // default, for runs not paced by a clock) is discarded after its QP, as when the QP fails.
+  void set_deadline_us(double deadline_us) { deadline_us_ = deadline_us; }
+  // The next feedback() is an overrun whatever its time: a replay reproduces a recorded one.
+  void force_overrun_next() { force_overrun_ = true; }
+
   // Iterates prepare/feedback from the current trajectory until ‖(Δx, Δu)‖∞ ≤ tol.
   SqpResult sqp(const Eigen::Ref<const Eigen::VectorXd>& x0, int max_iterations, double tol);
 
@@ -147,6 +156,8 @@ class RtiSolver {
   RtiStats stats_{};
   bool prepared_ = false;
   bool have_qp_solution_ = false;
+  double deadline_us_ = 0.0;
+  bool force_overrun_ = false;
 };
 
 }  // namespace mixpilot

@@ -6,6 +6,8 @@ namespace mixpilot {
 
 RealtimeRunner::RealtimeRunner(Session& session, std::size_t ring_capacity) : session_(&session) {
   ring_.setup(ring_capacity, session.mode().telemetry());
+  // SPEC §4: a solve must end within the control period, else its step falls back.
+  session.mode().set_deadline_us(1e6 * session.mode().dt());
 }
 
 RealtimeRunner::~RealtimeRunner() { stop(); }

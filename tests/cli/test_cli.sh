@@ -129,7 +129,8 @@ check "... and writes nothing" test -z "$(ls "$work" | grep nodisplay)"
 
 # The window, under Xvfb where it is installed: flies, closes itself, and its frame shows the UI.
 if command -v xvfb-run >/dev/null 2>&1; then
-  xvfb-run -a -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
+  # A random first display number: parallel runs on one machine do not race for :99.
+  xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
     --pilot novice --duration 2 --exit-at-end --screenshot 1.5:"$work/window.png" >"$work/win.out" 2>&1
   check "the window flies and closes itself" test $? -eq 0
   check "... with a frame of it" test -s "$work/window.png"
