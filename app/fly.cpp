@@ -331,6 +331,29 @@ int run_fly(const FlyOptions& o) {
   return status;
 }
 
+// --screenshot, --size and --exit-at-end, shared by fly and replay: true when `a` is one of them
+// (its value taken through `value`).
+template <class Value>
+bool parse_view_option(std::string_view a, const Value& value, FlyOptions& o) {
+  if (a == "--screenshot") {
+    const std::string v = value();
+    const auto shot = parse_screenshot(v);
+    if (!shot)
+      usage_error(o.command,
+                  "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, got '" + v + "'");
+    o.screenshots.push_back(*shot);
+  } else if (a == "--size") {
+    const std::string v = value();
+    if (!parse_size(v, o.width, o.height))
+      usage_error(o.command, "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+  } else if (a == "--exit-at-end") {
+    o.exit_at_end = true;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int fly_command(int argc, char** argv) {
@@ -360,21 +383,9 @@ int fly_command(int argc, char** argv) {
       o.record = value();
     } else if (a == "--report") {
       o.report = value();
-    } else if (a == "--screenshot") {
-      const std::string v = value();
-      const auto shot = parse_screenshot(v);
-      if (!shot)
-        usage_error(o.command, "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, got '" +
-                               v + "'");
-      o.screenshots.push_back(*shot);
-    } else if (a == "--size") {
-      const std::string v = value();
-      if (!parse_size(v, o.width, o.height))
-        usage_error(o.command, "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+    } else if (parse_view_option(a, value, o)) {
     } else if (a == "--realtime") {
       o.realtime = true;
-    } else if (a == "--exit-at-end") {
-      o.exit_at_end = true;
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
     } else if (a == "--force") {
@@ -419,19 +430,7 @@ int replay_command(int argc, char** argv) {
       return kExitOk;
     } else if (a == "--headless") {
       o.headless = true;
-    } else if (a == "--screenshot") {
-      const std::string v = value();
-      const auto shot = parse_screenshot(v);
-      if (!shot)
-        usage_error("replay", "--screenshot expects T:FILE.png with T a time in seconds ≥ 0, "
-                              "got '" + v + "'");
-      o.screenshots.push_back(*shot);
-    } else if (a == "--size") {
-      const std::string v = value();
-      if (!parse_size(v, o.width, o.height))
-        usage_error("replay", "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
-    } else if (a == "--exit-at-end") {
-      o.exit_at_end = true;
+    } else if (parse_view_option(a, value, o)) {
     } else if (a == "--force") {
       o.force = true;
     } else if (!a.empty() && a[0] == '-') {

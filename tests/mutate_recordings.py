@@ -29,7 +29,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from mutate_scenarios import finite_json, limit_memory
+from mutate_scenarios import Tally, finite_json, limit_memory
 
 MAGIC = b"\x89MCAP0\r\n"
 CHUNK, DATA_END, FOOTER = 0x06, 0x0F, 0x02
@@ -187,8 +187,7 @@ def main():
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
 
-    counts = {k: 0 for k in ("clean error", "accepted", "crash", "hang", "nonsense")}
-    bad = []
+    tally = Tally(args.verbose)
     path = work / "variant.mcap"
     report = work / "report.json"
     recovered = work / "recovered.mcap"
@@ -202,18 +201,9 @@ def main():
             for stale in (report, recovered):
                 stale.unlink(missing_ok=True)
             kind, why = run(cmd, args.timeout, memory, path, rep)
-            counts[kind] += 1
-            if args.verbose:
-                print(f"{kind:12s} {cmd_name} {label}: {why}")
-            if kind in ("crash", "hang", "nonsense"):
-                bad.append(f"{kind}: {cmd_name} {label}: {why}")
+            tally.add(kind, f"{cmd_name} {label}", why)
     shutil.rmtree(work, ignore_errors=True)
-    for b in bad:
-        print(b)
-    tried = sum(counts.values())
-    print(f"tried {tried} / clean error {counts['clean error']} / accepted {counts['accepted']} "
-          f"/ crash {counts['crash']} / hang {counts['hang']} / nonsense {counts['nonsense']}")
-    return 1 if bad else 0
+    return tally.report()
 
 
 if __name__ == "__main__":

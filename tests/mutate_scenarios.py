@@ -202,6 +202,34 @@ def fly(binary, scenario, workdir, duration, timeout, memory, allowed_nulls=froz
     return "nonsense", f"exit {p.returncode} with message {err[:200]!r}"
 
 
+class Tally:
+    """Counts of each class of run; the bad ones listed; the summary line of a mutation run."""
+
+    KINDS = ("clean error", "accepted", "crash", "hang", "nonsense")
+
+    def __init__(self, verbose=False):
+        self.counts = {k: 0 for k in self.KINDS}
+        self.bad = []
+        self.verbose = verbose
+
+    def add(self, kind, label, why):
+        self.counts[kind] += 1
+        if self.verbose:
+            print(f"{kind:12s} {label}: {why}")
+        if kind in ("crash", "hang", "nonsense"):
+            self.bad.append(f"{kind}: {label}: {why}")
+
+    def report(self):
+        """Prints the bad runs and the counts; the exit status (1 if any run was bad)."""
+        for b in self.bad:
+            print(b)
+        c = self.counts
+        print(f"tried {sum(c.values())} / clean error {c['clean error']} / accepted "
+              f"{c['accepted']} / crash {c['crash']} / hang {c['hang']} / nonsense "
+              f"{c['nonsense']}")
+        return 1 if self.bad else 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mixpilot", default="build/release/app/mixpilot")
@@ -248,9 +276,6 @@ def main():
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
 
-    counts = {k: 0 for k in ("clean error", "accepted", "crash", "hang", "nonsense")}
-    bad = []
-
     def run(idx_case):
         idx, (stem, label, text, csv) = idx_case
         d = work / f"run{idx % max(1, args.jobs)}"
@@ -282,19 +307,11 @@ def main():
             results = [r for rs in ex.map(lambda s: [run(c) for c in s], slots) for r in rs]
     else:
         results = [run(c) for c in enumerate(cases)]
+    tally = Tally(args.verbose)
     for stem, label, (kind, why) in results:
-        counts[kind] += 1
-        if args.verbose:
-            print(f"{kind:12s} {stem}: {label}: {why}")
-        if kind in ("crash", "hang", "nonsense"):
-            bad.append(f"{kind}: {stem}: {label}: {why}")
+        tally.add(kind, f"{stem}: {label}", why)
     shutil.rmtree(work, ignore_errors=True)
-    for b in bad:
-        print(b)
-    print(f"tried {len(results)} / clean error {counts['clean error']} / accepted "
-          f"{counts['accepted']} / crash {counts['crash']} / hang {counts['hang']} / nonsense "
-          f"{counts['nonsense']}")
-    return 1 if bad else 0
+    return tally.report()
 
 
 if __name__ == "__main__":
