@@ -9,8 +9,11 @@
 
 #include "app/cli.hpp"
 #include "app/commands.hpp"
+#include "app/flight.hpp"
 #include "app/replay.hpp"
 #include "app/screenshot.hpp"
+#include "app/offscreen.hpp"
+#include "app/trainer.hpp"
 #include "app/window.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/modes/make_mode.hpp"
@@ -67,133 +70,66 @@ constexpr const char* kFlyUsage =
     "exit status: 0 done, 1 bad input or failure, 2 usage, 3 replay differs from the recording,\n"
     "130 interrupted\n";
 
-struct FlyOptions {
-  std::string scenario_path;
-  std::string pilot;
-  bool headless = false;
-  std::optional<double> duration;
-  std::string record;
-  std::string report;
-  bool allow_mismatch = false;
-  bool force = false;
-  std::vector<ScreenshotRequest> screenshots;
-  int width = 1280, height = 720;  // of the screenshots and the window
-  bool realtime = false;           // headless, paced by the wall clock
-  bool exit_at_end = false;        // window: start at once, close when the run is over
-  bool replay = false;             // `mixpilot replay`: a recording of any mode flown again
-  const char* command = "fly";     // for messages
-};
-
-// The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
-// --pilot, and the mode it names.
-struct Flight {
-  std::string scenario_text;
-  std::string scenario_source;  // for messages and relative paths
-  std::string scenario_file;    // the scenario's file, absolute (recorded as scenario_path)
-  std::optional<RecordingContents> recording;  // --pilot REC.mcap
-  std::unique_ptr<Mode> mode;
-  std::string pilot;  // mixed initiative: the pilot source's name
-};
-
-// Reads the scenario and, for a replay, the recording; on failure `status` may name a more
-// specific exit status than kExitError.
-std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
-  Flight f;
-  if (o.pilot.ends_with(".mcap")) {
-    f.recording = read_recording(o.pilot, error);
-    if (!f.recording) return std::nullopt;
-    if (!embedded_scenario(*f.recording, o.pilot, error)) return std::nullopt;
+// The window: the app (app/trainer.hpp) on the live flight or the replay the options name.
+int run_in_window(const FlyOptions& o) {
+  std::string error;
+  int status = kExitOk;
+  catch_interrupts();
+  Trainer app(o);
+  const bool opened = o.replay ? app.open_replay(o.pilot, error) : app.open_live(error, status);
+  if (!opened) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return status == kExitOk ? kExitError : status;
   }
-  if (!o.scenario_path.empty()) {
-    if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
-    f.scenario_source = o.scenario_path;
-    f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
-    if (f.recording && *embedded_scenario(*f.recording, o.pilot, error) != f.scenario_text &&
-        !o.allow_mismatch) {
-      error = o.scenario_path + " differs from the scenario embedded in " + o.pilot +
-              " (--allow-mismatch flies it anyway)";
-      status = kExitReplayMismatch;
-      return std::nullopt;
+  std::vector<std::string> shots;
+  const WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force};
+  const bool shown = run_window(app, wo, shots, error);
+  status = app.finish();
+  for (const std::string& path : shots) std::printf("  screenshot %s\n", path.c_str());
+  if (!shown) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    if (status == kExitOk) status = kExitError;
+  }
+  return interrupted() ? kExitInterrupted : status;
+}
+
+// `replay --headless`: the recording flown again into the app's tape, then each --screenshot
+// rendered as the window shows the replay at that time (transport bar included).
+int run_replay_headless(const FlyOptions& o) {
+  std::string error;
+  catch_interrupts();
+  Trainer app(o);
+  if (!app.open_replay(o.pilot, error)) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
+  std::optional<Offscreen> screen;
+  if (!o.screenshots.empty()) {
+    screen.emplace();
+    if (!screen->open(o.width, o.height, error)) {
+      std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
+      return kExitError;
     }
-  } else if (f.recording) {
-    f.scenario_text = *embedded_scenario(*f.recording, o.pilot, error);
-    f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
-    f.scenario_file = f.recording->metadata["scenario_path"];
-  } else {
-    usage_error(o.command, "--scenario FILE is required");
   }
-  return f;
-}
-
-std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status) {
-  status = kExitError;  // unless said otherwise below
-  std::optional<Flight> f = load_flight(o, error, status);
-  if (!f) return std::nullopt;
-  const auto kind_name = scenario_mode(f->scenario_text, f->scenario_source, error);
-  if (!kind_name) {
-    if (f->recording && o.scenario_path.empty()) error = in_embedded_scenario(o.pilot, error);
-    return std::nullopt;
+  app.load_replay();
+  if (interrupted()) return kExitInterrupted;
+  const double end = double(app.replay()->steps()) * app.replay()->dt();
+  int status = kExitOk;
+  for (const ScreenshotRequest& r : o.screenshots) {
+    if (r.t >= end)
+      usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
+                                 " s is beyond the recording's end (" + seconds_text(end) + " s)");
+    app.seek(r.t);
+    for (int f = 0; f < 2; ++f) screen->frame([&] { app.build_frame(0.0); });
+    if (!write_file(r.path, screen->png(), o.force, error)) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      status = kExitError;
+    } else {
+      std::printf("  screenshot %s\n", r.path.c_str());
+    }
   }
-  if (*kind_name != "mixed_initiative" && !o.pilot.empty() && !o.replay)
-    usage_error(o.command, "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
-                           " is " + *kind_name);
-  if (f->recording) {
-    f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
-                          o.duration, error);
-  } else {
-    ModeRequest request;
-    request.duration = o.duration;
-    request.pilot_name = o.pilot;
-    f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
-  }
-  if (!f->mode) return std::nullopt;
-  if (const auto* mi = dynamic_cast<const MiMode*>(f->mode.get())) f->pilot = mi->pilot().name();
-  status = kExitOk;
-  return f;
-}
-
-SessionInfo session_info(const Flight& f) {
-  SessionInfo info;
-  info.mode = to_string(f.mode->kind());
-  info.scenario = f.scenario_text;
-  info.scenario_path = f.scenario_file;
-  info.pilot = f.pilot;
-  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
-    info.seed = mi->scenario().plant.seed;
-  return info;
-}
-
-Labels report_labels(const Flight& f, bool was_interrupted) {
-  Labels labels = {{"mode", to_string(f.mode->kind())}, {"scenario", f.mode->scenario_name()}};
-  if (!f.pilot.empty()) labels.emplace_back("pilot", f.pilot);
-  if (was_interrupted) labels.emplace_back("interrupted", "true");
-  return labels;
-}
-
-// Output paths, checked before the flight: distinct, writable, and never over a special file,
-// nor over an existing file without --force. False with the reason.
-bool check_outputs(const FlyOptions& o, std::string& error) {
-  if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
-    usage_error(o.command, "--record and --report name the same file '" + o.record + "'");
-  for (const std::string* path : {&o.record, &o.report})
-    if (!path->empty() && !check_output_path(*path, o.force, error)) return false;
-  for (std::size_t i = 0; i < o.screenshots.size(); ++i) {
-    const std::string& shot = o.screenshots[i].path;
-    for (const std::string* other : {&o.record, &o.report})
-      if (!other->empty() && same_output_path(shot, *other))
-        usage_error(o.command, "--screenshot and another output name the same file '" + shot + "'");
-    for (std::size_t j = 0; j < i; ++j)
-      if (same_output_path(shot, o.screenshots[j].path))
-        usage_error(o.command, "two --screenshot options name the same file '" + shot + "'");
-    if (!check_output_path(shot, o.force, error)) return false;
-  }
-  return true;
-}
-
-std::string seconds_text(double t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", t);
-  return buf;
+  const int finished = app.finish();
+  return status != kExitOk ? status : finished;
 }
 
 int run_fly(const FlyOptions& o) {
@@ -207,6 +143,8 @@ int run_fly(const FlyOptions& o) {
     return kExitError;
   }
   int status = kExitOk;
+  if (!o.headless) return run_in_window(o);
+  if (o.replay) return run_replay_headless(o);
   std::optional<Flight> flight = prepare_flight(o, error, status);
   if (!flight) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
@@ -250,18 +188,7 @@ int run_fly(const FlyOptions& o) {
   catch_interrupts();
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<RealtimeStats> realtime;
-  std::vector<std::string> window_shots;
-  if (!o.headless) {
-    WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force};
-    WindowResult wr;
-    if (!fly_window(session, ui::scene_of(mode, source), wo, wr, error)) {
-      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-      status = kExitError;
-    }
-    realtime = RealtimeStats{mode.steps_done(), wr.deadline_misses, wr.worst_lateness_us,
-                             wr.worst_step_us};
-    window_shots = wr.screenshots;
-  } else if (o.realtime) {
+  if (o.realtime) {
     RealtimeRunner runner(session, 64);
     runner.start();
     Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
@@ -289,12 +216,7 @@ int run_fly(const FlyOptions& o) {
   const double flown = double(mode.steps_done()) * mode.dt();
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
-  if (realtime)
-    std::printf("  real time: %lld deadline misses; worst start lateness %.0f us, longest step "
-                "%.0f us (dt %.0f us)\n",
-                static_cast<long long>(realtime->deadline_misses), realtime->worst_lateness_us,
-                realtime->worst_step_us, 1e6 * mode.dt());
-  for (const std::string& path : window_shots) std::printf("  screenshot %s\n", path.c_str());
+  if (realtime) print_realtime(*realtime, mode.dt());
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
     const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)

@@ -24,6 +24,10 @@ class Offscreen {
   // `dt` is the frame's time step for ImGui [s].
   void frame(const std::function<void()>& build, float dt = 1.0f / 60.0f);
 
+  // One frame's layout and input only, nothing rendered: cheap, for tests that look for what
+  // lies under the mouse.
+  void layout(const std::function<void()>& build, float dt = 1.0f / 60.0f);
+
   // The last frame, RGBA, top row first: width × height × 4 bytes.
   std::vector<std::uint8_t> pixels() const;
   // The last frame as a PNG file's bytes.

@@ -10,10 +10,10 @@
 #include <stb/stb_image_write.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "app/cli.hpp"
-#include "core/runtime/realtime_runner.hpp"
 #include "ui/screen.hpp"
 #include "ui/theme.hpp"
 
@@ -51,8 +51,8 @@ bool window_available(std::string& error) {
   return true;
 }
 
-bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o,
-                WindowResult& result, std::string& error) {
+bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& written,
+                std::string& error) {
   if (!glfwInit()) {
     error = "cannot open a window (" + glfw_error() + "); use --headless";
     return false;
@@ -60,8 +60,7 @@ bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  GLFWwindow* window = glfwCreateWindow(o.width, o.height, ("mixpilot — " + scene.title).c_str(),
-                                        nullptr, nullptr);
+  GLFWwindow* window = glfwCreateWindow(o.width, o.height, "mixpilot", nullptr, nullptr);
   if (!window) {
     error = "cannot open an OpenGL 3.3 window (" + glfw_error() + "); use --headless";
     glfwTerminate();
@@ -79,71 +78,42 @@ bool fly_window(Session& session, const ui::Scene& scene, const WindowOptions& o
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
-  RealtimeRunner runner(session, 8192);
-  ui::History history;
-  ui::UiState ui_state;
   std::vector<bool> shot(o.screenshots.size(), false);
-  bool started = false, ok = true;
-  if (o.exit_at_end) {
-    runner.start();
-    started = true;
-  }
-  Telemetry sample = session.mode().telemetry();  // sized once; the ring copies into it
-  Metrics metrics;
+  bool ok = true;
+  if (o.exit_at_end) app.start();
+  auto last = std::chrono::steady_clock::now();
+  std::string title;
   while (!glfwWindowShouldClose(window) && !interrupted()) {  // ^C ends the flight as headless
     glfwPollEvents();
-    while (runner.telemetry().pop(sample)) history.push(sample);
-    const RealtimeStats st = runner.stats();
-    ui::RunInfo run;
-    run.speed = runner.speed();
-    run.deadline_misses = st.deadline_misses;
-    run.state = !started ? ui::RunState::ready
-                : session.mode().lost() ? ui::RunState::lost
-                : !runner.running() ? ui::RunState::finished
-                : runner.paused() ? ui::RunState::paused
-                                  : ui::RunState::flying;
-    // The score card once the run is over (the runner's thread has ended: the mode is ours).
-    if (started && !runner.running() && metrics.empty()) metrics = session.mode().metrics();
-    run.metrics = metrics;
+    const auto now = std::chrono::steady_clock::now();
+    const double wall_dt = std::chrono::duration<double>(now - last).count();
+    last = now;
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
-    const ui::UiRequest req = ui::draw_screen(scene, history, run, ui_state);
+    app.build_frame(wall_dt);
     ImGui::Render();
-    if (req.start && !started) {
-      runner.start();
-      started = true;
-    }
-    if (req.toggle_pause && started) runner.set_paused(!runner.paused());
-    if (req.speed > 0) runner.set_speed(req.speed);
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     glViewport(0, 0, w, h);
     glClearColor(0.086f, 0.098f, 0.118f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    const double shown = app.shown_time();
     for (std::size_t i = 0; i < shot.size(); ++i) {
-      if (shot[i] || history.empty() || history.newest().t < o.screenshots[i].t) continue;
+      if (shot[i] || shown < o.screenshots[i].t) continue;
       shot[i] = true;
       std::string e;
       if (write_file(o.screenshots[i].path, frame_png(w, h), o.overwrite, e)) {
-        result.screenshots.push_back(o.screenshots[i].path);
+        written.push_back(o.screenshots[i].path);
       } else if (ok) {
         ok = false;
         error = e;
       }
     }
     glfwSwapBuffers(window);
-    if (o.exit_at_end && started && !runner.running() && history.size() > 0 &&
-        history.newest().step + 1 >= session.mode().steps_done())
-      break;
+    if (o.exit_at_end && app.over()) break;
   }
-  runner.stop();
-  const RealtimeStats st = runner.stats();
-  result.finished = session.mode().finished();
-  result.deadline_misses = st.deadline_misses;
-  result.worst_lateness_us = st.worst_lateness_us;
-  result.worst_step_us = st.worst_step_us;
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

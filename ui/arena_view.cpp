@@ -155,6 +155,12 @@ void draw_vehicle(ImDrawList* dl, const View& v, const Scene& sc, const Telemetr
 
 }  // namespace
 
+bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& ui, ImVec2 min,
+                      ImVec2 max, const Eigen::Vector3d& p, ImVec2& px) {
+  UiState copy = ui;
+  return make_view(sc, newest, copy, min, max).project(p, px);
+}
+
 void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
@@ -191,10 +197,10 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
   }
   // The trail of the last seconds, coloured by λ in mixed initiative.
   const double t0 = s.t - 6.0;
-  for (std::size_t i = 1; i < h.size(); ++i) {
+  for (std::size_t i = std::max<std::size_t>(1, h.first_at_or_after(t0) + 1); i < h.size(); ++i) {
     const Telemetry& a = h[i - 1];
     const Telemetry& b = h[i];
-    if (a.t < t0 || a.x.size() < 3) continue;
+    if (a.x.size() < 3) continue;
     const ImU32 c = sc.mode == ModeKind::mixed_initiative ? authority_colour(b.lambda) : colour::kPilot;
     line(dl, v, a.x.head<3>(), b.x.head<3>(), c, 3.0f);
   }

@@ -10,6 +10,10 @@ namespace mixpilot::ui {
 
 // 3D arena of the quadrotor modes; the mouse orbits and zooms when over it.
 void draw_arena(const Scene& scene, const History& history, UiState& ui, ImVec2 min, ImVec2 max);
+// Where draw_arena puts the world point `p` on screen, `newest` being the newest telemetry;
+// false when it is behind the camera.
+bool project_in_arena(const Scene& scene, const Telemetry& newest, const UiState& ui, ImVec2 min,
+                      ImVec2 max, const Eigen::Vector3d& p, ImVec2& px);
 // 2D side view of the Pendubot.
 void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec2 max);
 // The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour.
@@ -17,7 +21,15 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max);
 // Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
 // The thrust stick is centred on the hover rotor speed `hover`.
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
-// Rolling plots of the mode's channels.
+// Rolling plots of the mode's channels (frozen while ui.plots_paused).
 void draw_plots(const Scene& scene, const History& history, UiState& ui);
+// The session panel: scenario, pilot, trainee, record, start / restart (run.session).
+void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req);
+// A replay's transport bar: timeline with event ticks, play / pause, events, speeds (run.replay).
+void draw_transport(const RunInfo& run, UiRequest& req);
+// File → Open: a modal browser of scenarios and recordings while ui.open_dialog.open.
+void draw_open_dialog(UiState& ui, UiRequest& req);
+// Fills the dialog's entries from its folder.
+void list_folder(OpenDialog& dialog);
 
 }  // namespace mixpilot::ui

@@ -88,4 +88,14 @@ void History::push(const Telemetry& s) {
   size_ = std::min(size_ + 1, capacity_);
 }
 
+std::size_t History::first_at_or_after(double t) const {
+  std::size_t lo = 0, hi = size_;
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if ((*this)[mid].t < t) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
 }  // namespace mixpilot::ui

@@ -1,6 +1,7 @@
 #pragma once
 // What the UI draws from (SPEC §8): the flight's fixed description (Scene) and a rolling copy of
 // its telemetry (History). Both belong to the UI thread; the simulation never sees them.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -43,23 +44,34 @@ double channel_value(const Telemetry& s, std::string_view name, double fallback 
 // The scene of a mode, read through its const accessors (no effect on the flight).
 Scene scene_of(const Mode& mode, const std::string& input_source);
 
-// The newest telemetry values, oldest first, at most `capacity` of them.
+// The telemetry the screen draws, oldest first, newest last: either a ring of the newest
+// `capacity` values (a live flight), or a view of the first values of a replay's tape.
 class History {
  public:
   explicit History(std::size_t capacity = 4096) : capacity_(capacity) {}
+  // A view of tape[0 .. count): the replay's flight up to its playhead. `tape` must outlive it.
+  static History view(const std::vector<Telemetry>& tape, std::size_t count) {
+    History h(0);
+    h.view_ = tape.data();
+    h.size_ = std::min(count, tape.size());
+    return h;
+  }
   void push(const Telemetry& s);
   void clear() { size_ = 0; head_ = 0; }
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   // i = 0 is the oldest kept, size() − 1 the newest.
   const Telemetry& operator[](std::size_t i) const {
-    return ring_[(head_ + capacity_ - size_ + i) % capacity_];
+    return view_ ? view_[i] : ring_[(head_ + capacity_ - size_ + i) % capacity_];
   }
   const Telemetry& newest() const { return (*this)[size_ - 1]; }
+  // The first index whose time is ≥ t (size() when none): windows of the last seconds.
+  std::size_t first_at_or_after(double t) const;
 
  private:
   std::size_t capacity_;
   std::vector<Telemetry> ring_;
+  const Telemetry* view_ = nullptr;
   std::size_t head_ = 0;  // where the next value goes
   std::size_t size_ = 0;
 };

@@ -25,6 +25,7 @@ const char* to_string(RunState s) {
     case RunState::paused: return "PAUSED";
     case RunState::finished: return "FINISHED";
     case RunState::replay: return "REPLAY";
+    case RunState::loading: return "LOADING";
     case RunState::lost: return "LOST";
   }
   return "?";
@@ -62,8 +63,8 @@ void pill(const char* text, ImU32 c) {
   ImGui::Dummy(size);
 }
 
-void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiRequest& req, ImVec2 pos,
-             ImVec2 size) {
+void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui, UiRequest& req,
+             ImVec2 pos, ImVec2 size) {
   ImGui::SetNextWindowPos(pos);
   ImGui::SetNextWindowSize(size);
   ImGui::Begin("##top", nullptr, kPane);
@@ -71,30 +72,48 @@ void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiRequest& r
   ImGui::SameLine();
   ImGui::Text("%s   ·   %s   ·   %s", sc.title.c_str(), to_string(sc.mode),
               sc.input_source.c_str());
+  // File and help at the right end.
+  const float right_w = ImGui::CalcTextSize("Open... (Ctrl+O)").x + ImGui::CalcTextSize("Help (F1)").x + 40;
+  ImGui::SameLine(std::max(ImGui::GetCursorPosX(), size.x - right_w));
+  if (ImGui::Button("Open... (Ctrl+O)")) ui.open_dialog.open = true;
+  ImGui::SameLine();
+  if (ImGui::Button("Help (F1)")) ui.show_help = !ui.show_help;
+
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
   ImGui::PushFont(mono_font());
   ImGui::Text("t %6.2f / %.0f s   speed %.2fx", s ? s->t : 0.0, sc.duration, run.speed);
   ImGui::PopFont();
-  if (run.state == RunState::ready) {
-    if (ImGui::Button("Start (Space)")) req.start = true;
-  } else if (run.state == RunState::flying || run.state == RunState::paused) {
-    if (ImGui::Button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
-      req.toggle_pause = true;
-  }
-  ImGui::SameLine();
-  if (run.can_restart) {
-    if (ImGui::Button("Restart (R)")) req.restart = true;
+  if (run.replay) {
+    if (ImGui::Button("Back to live (Esc)")) req.leave_replay = true;
+  } else {
+    if (run.state == RunState::ready) {
+      if (ImGui::Button("Start (Space)")) req.start = true;
+    } else if (run.state == RunState::flying || run.state == RunState::paused) {
+      if (ImGui::Button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
+        req.toggle_pause = true;
+    }
     ImGui::SameLine();
+    if (run.can_restart && run.state != RunState::ready) {
+      if (ImGui::Button("Restart (R)")) req.restart = true;
+      ImGui::SameLine();
+    }
+    for (double sp : {0.25, 0.5, 1.0}) {
+      char label[16];
+      std::snprintf(label, sizeof label, "%gx", sp);
+      if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
+      ImGui::SameLine();
+    }
   }
-  for (double sp : {0.25, 0.5, 1.0}) {
-    char label[16];
-    std::snprintf(label, sizeof label, "%gx", sp);
-    if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
+  if (run.recording) {
     ImGui::SameLine();
+    ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "● REC");
   }
-  if (run.recording) ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "● REC");
-  else ImGui::NewLine();
-  if (!run.message.empty()) ImGui::TextUnformatted(run.message.c_str());
+  if (!run.message.empty()) {
+    if (run.message_is_error)
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", run.message.c_str());
+    else
+      ImGui::TextUnformatted(run.message.c_str());
+  }
   ImGui::End();
 }
 
@@ -108,21 +127,27 @@ void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVe
     draw_authority_bar(s ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + size.x - 16, bar_min.y + 30));
     ImGui::Dummy(ImVec2(size.x - 16, 30 + ImGui::GetTextLineHeightWithSpacing()));
   }
-  std::int64_t fallbacks = 0, in_ball = 0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    fallbacks += (h[i].events & kEventFallback) ? 1 : 0;
+  // Over the last minute at most (a replay's history is the whole flight up to the playhead).
+  std::int64_t in_ball = 0;
+  const std::size_t from = h.empty() ? 0 : h.first_at_or_after(h.newest().t - 60.0 + 0.5 * sc.dt);
+  for (std::size_t i = from; i < h.size(); ++i) {
     in_ball += channel_value(h[i], "deviation") <= sc.ball_radius ? 1 : 0;
   }
-  const std::size_t n = h.size();
+  const std::size_t n = h.size() - from;
   const double dev = s ? channel_value(*s, "deviation") : 0.0;
   ImGui::PushFont(mono_font());
   if (sc.mode == ModeKind::mixed_initiative)
     ImGui::Text("deviation %.3f m (r %.2f)   in B %5.1f %% of the last %.0f s", dev,
                 sc.ball_radius,
                 n ? 100.0 * double(in_ball) / double(n) : 100.0,
-                n ? h.newest().t - h[0].t + sc.dt : 0.0);
-  ImGui::Text("RTI %5.0f us   fallbacks %lld   deadline misses %lld", s ? s->stats.total_us : 0.0,
-              static_cast<long long>(fallbacks), static_cast<long long>(run.deadline_misses));
+                n ? h.newest().t - h[from].t + sc.dt : 0.0);
+  ImGui::Text("RTI %5.0f us   fallbacks %lld", s ? s->stats.total_us : 0.0,
+              static_cast<long long>(run.fallbacks));
+  ImGui::SameLine();
+  // Deadline misses in the caution colour once there are any (UI.md §8).
+  if (run.deadline_misses > 0) ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+  ImGui::Text("  deadline misses %lld", static_cast<long long>(run.deadline_misses));
+  if (run.deadline_misses > 0) ImGui::PopStyleColor();
   ImGui::PopFont();
   ImGui::End();
 }
@@ -154,10 +179,11 @@ const char* meaning(const std::string& key) {
   return "";
 }
 
-void score_card(const RunInfo& run, ImVec2 display) {
+void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
                           ImVec2(0.5f, 0.5f));
-  ImGui::Begin("Score card", nullptr,
+  bool open = true;
+  ImGui::Begin("Score card", &open,
                ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
   if (ImGui::BeginTable("##score", 3, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
@@ -175,42 +201,142 @@ void score_card(const RunInfo& run, ImVec2 display) {
     ImGui::EndTable();
   }
   ImGui::End();
+  if (!open) ui.score_card_closed = true;
 }
 
-void keys(UiState& ui, UiRequest& req, const RunInfo& run) {
-  if (ImGui::GetIO().WantCaptureKeyboard) return;
-  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Space)))
+// The shortcut sheet (F1 or ?), UI.md §10.
+void help_sheet(UiState& ui, ImVec2 display) {
+  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  ImGui::Begin("Keyboard and mouse (F1)", &ui.show_help,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"Space", "start / pause / resume the flight; play / pause a replay"},
+      {"R", "restart the flight"},
+      {"Ctrl+R", "record the next flight or not"},
+      {"Ctrl+O", "open a scenario (.toml) or a recording (.mcap)"},
+      {"1  2  3  4", "camera: chase, orbit, top, side"},
+      {"mouse drag, wheel", "orbit the arena, zoom"},
+      {"D", "show / hide the sticks"},
+      {"P", "pause / resume the plots"},
+      {"Left / Right", "replay: step 100 ms (Shift 10 ms, Alt 500 ms)"},
+      {"Home / End", "replay: start / end"},
+      {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
+      {"[  ]", "replay: previous / next event"},
+      {"Esc", "leave the replay; close this sheet"},
+      {"F1  ?", "this sheet"},
+  };
+  if (ImGui::BeginTable("##keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    for (const auto& [key, what] : kKeys) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::PushFont(mono_font());
+      ImGui::TextUnformatted(key);
+      ImGui::PopFont();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(what);
+    }
+    ImGui::EndTable();
+  }
+  ImGui::End();
+}
+
+bool pressed(int key) { return ImGui::IsKeyPressed(key); }
+bool pressed(ImGuiKey_ key) { return ImGui::IsKeyPressed(ImGui::GetKeyIndex(key)); }
+
+// The replay speeds, slowest first (↑ / ↓ move along them).
+constexpr double kReplaySpeeds[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
+
+void replay_keys(const RunInfo& run, UiRequest& req) {
+  const ReplayInfo& r = *run.replay;
+  const ImGuiIO& io = ImGui::GetIO();
+  const double step = io.KeyShift ? 0.01 : io.KeyAlt ? 0.5 : 0.1;
+  if (pressed(ImGuiKey_LeftArrow)) req.seek = std::max(0.0, r.t - step);
+  if (pressed(ImGuiKey_RightArrow)) req.seek = std::min(r.loaded * r.duration, r.t + step);
+  if (pressed(ImGuiKey_Home)) req.seek = 0.0;
+  if (pressed(ImGuiKey_End)) req.seek = r.loaded * r.duration;
+  const auto at = std::find(std::begin(kReplaySpeeds), std::end(kReplaySpeeds), run.speed);
+  if (pressed(ImGuiKey_UpArrow))
+    req.speed = at == std::end(kReplaySpeeds) || at + 1 == std::end(kReplaySpeeds) ? 8.0 : *(at + 1);
+  if (pressed(ImGuiKey_DownArrow))
+    req.speed = at == std::end(kReplaySpeeds) || at == std::begin(kReplaySpeeds) ? 0.25 : *(at - 1);
+  if (pressed('[')) req.jump = -1;
+  if (pressed(']')) req.jump = +1;
+  if (pressed(ImGuiKey_Escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId)) req.leave_replay = true;
+}
+
+void keys(UiState& ui, UiRequest& req, const RunInfo& run, const History& h) {
+  const ImGuiIO& io = ImGui::GetIO();
+  if (io.WantCaptureKeyboard || ui.open_dialog.open) return;
+  if (pressed(kKeyF1)) ui.show_help = !ui.show_help;
+  for (int i = 0; i < io.InputQueueCharacters.Size; ++i)
+    if (io.InputQueueCharacters[i] == '?') ui.show_help = !ui.show_help;
+  if (io.KeyCtrl) {
+    if (pressed('O')) ui.open_dialog.open = true;
+    if (pressed('R') && run.session) req.record = run.session->record ? 0 : 1;
+    return;
+  }
+  if (pressed(ImGuiKey_Escape) && ui.show_help) ui.show_help = false;
+  else if (run.replay) replay_keys(run, req);
+  if (pressed(ImGuiKey_Space))
     (run.state == RunState::ready ? req.start : req.toggle_pause) = true;
-  if (ImGui::IsKeyPressed('R') && run.can_restart) req.restart = true;
-  if (ImGui::IsKeyPressed('1')) ui.camera = Camera::chase;
-  if (ImGui::IsKeyPressed('2')) ui.camera = Camera::orbit;
-  if (ImGui::IsKeyPressed('3')) ui.camera = Camera::top;
-  if (ImGui::IsKeyPressed('4')) ui.camera = Camera::side;
-  if (ImGui::IsKeyPressed('D')) ui.show_sticks = !ui.show_sticks;
+  if (pressed('R') && run.can_restart && !run.replay) req.restart = true;
+  if (pressed('1')) ui.camera = Camera::chase;
+  if (pressed('2')) ui.camera = Camera::orbit;
+  if (pressed('3')) ui.camera = Camera::top;
+  if (pressed('4')) ui.camera = Camera::side;
+  if (pressed('D')) ui.show_sticks = !ui.show_sticks;
+  if (pressed('P')) set_plots_paused(ui, h, !ui.plots_paused);
 }
 
 }  // namespace
 
+void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max) {
+  const float top = 96.0f, right = std::clamp(0.3f * display.x, 280.0f, 460.0f);
+  const float bottom = run.replay ? 78.0f : 0.0f;  // the replay's transport bar
+  min = ImVec2(0, top);
+  max = ImVec2(display.x - right, display.y - bottom);
+}
+
 UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState& ui) {
   UiRequest req;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
-  const float top = 96.0f, right = std::clamp(0.3f * d.x, 280.0f, 460.0f);
-  top_bar(sc, h, run, req, ImVec2(0, 0), ImVec2(d.x, top));
+  ImVec2 vmin, vmax;
+  view_rect(d, run, vmin, vmax);
+  const float top = vmin.y, right = d.x - vmax.x, bottom = d.y - vmax.y;
+  top_bar(sc, h, run, ui, req, ImVec2(0, 0), ImVec2(d.x, top));
 
-  ImGui::SetNextWindowPos(ImVec2(0, top));
-  ImGui::SetNextWindowSize(ImVec2(d.x - right, d.y - top));
+  ImGui::SetNextWindowPos(vmin);
+  ImGui::SetNextWindowSize(ImVec2(vmax.x - vmin.x, vmax.y - vmin.y));
   ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
-  const ImVec2 vmin(0, top), vmax(d.x - right, d.y);
   if (sc.mode == ModeKind::pendubot_swingup) draw_pendubot(sc, h, vmin, vmax);
   else draw_arena(sc, h, ui, vmin, vmax);
   ImGui::End();
 
-  const float hud_w = std::min(0.6f * (d.x - right), 640.0f);
-  hud(sc, h, run, ImVec2(0.5f * (d.x - right - hud_w), top + 8), ImVec2(hud_w, 110));
+  // The session panel at the view's top left while no flight is under way.
+  const bool panel = run.session && !run.replay && run.state != RunState::flying &&
+                     run.state != RunState::paused;
+  const float panel_w = 300.0f;
+  if (panel) {
+    ImGui::SetNextWindowPos(ImVec2(8, top + 8));
+    ImGui::SetNextWindowSize(ImVec2(panel_w, 0));
+    ImGui::Begin("Session", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                     ImGuiWindowFlags_AlwaysAutoResize);
+    draw_session_panel(run, ui, req);
+    ImGui::End();
+  }
+
+  const float view_w = d.x - right;
+  const float hud_w = std::min(0.6f * view_w, 640.0f);
+  const float hud_x = std::max(0.5f * (view_w - hud_w), panel ? panel_w + 16 : 0.0f);
+  hud(sc, h, run, ImVec2(hud_x, top + 8), ImVec2(std::min(hud_w, view_w - hud_x - 8), 110));
 
   if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty()) {
     const float w = 300, ht = 170;
-    ImGui::SetNextWindowPos(ImVec2(0.5f * (d.x - right - w), d.y - ht - 8));
+    ImGui::SetNextWindowPos(ImVec2(0.5f * (view_w - w), d.y - bottom - ht - 8));
     ImGui::SetNextWindowSize(ImVec2(w, ht));
     ImGui::Begin("##sticks", nullptr, kOverlay);
     const ImVec2 p = ImGui::GetCursorScreenPos();
@@ -219,13 +345,29 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   }
 
   ImGui::SetNextWindowPos(ImVec2(d.x - right, top));
-  ImGui::SetNextWindowSize(ImVec2(right, d.y - top));
+  ImGui::SetNextWindowSize(ImVec2(right, d.y - top - bottom));
   ImGui::Begin("##plots", nullptr, kPane);
   draw_plots(sc, h, ui);
   ImGui::End();
-  if (!run.metrics.empty()) score_card(run, d);
-  keys(ui, req, run);
+
+  if (run.replay) {
+    ImGui::SetNextWindowPos(ImVec2(0, d.y - bottom));
+    ImGui::SetNextWindowSize(ImVec2(d.x, bottom));
+    ImGui::Begin("##transport", nullptr, kPane);
+    draw_transport(run, req);
+    ImGui::End();
+  }
+  if (run.metrics.empty()) ui.score_card_closed = false;
+  else if (!ui.score_card_closed) score_card(run, ui, d);
+  if (ui.show_help) help_sheet(ui, d);
+  draw_open_dialog(ui, req);
+  keys(ui, req, run, h);
   return req;
+}
+
+void set_plots_paused(UiState& ui, const History& h, bool paused) {
+  ui.plots_paused = paused;
+  ui.plots_paused_at = paused && !h.empty() ? h.newest().t : -1.0;
 }
 
 }  // namespace mixpilot::ui

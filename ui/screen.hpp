@@ -1,8 +1,13 @@
 #pragma once
 // The whole window, one frame at a time (SPEC §8, UI.md §1): a top bar with the status pill,
-// the authority bar and the session buttons; the arena (3D) or Pendubot (2D) view in the centre;
-// plots on the right; the sticks at the bottom. A function of the scene, the telemetry history
+// the session buttons and the authority bar; the session panel; the arena (3D) or Pendubot (2D)
+// view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A function of the scene, the telemetry history
 // and the UI's own state; what the user asked for comes back as a UiRequest.
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+
 #include "ui/scene.hpp"
 
 namespace mixpilot::ui {
@@ -11,17 +16,60 @@ enum class Camera { chase, orbit, top, side };
 const char* to_string(Camera c);
 
 // What the app shows about the flight besides its telemetry.
-enum class RunState { ready, flying, paused, finished, replay, lost };
+enum class RunState { ready, flying, paused, finished, replay, loading, lost };
 const char* to_string(RunState s);
+
+// Events a replay's timeline marks and jumps to (UI.md §6).
+enum class EventKind { collision, fallback, low_lambda, lost };
+const char* to_string(EventKind k);
+
+struct TimelineEvent {
+  double t = 0.0;  // [s]
+  EventKind kind = EventKind::collision;
+};
+
+// A replay's transport: a playhead over a recorded flight.
+struct ReplayInfo {
+  bool playing = false;
+  double t = 0.0;             // [s] the playhead
+  double duration = 0.0;      // [s] of the recording
+  double loaded = 1.0;        // fraction of the flight ready to show (it is flown again first)
+  double lambda_threshold = 0.5;         // "λ below" events cross it downwards
+  std::vector<TimelineEvent> events;     // by time
+};
+
+// The session panel's choices (SPEC §8): what the next flight flies.
+struct SessionChoices {
+  std::vector<std::string> scenarios;  // labels: shipped scenarios, then opened files
+  int scenario = -1;                   // index into scenarios
+  std::vector<std::string> pilots;     // pilot sources of the scenario (empty: the mode has none)
+  int pilot = -1;
+  bool record = false;                 // record the next flight
+  std::string record_to;               // where (a file, or the folder of automatic names)
+  std::string trainee;                 // the person flying
+};
 
 struct RunInfo {
   RunState state = RunState::ready;
   double speed = 1.0;            // real-time factor (slow motion < 1)
   std::int64_t deadline_misses = 0;
+  std::int64_t fallbacks = 0;    // steps that applied the previous solution's input, so far
   bool recording = false;
   bool can_restart = false;      // the app can start the flight again (Restart, R)
   std::string message;           // a line for the status area ("" none)
+  bool message_is_error = false;
   Metrics metrics;               // the score card at the end of a flight (empty: none yet)
+  const SessionChoices* session = nullptr;  // the session panel (nullptr: none, e.g. headless)
+  const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
+};
+
+// A file browser's state (File → Open): the folder shown and what it holds.
+struct OpenDialog {
+  bool open = false;
+  std::string folder;                // absolute
+  std::vector<std::string> entries;  // sub-folders (ending in '/') then .toml and .mcap files
+  std::string error;                 // why the folder could not be listed
+  char path[1024] = "";              // the path being typed or picked
 };
 
 // The UI's own state: kept by the app between frames, changed only by the UI.
@@ -31,22 +79,54 @@ struct UiState {
   float orbit_pitch = 0.5f;   // [rad]
   float orbit_distance = 0.0f;  // [m] 0: fit the arena
   bool plots_paused = false;
+  double plots_paused_at = -1.0;  // [s] the plots' right edge while paused
   double plot_window = 10.0;  // [s]
   bool show_sticks = true;
+  bool show_help = false;      // the shortcut sheet (F1, ?)
+  bool score_card_closed = false;
+  OpenDialog open_dialog;
+  char trainee[64] = "";
 };
 
 // What the user asked for in this frame (buttons, keys); the app acts on it.
 struct UiRequest {
   bool start = false;
-  bool toggle_pause = false;
+  bool toggle_pause = false;   // live: pause / resume; replay: play / pause
   bool restart = false;
   bool quit = false;
-  double speed = 0.0;  // > 0: a new speed
+  double speed = 0.0;          // > 0: a new speed (live: 0.25–1; replay: 0.25–8)
+  int scenario = -1;           // ≥ 0: fly this scenario of SessionChoices next
+  int pilot = -1;              // ≥ 0: with this pilot
+  int record = -1;             // 0 / 1: record the next flight or not
+  bool trainee_changed = false;
+  std::string trainee;
+  std::string open;            // a file to open: a scenario (.toml) or a recording (.mcap)
+  bool leave_replay = false;   // back to the live flight (Esc)
+  double seek = -1.0;          // ≥ 0: move the playhead there [s]
+  int jump = 0;                // −1 / +1: previous / next event
+  double lambda_threshold = -1.0;  // ≥ 0: a new threshold for "λ below" events
 };
+
+// The events of a flight for a replay's timeline: collisions, fallbacks (overruns included),
+// the vehicle lost, and λ crossing `lambda_threshold` downwards (mixed initiative).
+std::vector<TimelineEvent> timeline_events(const History& flight, double lambda_threshold);
+
+// The time of the next (direction +1) or previous (−1) event after / before `t`, or −1.
+double event_after(const std::vector<TimelineEvent>& events, double t, int direction);
 
 // Builds one frame's ImGui windows over the whole display (between ImGui::NewFrame() and
 // ImGui::Render()).
 UiRequest draw_screen(const Scene& scene, const History& history, const RunInfo& run,
                       UiState& ui);
+
+// The arena or Pendubot view's region of a display of size `display` [pixels].
+void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max);
+
+// Freezes the plots at the newest time of `h` (or lets them roll again).
+void set_plots_paused(UiState& ui, const History& h, bool paused);
+
+// GLFW's key code for F1: the window's backend and the headless renderer both use GLFW's key
+// codes (ImGui 1.86 has no ImGuiKey for F1).
+inline constexpr int kKeyF1 = 290;
 
 }  // namespace mixpilot::ui

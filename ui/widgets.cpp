@@ -90,7 +90,7 @@ int channel_index(const Telemetry& s, const char* name) {
 
 // One rolling plot of channels over [t_end − window, t_end].
 void plot(const History& h, const char* title, std::initializer_list<Series> named, double window,
-          float height) {
+          double t_end, float height) {
   struct Indexed {
     int channel;
     ImU32 colour;
@@ -108,16 +108,11 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->AddRectFilled(min, max, colour::rgb(0x12, 0x14, 0x18));
   if (h.empty()) return;
-  const double t1 = h.newest().t, t0 = t1 - window;
-  // The first sample in the window (times increase along the history).
-  std::size_t first = 0, last = h.size();
-  while (first < last) {
-    const std::size_t mid = (first + last) / 2;
-    if (h[mid].t < t0) first = mid + 1;
-    else last = mid;
-  }
+  const double t1 = t_end, t0 = t1 - window;
+  const std::size_t first = h.first_at_or_after(t0);
+  const std::size_t end = h.first_at_or_after(t1 + 1e-9);  // past the right edge
   double lo = 1e300, hi = -1e300;
-  for (std::size_t i = first; i < h.size(); ++i) {
+  for (std::size_t i = first; i < end; ++i) {
     for (int k = 0; k < count; ++k) {
       const Indexed& s = series[k];
       if (s.channel >= h[i].num_channels) continue;
@@ -150,7 +145,7 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
       dl->PathLineTo(ImVec2(float(column), a));
       if (b != a) dl->PathLineTo(ImVec2(float(column), b));
     };
-    for (std::size_t i = first; i < h.size(); ++i) {
+    for (std::size_t i = first; i < end; ++i) {
       if (s.channel >= h[i].num_channels) continue;
       const ImVec2 p = to_px(h[i].t, h[i].channels[std::size_t(s.channel)].value);
       const int c = int(p.x);
@@ -174,14 +169,21 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
   dl->AddText(ImVec2(min.x + 3, min.y + 1), colour::rgb(170, 170, 170), buf);
   std::snprintf(buf, sizeof buf, "%.3g", lo + pad);
   dl->AddText(ImVec2(min.x + 3, max.y - ImGui::GetTextLineHeight() - 1), colour::rgb(170, 170, 170), buf);
-  // The legend: each series' name and latest value.
+  // The legend: each series' name and its value at the right edge, or under the mouse.
+  const Telemetry* at = end > 0 ? &h[end - 1] : nullptr;
+  if (ImGui::IsMouseHoveringRect(min, max) && first < end) {
+    const double tm = t0 + double(ImGui::GetIO().MousePos.x - min.x) / double(max.x - min.x) * window;
+    const std::size_t k = std::min(end - 1, h.first_at_or_after(tm));
+    at = &h[k];
+    const float x = to_px(at->t, 0.0).x;
+    dl->AddLine(ImVec2(x, min.y), ImVec2(x, max.y), colour::rgb(0xDD, 0xDD, 0xDD, 140), 1.0f);
+  }
   float x = title_at.x + 12;
   const float legend_y = title_at.y - ImGui::GetTextLineHeight();
-  for (int k = 0; k < count; ++k) {
+  for (int k = 0; at && k < count; ++k) {
     const Indexed& s = series[k];
-    const Telemetry& n = h.newest();
-    if (s.channel >= n.num_channels) continue;
-    const Channel& c = n.channels[std::size_t(s.channel)];
+    if (s.channel >= at->num_channels) continue;
+    const Channel& c = at->channels[std::size_t(s.channel)];
     std::snprintf(buf, sizeof buf, "%s %.3g %s", c.name, c.value, c.unit);
     dl->AddText(ImVec2(x, legend_y), s.colour, buf);
     x += ImGui::CalcTextSize(buf).x + 12;
@@ -194,28 +196,30 @@ const ImU32 kCycle[] = {colour::kPilot, colour::kPlanner, colour::kMpc, colour::
 }  // namespace
 
 void draw_plots(const Scene& sc, const History& h, UiState& ui) {
-  ImGui::Checkbox("pause plots", &ui.plots_paused);
+  bool paused = ui.plots_paused;
+  if (ImGui::Checkbox("pause plots (P)", &paused)) set_plots_paused(ui, h, paused);
+  if (h.empty()) return;
+  const double t_end = ui.plots_paused ? ui.plots_paused_at : h.newest().t;
   const float height = 80.0f;
   if (sc.mode == ModeKind::mixed_initiative) {
-    plot(h, "authority λ", {{"lambda", colour::kPilot}}, ui.plot_window, height);
+    plot(h, "authority λ", {{"lambda", colour::kPilot}}, ui.plot_window, t_end, height);
     plot(h, "deviation |p − η_r| vs r",
          {{"deviation", colour::kPilot}, {"ball radius r", colour::kCaution}}, ui.plot_window,
-         height);
+         t_end, height);
     plot(h, "roll φ_h vs φ*₁", {{"roll pilot", colour::kPilot}, {"roll MPC", colour::kMpc}},
-         ui.plot_window, height);
+         ui.plot_window, t_end, height);
     plot(h, "pitch θ_h vs θ*₁", {{"pitch pilot", colour::kPilot}, {"pitch MPC", colour::kMpc}},
-         ui.plot_window, height);
+         ui.plot_window, t_end, height);
     plot(h, "rotor speed Ω vs bound",
          {{"rotor speed max", colour::kMpc}, {"rotor speed bound", colour::kCritical}},
-         ui.plot_window, height);
-    plot(h, "RTI time", {{"RTI time", colour::kCaution}}, ui.plot_window, height);
+         ui.plot_window, t_end, height);
+    plot(h, "RTI time", {{"RTI time", colour::kCaution}}, ui.plot_window, t_end, height);
     return;
   }
-  if (h.empty()) return;
   const Telemetry& n = h.newest();
   for (int i = 0; i < n.num_channels; ++i)
     plot(h, n.channels[std::size_t(i)].name, {{n.channels[std::size_t(i)].name, kCycle[i % 6]}},
-         ui.plot_window, 56.0f);
+         ui.plot_window, t_end, 56.0f);
 }
 
 }  // namespace mixpilot::ui

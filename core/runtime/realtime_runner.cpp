@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace mixpilot {
 
 RealtimeRunner::RealtimeRunner(Session& session, std::size_t ring_capacity) : session_(&session) {
@@ -25,11 +28,37 @@ void RealtimeRunner::stop() {
 }
 
 RealtimeStats RealtimeRunner::stats() const {
-  return {steps_.load(), misses_.load(), worst_lateness_us_.load(), worst_step_us_.load()};
+  RealtimeStats st{steps_.load(), misses_.load(), worst_lateness_us_.load(),
+                   worst_step_us_.load(), 0.0, fifo_.load()};
+  // The smallest bin edge below which 99 % of the steps fall.
+  std::uint64_t total = 0;
+  for (const auto& b : step_bins_) total += b.load(std::memory_order_relaxed);
+  std::uint64_t below = 0;
+  for (int i = 0; i < kBins && total > 0; ++i) {
+    below += step_bins_[std::size_t(i)].load(std::memory_order_relaxed);
+    if (100 * below >= 99 * total) {
+      st.p99_step_us = double(i + 1) * kBinUs;
+      break;
+    }
+  }
+  return st;
 }
+
+namespace {
+
+// SCHED_FIFO at a modest priority (above every normal thread, below the kernel's own); false
+// where the system refuses it.
+bool ask_realtime_priority() {
+  sched_param p{};
+  p.sched_priority = std::min(10, sched_get_priority_max(SCHED_FIFO));
+  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+}
+
+}  // namespace
 
 void RealtimeRunner::loop() {
   using clock = std::chrono::steady_clock;
+  fifo_.store(ask_realtime_priority());
   const double dt = session_->mode().dt();
   auto next = clock::now();
   while (!stop_.load(std::memory_order_relaxed)) {
@@ -50,6 +79,8 @@ void RealtimeRunner::loop() {
     if (late_us > 0.1 * 1e6 * dt || step_us > 1e6 * dt) misses_.fetch_add(1);
     if (late_us > worst_lateness_us_.load()) worst_lateness_us_.store(late_us);
     if (step_us > worst_step_us_.load()) worst_step_us_.store(step_us);
+    step_bins_[std::size_t(std::min(double(kBins - 1), step_us / kBinUs))].fetch_add(
+        1, std::memory_order_relaxed);
     steps_.fetch_add(1);
     const auto period =
         std::chrono::duration_cast<clock::duration>(std::chrono::duration<double, std::micro>(period_us));

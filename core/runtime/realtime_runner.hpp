@@ -7,6 +7,11 @@
 // Deadline misses: a step that starts later than its scheduled time by more than 10 % of Δt,
 // or whose step time exceeds Δt, counts one miss. After a late start the schedule restarts
 // from now (no burst of catch-up steps).
+//
+// The control thread asks for real-time scheduling (SCHED_FIFO) so that a busy UI or renderer
+// (Mesa's software rasterizer runs a thread per core) cannot delay its steps; where the system
+// does not grant it (no CAP_SYS_NICE, no rtprio limit) it runs at normal priority and says so.
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -22,6 +27,8 @@ struct RealtimeStats {
   std::int64_t deadline_misses = 0;
   double worst_lateness_us = 0.0;  // the latest start after its schedule
   double worst_step_us = 0.0;      // the longest step
+  double p99_step_us = 0.0;        // 99th percentile of the step times (to 20 us)
+  bool realtime_priority = false;  // the control thread runs under SCHED_FIFO
 };
 
 class RealtimeRunner {
@@ -51,10 +58,15 @@ class RealtimeRunner {
   Session* session_;
   SpscRing<Telemetry> ring_;
   std::thread thread_;
-  std::atomic<bool> stop_{false}, paused_{false}, running_{false};
+  std::atomic<bool> stop_{false}, paused_{false}, running_{false}, fifo_{false};
   std::atomic<double> speed_{1.0};
   std::atomic<std::int64_t> steps_{0}, misses_{0};
   std::atomic<double> worst_lateness_us_{0.0}, worst_step_us_{0.0};
+  // Step times in 20 us bins (the last bin holds every longer step): percentiles without
+  // keeping the samples.
+  static constexpr int kBins = 2500;
+  static constexpr double kBinUs = 20.0;
+  std::array<std::atomic<std::uint32_t>, kBins> step_bins_{};
 };
 
 }  // namespace mixpilot

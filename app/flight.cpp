@@ -1,0 +1,128 @@
+#include "app/flight.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "app/cli.hpp"
+#include "app/replay.hpp"
+#include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
+#include "core/recording/output_file.hpp"
+#include "core/scenario/scenario_toml.hpp"
+
+namespace mixpilot::cli {
+
+namespace {
+
+// Reads the scenario and, for a replay, the recording; on failure `status` may name a more
+// specific exit status than kExitError.
+std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
+  Flight f;
+  if (o.pilot.ends_with(".mcap")) {
+    f.recording = read_recording(o.pilot, error);
+    if (!f.recording) return std::nullopt;
+    if (!embedded_scenario(*f.recording, o.pilot, error)) return std::nullopt;
+  }
+  if (!o.scenario_path.empty()) {
+    if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
+    f.scenario_source = o.scenario_path;
+    f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
+    if (f.recording && *embedded_scenario(*f.recording, o.pilot, error) != f.scenario_text &&
+        !o.allow_mismatch) {
+      error = o.scenario_path + " differs from the scenario embedded in " + o.pilot +
+              " (--allow-mismatch flies it anyway)";
+      status = kExitReplayMismatch;
+      return std::nullopt;
+    }
+  } else if (f.recording) {
+    f.scenario_text = *embedded_scenario(*f.recording, o.pilot, error);
+    f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
+    f.scenario_file = f.recording->metadata["scenario_path"];
+  } else {
+    usage_error(o.command, "--scenario FILE is required");
+  }
+  return f;
+}
+
+}  // namespace
+
+std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status) {
+  status = kExitError;  // unless said otherwise below
+  std::optional<Flight> f = load_flight(o, error, status);
+  if (!f) return std::nullopt;
+  const auto kind_name = scenario_mode(f->scenario_text, f->scenario_source, error);
+  if (!kind_name) {
+    if (f->recording && o.scenario_path.empty()) error = in_embedded_scenario(o.pilot, error);
+    return std::nullopt;
+  }
+  if (*kind_name != "mixed_initiative" && !o.pilot.empty() && !o.replay)
+    usage_error(o.command, "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
+                           " is " + *kind_name);
+  if (f->recording) {
+    f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
+                          o.duration, error);
+  } else {
+    ModeRequest request;
+    request.duration = o.duration;
+    request.pilot_name = o.pilot;
+    f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
+  }
+  if (!f->mode) return std::nullopt;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f->mode.get())) f->pilot = mi->pilot().name();
+  status = kExitOk;
+  return f;
+}
+
+SessionInfo session_info(const Flight& f, const std::string& trainee) {
+  SessionInfo info;
+  info.trainee = trainee;
+  info.mode = to_string(f.mode->kind());
+  info.scenario = f.scenario_text;
+  info.scenario_path = f.scenario_file;
+  info.pilot = f.pilot;
+  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
+    info.seed = mi->scenario().plant.seed;
+  return info;
+}
+
+Labels report_labels(const Flight& f, bool was_interrupted) {
+  Labels labels = {{"mode", to_string(f.mode->kind())}, {"scenario", f.mode->scenario_name()}};
+  if (!f.pilot.empty()) labels.emplace_back("pilot", f.pilot);
+  if (was_interrupted) labels.emplace_back("interrupted", "true");
+  return labels;
+}
+
+bool check_outputs(const FlyOptions& o, std::string& error) {
+  if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
+    usage_error(o.command, "--record and --report name the same file '" + o.record + "'");
+  for (const std::string* path : {&o.record, &o.report})
+    if (!path->empty() && !check_output_path(*path, o.force, error)) return false;
+  for (std::size_t i = 0; i < o.screenshots.size(); ++i) {
+    const std::string& shot = o.screenshots[i].path;
+    for (const std::string* other : {&o.record, &o.report})
+      if (!other->empty() && same_output_path(shot, *other))
+        usage_error(o.command, "--screenshot and another output name the same file '" + shot + "'");
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_output_path(shot, o.screenshots[j].path))
+        usage_error(o.command, "two --screenshot options name the same file '" + shot + "'");
+    if (!check_output_path(shot, o.force, error)) return false;
+  }
+  return true;
+}
+
+void print_realtime(const RealtimeStats& st, double dt) {
+  std::printf("  real time: %lld deadline misses; worst start lateness %.0f us, step p99 %.0f us, "
+              "longest %.0f us (dt %.0f us); control thread %s\n",
+              static_cast<long long>(st.deadline_misses), st.worst_lateness_us, st.p99_step_us,
+              st.worst_step_us, 1e6 * dt,
+              st.realtime_priority ? "SCHED_FIFO" : "at normal priority (no real-time scheduling granted)");
+}
+
+std::string seconds_text(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", t);
+  return buf;
+}
+
+
+}  // namespace mixpilot::cli

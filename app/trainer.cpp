@@ -1,0 +1,456 @@
+#include "app/trainer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <system_error>
+
+#include <imgui.h>
+
+#include "app/cli.hpp"
+#include "core/modes/mi_mode.hpp"
+#include "core/modes/report.hpp"
+
+#ifndef MIXPILOT_SOURCE_DIR
+#define MIXPILOT_SOURCE_DIR "."
+#endif
+
+namespace mixpilot::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string absolute_path(const std::string& p) {
+  std::error_code ec;
+  const fs::path a = fs::absolute(p, ec);
+  return (ec ? fs::path(p) : a).lexically_normal().string();
+}
+
+// The shipped scenarios, by name.
+std::vector<std::string> shipped_scenarios() {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (fs::directory_iterator it(MIXPILOT_SOURCE_DIR "/scenarios", ec), end; !ec && it != end;
+       it.increment(ec))
+    if (it->path().extension() == ".toml") out.push_back(absolute_path(it->path().string()));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Where the app's recordings go: $XDG_DATA_HOME/mixpilot/recordings (~/.local/share/...).
+fs::path recordings_folder() {
+  if (const char* x = std::getenv("XDG_DATA_HOME"); x && *x == '/')
+    return fs::path(x) / "mixpilot" / "recordings";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return fs::path(home) / ".local" / "share" / "mixpilot" / "recordings";
+  return fs::current_path() / "mixpilot-recordings";
+}
+
+bool is_flying(const LiveFlight& f) { return f.started && f.runner->running(); }
+
+}  // namespace
+
+Trainer::Trainer(FlyOptions o) : options_(std::move(o)) {
+  first_record_ = options_.record;
+  choices_.record = !options_.record.empty();
+  scenario_paths_ = shipped_scenarios();
+  for (const std::string& p : scenario_paths_) choices_.scenarios.push_back(fs::path(p).stem().string());
+  if (!options_.scenario_path.empty()) {
+    const std::string mine = absolute_path(options_.scenario_path);
+    const auto it = std::find(scenario_paths_.begin(), scenario_paths_.end(), mine);
+    if (it == scenario_paths_.end()) {
+      scenario_paths_.push_back(mine);
+      choices_.scenarios.push_back(fs::path(mine).filename().string());
+      choices_.scenario = int(scenario_paths_.size()) - 1;
+    } else {
+      choices_.scenario = int(it - scenario_paths_.begin());
+    }
+  }
+}
+
+Trainer::~Trainer() {
+  if (live_ && !live_->closed) close_live(*live_);
+  if (replay_) replay_->stop();
+}
+
+std::string Trainer::next_record_path() const {
+  if (!first_record_.empty()) return first_record_;
+  char stamp[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  std::string name = live_ ? live_->flight.mode->scenario_name() : "flight";
+  if (live_ && !live_->flight.pilot.empty() && !live_->flight.recording)
+    name += "-" + live_->flight.pilot;
+  return (recordings_folder() / (name + "-" + stamp + ".mcap")).string();
+}
+
+std::unique_ptr<LiveFlight> Trainer::make_live(std::string& error, int& status) {
+  auto f = std::make_unique<LiveFlight>();
+  FlyOptions o = options_;
+  o.replay = o.pilot.ends_with(".mcap");  // a recording's pilot: any mode flies it again
+  std::optional<Flight> flight = prepare_flight(o, error, status);
+  if (!flight) return nullptr;
+  f->flight = std::move(*flight);
+  Mode& mode = *f->flight.mode;
+  f->session = std::make_unique<Session>(mode);
+  if (f->flight.recording) {
+    f->check.emplace(*f->flight.recording);
+    f->session->add_sink(&*f->check);
+  }
+  f->runner = std::make_unique<RealtimeRunner>(*f->session, 8192);
+  const std::string source =
+      f->flight.pilot.empty() ? std::string("the thesis's controller") : "pilot " + f->flight.pilot;
+  f->scene = ui::scene_of(mode, source);
+  f->sample = mode.telemetry();
+  return f;
+}
+
+bool Trainer::open_live(std::string& error, int& status) {
+  live_ = make_live(error, status);
+  refresh_choices();
+  return live_ != nullptr;
+}
+
+bool Trainer::replace_live(std::string& error) {
+  int status = 0;
+  auto next = make_live(error, status);
+  if (!next) return false;
+  if (live_ && !live_->closed) close_live(*live_);
+  live_ = std::move(next);
+  refresh_choices();
+  return true;
+}
+
+void Trainer::refresh_choices() {
+  choices_.pilots.clear();
+  choices_.pilot = -1;
+  if (!live_) return;
+  if (const auto* mi = dynamic_cast<const MiMode*>(live_->flight.mode.get())) {
+    for (const auto& [name, profile] : mi->scenario().pilots) choices_.pilots.push_back(name);
+    if (options_.pilot.ends_with(".mcap")) choices_.pilots.push_back(options_.pilot);
+    const auto it = std::find(choices_.pilots.begin(), choices_.pilots.end(),
+                              options_.pilot.empty() ? live_->flight.pilot : options_.pilot);
+    choices_.pilot = it == choices_.pilots.end() ? -1 : int(it - choices_.pilots.begin());
+  }
+  choices_.record_to = choices_.record ? next_record_path() : "";
+}
+
+void Trainer::close_live(LiveFlight& f) {
+  f.runner->stop();
+  while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
+  if (!f.record_path.empty()) {
+    std::string error;
+    if (f.recorder.close(error, !f.flight.mode->finished())) {
+      recorded_.push_back(f.record_path);
+      if (f.record_path == first_record_) first_record_.clear();
+      const std::int64_t dropped = f.recorder.dropped();
+      say("recorded " + f.record_path +
+          (dropped ? " (" + std::to_string(dropped) + " steps lost: the disk was too slow)" : ""),
+          dropped > 0);
+    } else {
+      say(error, true);
+      status_ = kExitError;
+    }
+  }
+  f.closed = true;
+}
+
+void Trainer::start() {
+  if (replay_) {
+    replay_info_.playing = true;
+    return;
+  }
+  if (!live_ || live_->started) return;
+  if (choices_.record) {
+    const std::string path = next_record_path();
+    std::error_code ec;
+    if (path != options_.record) fs::create_directories(fs::path(path).parent_path(), ec);
+    RecordingSink::Settings rs;
+    rs.when_full = RecordingSink::FullRing::drop;  // the control thread never waits on the disk
+    rs.slots = 4096;
+    std::string error;
+    if (!live_->recorder.open(path, *live_->flight.mode,
+                              session_info(live_->flight, choices_.trainee), error, rs,
+                              path == options_.record && options_.force)) {
+      say(error, true);
+      return;
+    }
+    live_->record_path = path;
+    live_->session->add_sink(&live_->recorder);
+  }
+  live_->runner->start();
+  live_->started = true;
+  say("");
+}
+
+void Trainer::say(std::string message, bool error) {
+  run_.message = std::move(message);
+  run_.message_is_error = error;
+}
+
+bool Trainer::open_replay(const std::string& path, std::string& error) {
+  FlyOptions o;
+  o.pilot = path;
+  o.replay = true;
+  o.command = options_.command;
+  int status = 0;
+  std::optional<Flight> flight = prepare_flight(o, error, status);
+  if (!flight) return false;
+  if (live_ && !live_->closed) close_live(*live_);
+  replay_ = std::make_unique<ReplayTape>(std::move(*flight), path);
+  replay_->start();
+  replay_info_ = ui::ReplayInfo{};
+  replay_info_.duration = double(replay_->steps()) * replay_->dt();
+  replay_events_final_ = false;
+  ui_.score_card_closed = false;
+  return true;
+}
+
+void Trainer::update_live() {
+  LiveFlight& f = *live_;
+  if (!f.closed) {
+    while (f.runner->telemetry().pop(f.sample)) {
+      f.history.push(f.sample);
+      if (f.sample.events & (kEventFallback | kEventOverrun)) ++f.fallbacks;
+    }
+  }
+  const Mode& mode = *f.flight.mode;
+  const bool over = f.started && !f.runner->running();
+  // The run is over: its recording is completed at once, and the score card shows.
+  if (over && !f.closed) close_live(f);
+  if (over && f.metrics.empty())
+    f.metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
+                                   : with_lost_fields(mode.metrics(), mode);
+  const RealtimeStats st = f.runner->stats();
+  run_.state = !f.started ? ui::RunState::ready
+               : mode.lost() ? ui::RunState::lost
+               : over ? ui::RunState::finished
+               : f.runner->paused() ? ui::RunState::paused
+                                    : ui::RunState::flying;
+  run_.speed = f.runner->speed();
+  run_.deadline_misses = st.deadline_misses;
+  run_.fallbacks = f.fallbacks;
+  run_.recording = !f.record_path.empty() && !f.closed;
+  run_.can_restart = true;
+  run_.metrics = f.metrics;
+  run_.replay = nullptr;
+  run_.session = &choices_;
+}
+
+void Trainer::update_replay(double wall_dt) {
+  ReplayTape& r = *replay_;
+  ui::ReplayInfo& info = replay_info_;
+  const std::size_t ready = r.ready();
+  info.duration = double(r.steps()) * r.dt();
+  info.loaded = r.steps() ? double(ready) / double(r.steps()) : 1.0;
+  if (r.done()) info.loaded = 1.0;
+  const double last = ready ? double(ready - 1) * r.dt() : 0.0;
+  if (info.playing) {
+    info.t += wall_dt * replay_speed_;
+    if (info.t >= last) {
+      info.t = last;
+      if (r.done()) info.playing = false;  // at the end
+    }
+  }
+  if (r.done() && !replay_events_final_) {
+    info.events = ui::timeline_events(ui::History::view(r.tape(), ready), info.lambda_threshold);
+    replay_events_final_ = true;
+    if (!r.mismatch().empty() && r.mismatch() != "interrupted")
+      say("the replay differs from the recording: " + r.mismatch(), true);
+  }
+  run_.state = r.done() ? ui::RunState::replay : ui::RunState::loading;
+  run_.speed = replay_speed_;
+  run_.deadline_misses = 0;
+  run_.fallbacks = 0;
+  const std::size_t k = tape_index(r, info.t);
+  for (const ui::TimelineEvent& e : info.events)
+    run_.fallbacks += e.kind == ui::EventKind::fallback && e.t <= info.t + 1e-9 ? 1 : 0;
+  run_.recording = false;
+  run_.can_restart = false;
+  run_.metrics = r.done() && ready > 0 && k + 1 >= ready ? r.metrics() : Metrics{};
+  run_.replay = &info;
+  run_.session = nullptr;
+}
+
+void Trainer::build_frame(double wall_dt) {
+  if (replay_) update_replay(wall_dt);
+  else if (live_) update_live();
+  static const ui::Scene kEmpty;
+  static const ui::History kNothing;
+  ui::UiRequest req;
+  if (replay_) {
+    const std::size_t n = replay_->ready();
+    const ui::History view =
+        ui::History::view(replay_->tape(), n ? tape_index(*replay_, replay_info_.t) + 1 : 0);
+    req = ui::draw_screen(replay_->scene(), view, run_, ui_);
+  } else if (live_) {
+    req = ui::draw_screen(live_->scene, live_->history, run_, ui_);
+  } else {
+    req = ui::draw_screen(kEmpty, kNothing, run_, ui_);
+  }
+  act(req);
+}
+
+void Trainer::act(const ui::UiRequest& req) {
+  std::string error;
+  if (!req.open.empty()) {
+    if (req.open.ends_with(".mcap")) {
+      if (!open_replay(req.open, error)) say(error, true);
+    } else {
+      const std::string p = absolute_path(req.open);
+      auto it = std::find(scenario_paths_.begin(), scenario_paths_.end(), p);
+      if (it == scenario_paths_.end()) {
+        scenario_paths_.push_back(p);
+        choices_.scenarios.push_back(fs::path(p).filename().string());
+        it = scenario_paths_.end() - 1;
+      }
+      replay_.reset();
+      const FlyOptions before = options_;
+      options_.scenario_path = p;
+      if (!options_.pilot.ends_with(".mcap")) options_.pilot.clear();
+      if (replace_live(error)) choices_.scenario = int(it - scenario_paths_.begin());
+      else { options_ = before; say(error, true); }
+    }
+    return;
+  }
+  if (replay_) {
+    ui::ReplayInfo& info = replay_info_;
+    if (req.start) start();
+    if (req.toggle_pause) {
+      if (!info.playing && replay_->done() && info.t >= double(replay_->ready() - 1) * replay_->dt())
+        info.t = 0.0;  // played to the end: Play starts it again
+      info.playing = !info.playing;
+    }
+    if (req.speed > 0) replay_speed_ = std::clamp(req.speed, 0.25, 8.0);
+    // The playhead stays on a step that is ready: the last one is at (ready − 1) Δt.
+    const double last = replay_->ready() ? double(replay_->ready() - 1) * replay_->dt() : 0.0;
+    if (req.seek >= 0) info.t = std::min(req.seek, last);
+    if (req.jump != 0) {
+      const double t = ui::event_after(info.events, info.t, req.jump);
+      if (t >= 0) info.t = t;
+    }
+    if (req.lambda_threshold >= 0) {
+      info.lambda_threshold = req.lambda_threshold;
+      replay_events_final_ = false;
+    }
+    if (req.leave_replay) {
+      replay_.reset();
+      say("");
+      if (!live_ || live_->closed) {
+        if (!options_.scenario_path.empty() || options_.pilot.ends_with(".mcap")) {
+          if (!replace_live(error)) say(error, true);
+        } else {
+          live_.reset();
+        }
+      }
+    }
+    return;
+  }
+  if (!live_) return;
+  if (req.trainee_changed) choices_.trainee = req.trainee;
+  if (req.record >= 0 && !is_flying(*live_)) {
+    choices_.record = req.record == 1;
+    choices_.record_to = choices_.record ? next_record_path() : "";
+  }
+  if (req.scenario >= 0 && req.scenario < int(scenario_paths_.size()) && !is_flying(*live_)) {
+    const FlyOptions before = options_;
+    options_.scenario_path = scenario_paths_[std::size_t(req.scenario)];
+    if (!options_.pilot.ends_with(".mcap")) options_.pilot.clear();
+    if (replace_live(error)) choices_.scenario = req.scenario;
+    else { options_ = before; say(error, true); }
+  }
+  if (req.pilot >= 0 && req.pilot < int(choices_.pilots.size()) && !is_flying(*live_)) {
+    const FlyOptions before = options_;
+    options_.pilot = choices_.pilots[std::size_t(req.pilot)];
+    if (!replace_live(error)) { options_ = before; say(error, true); }
+  }
+  if (req.start) start();
+  if (req.toggle_pause && is_flying(*live_)) live_->runner->set_paused(!live_->runner->paused());
+  if (req.speed > 0) live_->runner->set_speed(std::clamp(req.speed, 0.25, 1.0));
+  if (req.restart) {
+    const double speed = live_->runner->speed();
+    if (replace_live(error)) {
+      live_->runner->set_speed(speed);
+      start();
+    } else {
+      say(error, true);
+    }
+  }
+}
+
+bool Trainer::over() const {
+  if (replay_) {
+    const std::size_t n = replay_->ready();
+    return replay_->done() && (n == 0 || tape_index(*replay_, replay_info_.t) + 1 >= n);
+  }
+  if (!live_) return true;
+  return live_->started && !live_->runner->running() && live_->closed;
+}
+
+double Trainer::shown_time() const {
+  if (replay_) return replay_->ready() ? replay_info_.t : -1.0;
+  if (live_ && !live_->history.empty()) return live_->history.newest().t;
+  return -1.0;
+}
+
+void Trainer::seek(double t) { replay_info_.t = std::max(0.0, t); }
+
+void Trainer::load_replay() {
+  if (replay_) replay_->fly();
+}
+
+int Trainer::finish() {
+  int status = status_;
+  if (replay_) {
+    replay_->stop();
+    std::fputs(replay_->mode().summary().c_str(), stdout);
+    const std::string& diff = replay_->mismatch();
+    if (diff.empty()) {
+      std::printf("  replay exact: every recorded step reproduced bit for bit\n");
+    } else if (diff != "interrupted") {
+      std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n",
+                   options_.command, replay_->path().c_str(), diff.c_str());
+      if (!options_.allow_mismatch && status == kExitOk) status = kExitReplayMismatch;
+    }
+    return status;
+  }
+  if (!live_) return status;
+  LiveFlight& f = *live_;
+  if (!f.closed) close_live(f);
+  while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
+  const Mode& mode = *f.flight.mode;
+  std::fputs(mode.summary().c_str(), stdout);
+  const RealtimeStats st = f.runner->stats();
+  std::printf("  %.1f s flown in the window\n", double(mode.steps_done()) * mode.dt());
+  print_realtime(st, mode.dt());
+  if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
+  for (const std::string& path : recorded_) std::printf("  recorded %s\n", path.c_str());
+  if (!options_.report.empty()) {
+    const Metrics metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
+                                               : with_lost_fields(mode.metrics(), mode);
+    const std::string json =
+        to_json(report_labels(f.flight, !mode.finished()), metrics) + "\n";
+    std::string error;
+    if (write_file(options_.report, json, options_.force, error)) {
+      std::printf("  report %s\n", options_.report.c_str());
+    } else {
+      std::fprintf(stderr, "mixpilot %s: %s\n", options_.command, error.c_str());
+      status = kExitError;
+    }
+  }
+  if (f.check && mode.finished()) {
+    const std::string diff = f.check->first_difference(mode.steps_done());
+    if (!diff.empty()) {
+      std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n",
+                   options_.command, options_.pilot.c_str(), diff.c_str());
+      if (!options_.allow_mismatch && status == kExitOk) status = kExitReplayMismatch;
+    }
+  }
+  return status;
+}
+
+}  // namespace mixpilot::cli

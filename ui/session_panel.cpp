@@ -1,0 +1,142 @@
+// The session panel (SPEC §8): what the next flight flies, who flies it and whether it is
+// recorded; and the File → Open browser for scenarios and recordings.
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+
+#include "ui/panels.hpp"
+#include "ui/theme.hpp"
+
+namespace mixpilot::ui {
+
+namespace {
+
+bool combo(const char* label, const std::vector<std::string>& items, int current, int& chosen) {
+  bool changed = false;
+  const char* preview = current >= 0 && current < int(items.size()) ? items[std::size_t(current)].c_str() : "";
+  if (ImGui::BeginCombo(label, preview)) {
+    for (int i = 0; i < int(items.size()); ++i) {
+      if (ImGui::Selectable(items[std::size_t(i)].c_str(), i == current)) {
+        chosen = i;
+        changed = true;
+      }
+    }
+    ImGui::EndCombo();
+  }
+  return changed;
+}
+
+}  // namespace
+
+void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
+  const SessionChoices& c = *run.session;
+  // Choices apply to the next flight: fixed while one flies.
+  const bool flying = run.state == RunState::flying || run.state == RunState::paused;
+  ImGui::BeginDisabled(flying);
+  ImGui::SetNextItemWidth(-80);
+  int chosen = -1;
+  if (combo("scenario", c.scenarios, c.scenario, chosen)) req.scenario = chosen;
+  if (!c.pilots.empty()) {
+    ImGui::SetNextItemWidth(-80);
+    if (combo("pilot", c.pilots, c.pilot, chosen)) req.pilot = chosen;
+  }
+  if (ImGui::Button("Open file... (Ctrl+O)")) ui.open_dialog.open = true;
+  ImGui::SetNextItemWidth(-80);
+  if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())
+    std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
+  ImGui::InputTextWithHint("trainee", "your name", ui.trainee, sizeof ui.trainee);
+  if (ImGui::IsItemDeactivatedAfterEdit()) {
+    req.trainee_changed = true;
+    req.trainee = ui.trainee;
+  }
+  bool record = c.record;
+  if (ImGui::Checkbox("record (Ctrl+R)", &record)) req.record = record ? 1 : 0;
+  if (c.record && !c.record_to.empty()) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + ImGui::GetContentRegionAvail().x);
+    ImGui::TextDisabled("to %s", c.record_to.c_str());
+    ImGui::PopTextWrapPos();
+  }
+  ImGui::EndDisabled();
+  if (run.state == RunState::ready) {
+    if (ImGui::Button("Start flight (Space)", ImVec2(-1, 0))) req.start = true;
+  } else if (run.can_restart) {
+    if (ImGui::Button(flying ? "Restart (R)" : "Fly again (R)", ImVec2(-1, 0))) req.restart = true;
+  }
+}
+
+void list_folder(OpenDialog& d) {
+  d.entries.clear();
+  d.error.clear();
+  std::error_code ec;
+  std::vector<std::string> folders, files;
+  for (std::filesystem::directory_iterator it(d.folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.empty() || name[0] == '.') continue;
+    std::error_code e2;
+    if (it->is_directory(e2)) folders.push_back(name + "/");
+    else if (name.ends_with(".toml") || name.ends_with(".mcap")) files.push_back(name);
+  }
+  if (ec) d.error = d.folder + ": " + ec.message();
+  std::sort(folders.begin(), folders.end());
+  std::sort(files.begin(), files.end());
+  d.entries = std::move(folders);
+  d.entries.insert(d.entries.end(), files.begin(), files.end());
+}
+
+void draw_open_dialog(UiState& ui, UiRequest& req) {
+  OpenDialog& d = ui.open_dialog;
+  if (d.open && !ImGui::IsPopupOpen("Open a scenario or a recording")) {
+    if (d.folder.empty()) {
+      std::error_code ec;
+      d.folder = std::filesystem::current_path(ec).string();
+    }
+    list_folder(d);
+    ImGui::OpenPopup("Open a scenario or a recording");
+  }
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, display.x - 40), std::min(440.0f, display.y - 40)));
+  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  if (!ImGui::BeginPopupModal("Open a scenario or a recording", &d.open,
+                              ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove))
+    return;
+  ImGui::TextDisabled("a scenario (.toml) to fly, or a recording (.mcap) to replay");
+  ImGui::TextUnformatted(d.folder.c_str());
+  ImGui::SameLine();
+  if (ImGui::SmallButton("up")) {
+    d.folder = std::filesystem::path(d.folder).parent_path().string();
+    list_folder(d);
+  }
+  const float footer = ImGui::GetFrameHeightWithSpacing() * 2.2f;
+  ImGui::BeginChild("##entries", ImVec2(0, -footer), true);
+  if (!d.error.empty()) ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", d.error.c_str());
+  std::string enter;
+  for (const std::string& e : d.entries) {
+    if (ImGui::Selectable(e.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick)) {
+      const std::string full = (std::filesystem::path(d.folder) / e).string();
+      if (e.ends_with("/")) {
+        enter = (std::filesystem::path(d.folder) / e.substr(0, e.size() - 1)).string();
+      } else {
+        std::snprintf(d.path, sizeof d.path, "%s", full.c_str());
+        if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) req.open = full;
+      }
+    }
+  }
+  ImGui::EndChild();
+  if (!enter.empty()) {
+    d.folder = enter;
+    list_folder(d);
+  }
+  ImGui::SetNextItemWidth(-150);
+  const bool typed = ImGui::InputText("##path", d.path, sizeof d.path, ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("Open", ImVec2(64, 0)) || typed) && d.path[0] != '\0') req.open = d.path;
+  ImGui::SameLine();
+  if (ImGui::Button("Cancel", ImVec2(64, 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+    d.open = false;
+  if (!req.open.empty()) d.open = false;
+  if (!d.open) ImGui::CloseCurrentPopup();
+  ImGui::EndPopup();
+}
+
+}  // namespace mixpilot::ui
