@@ -182,6 +182,7 @@ void Trainer::start() {
     live_->record_path = path;
     live_->session->add_sink(&live_->recorder);
   }
+  live_->history.clear();  // the initial state shown while ready
   live_->runner->start();
   live_->started = true;
   say("");
@@ -219,6 +220,8 @@ void Trainer::update_live() {
     }
   }
   const Mode& mode = *f.flight.mode;
+  // Before the start the screen shows the initial state: the arena, the vehicle, the reference.
+  if (!f.started && f.history.empty()) f.history.push(mode.telemetry());
   const bool over = f.started && !f.runner->running();
   // The run is over: its recording is completed at once, and the score card shows.
   if (over && !f.closed) close_live(f);

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
@@ -142,6 +144,14 @@ class App : public testing::Test {
   cli::Offscreen screen_;
 };
 
+// Saves the last frame as NAME.png in $MIXPILOT_SHOT_DIR when it is set (to look at the app's
+// states that no command line reaches).
+void save_shot(const cli::Offscreen& screen, const std::string& name) {
+  const char* dir = std::getenv("MIXPILOT_SHOT_DIR");
+  if (!dir || !*dir) return;
+  std::ofstream(std::string(dir) + "/" + name + ".png", std::ios::binary) << screen.png();
+}
+
 // A newcomer's first flight: one click on the session panel's Start, then Space pauses and
 // resumes it.
 TEST_F(App, ClickStartThenSpacePausesAndResumes) {
@@ -150,7 +160,9 @@ TEST_F(App, ClickStartThenSpacePausesAndResumes) {
   int status = 0;
   ASSERT_TRUE(app.open_live(error, status)) << error;
   frame(app);
+  frame(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::ready);
+  save_shot(screen_, "ready");
   const auto start = locate(app, "Session", "Start flight (Space)");
   ASSERT_TRUE(start) << "no Start button in the session panel";
   click(app, *start);
@@ -165,6 +177,8 @@ TEST_F(App, ClickStartThenSpacePausesAndResumes) {
   until_over(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::finished);
   EXPECT_FALSE(app.run_info().metrics.empty()) << "no score card at the end";
+  frame(app);
+  save_shot(screen_, "finished");
 }
 
 // R flies the same scenario again from its start: a new flight, the old one's telemetry gone.
@@ -355,6 +369,8 @@ TEST_F(App, HelpAndOpenDialogFromTheKeyboard) {
   frame(app);
   key(app, ui::kKeyF1);
   EXPECT_TRUE(app.ui_state().show_help);
+  frame(app);
+  save_shot(screen_, "help");
   const ImGuiWindow* sheet = ImGui::FindWindowByName("Keyboard and mouse (F1)");
   EXPECT_TRUE(sheet && sheet->Active);
   key(app, ImGuiKey_Escape);
@@ -362,6 +378,10 @@ TEST_F(App, HelpAndOpenDialogFromTheKeyboard) {
   key(app, 'O', true);
   EXPECT_TRUE(app.ui_state().open_dialog.open);
   EXPECT_FALSE(app.ui_state().open_dialog.entries.empty());
+  frame(app);  // a popup shows from its second frame
+  const ImGuiWindow* browser = ImGui::FindWindowByName("Open a scenario or a recording");
+  EXPECT_TRUE(browser && browser->Active);
+  save_shot(screen_, "open_dialog");
 }
 
 }  // namespace

@@ -124,7 +124,8 @@ void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVe
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
   const ImVec2 bar_min = ImGui::GetCursorScreenPos();
   if (sc.mode == ModeKind::mixed_initiative) {
-    draw_authority_bar(s ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + size.x - 16, bar_min.y + 30));
+    // Before the first solve (the initial state) the pilot has the authority.
+    draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + size.x - 16, bar_min.y + 30));
     ImGui::Dummy(ImVec2(size.x - 16, 30 + ImGui::GetTextLineHeightWithSpacing()));
   }
   // Over the last minute at most (a replay's history is the whole flight up to the playhead).
