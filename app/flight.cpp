@@ -111,9 +111,10 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
 }
 
 void print_realtime(const RealtimeStats& st, double dt) {
-  std::printf("  real time: %lld deadline misses; worst start lateness %.0f us, step p99 %.0f us, "
-              "longest %.0f us (dt %.0f us); control thread %s\n",
-              static_cast<long long>(st.deadline_misses), st.worst_lateness_us, st.p99_step_us,
+  std::printf("  real time: %lld deadline misses, %lld late starts; worst start lateness %.0f us, "
+              "step p99 %.0f us, longest %.0f us (dt %.0f us); control thread %s\n",
+              static_cast<long long>(st.deadline_misses), static_cast<long long>(st.late_starts),
+              st.worst_lateness_us, st.p99_step_us,
               st.worst_step_us, 1e6 * dt,
               st.realtime_priority ? "SCHED_FIFO" : "at normal priority (no real-time scheduling granted)");
 }

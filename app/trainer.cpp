@@ -145,12 +145,13 @@ void Trainer::close_live(LiveFlight& f) {
   if (!f.record_path.empty()) {
     std::string error;
     if (f.recorder.close(error, !f.flight.mode->finished())) {
-      recorded_.push_back(f.record_path);
       if (f.record_path == first_record_) first_record_.clear();
       const std::int64_t dropped = f.recorder.dropped();
-      say("recorded " + f.record_path +
-          (dropped ? " (" + std::to_string(dropped) + " steps lost: the disk was too slow)" : ""),
-          dropped > 0);
+      const std::string what =
+          f.record_path +
+          (dropped ? " (" + std::to_string(dropped) + " steps lost: the disk was too slow)" : "");
+      recorded_.push_back(what);
+      say("recorded " + what, dropped > 0);
     } else {
       say(error, true);
       status_ = kExitError;

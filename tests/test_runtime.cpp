@@ -116,5 +116,30 @@ TEST(RealtimeRunner, PauseStopsStepsAndResumeGoesOn) {
   EXPECT_FALSE(mode->finished());  // stopped early: the run was cut at the next step
 }
 
+// A step that ends after its period is a deadline miss, counted once: the schedule restarts
+// from its end, so the steps after it are on time again. Steps that take part of the period
+// are not, and the p99 step time reflects them, not the one outlier.
+TEST(RealtimeRunner, ADeadlineMissIsAStepThatEndsAfterItsPeriod) {
+  auto mode = short_flight(3.0);  // 200 steps of 15 ms
+  ASSERT_TRUE(mode);
+  struct Slow : TelemetrySink {
+    void on_sample(const Telemetry& s) override {
+      std::this_thread::sleep_for(std::chrono::milliseconds(s.step == 50 ? 40 : 4));
+    }
+  } slow;
+  Session session(*mode);
+  session.add_sink(&slow);
+  RealtimeRunner runner(session, 1024);
+  runner.start();
+  while (runner.running()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  runner.stop();
+  const RealtimeStats st = runner.stats();
+  EXPECT_EQ(st.steps, 200);
+  EXPECT_EQ(st.deadline_misses, 1);
+  EXPECT_GE(st.worst_step_us, 40000.0);
+  EXPECT_GE(st.p99_step_us, 4000.0);
+  EXPECT_LT(st.p99_step_us, 15000.0);
+}
+
 }  // namespace
 }  // namespace mixpilot

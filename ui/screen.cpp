@@ -53,6 +53,25 @@ ImU32 state_colour(RunState s) {
   }
 }
 
+// `text` shortened in its middle ("start…end") to fit `width` pixels of the current font.
+std::string elide_middle(const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
+  const std::string dots = "\u2026";
+  // Cut whole UTF-8 code points: never split a continuation byte (10xxxxxx).
+  auto cut = [&](std::size_t keep) {
+    std::size_t head = keep / 2, tail = text.size() - (keep - keep / 2);
+    while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
+    while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
+    return text.substr(0, head) + dots + text.substr(tail);
+  };
+  std::size_t lo = 0, hi = text.size();  // longest kept byte count that fits
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi + 1) / 2;
+    if (ImGui::CalcTextSize(cut(mid).c_str()).x <= width) lo = mid; else hi = mid - 1;
+  }
+  return cut(lo);
+}
+
 void pill(const char* text, ImU32 c) {
   const ImVec2 p = ImGui::GetCursorScreenPos();
   const ImVec2 ts = ImGui::CalcTextSize(text);
@@ -70,10 +89,17 @@ void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui,
   ImGui::Begin("##top", nullptr, kPane);
   pill(to_string(run.state), state_colour(run.state));
   ImGui::SameLine();
-  ImGui::Text("%s   ·   %s   ·   %s", sc.title.c_str(), to_string(sc.mode),
-              sc.input_source.c_str());
-  // File and help at the right end.
-  const float right_w = ImGui::CalcTextSize("Open... (Ctrl+O)").x + ImGui::CalcTextSize("Help (F1)").x + 40;
+  // File and help at the right end; the title gives way to them (elided, full text on hover).
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const float right_w = ImGui::CalcTextSize("Open... (Ctrl+O)").x +
+                        ImGui::CalcTextSize("Help (F1)").x + 4 * st.FramePadding.x +
+                        2 * st.ItemSpacing.x + st.WindowPadding.x;
+  const std::string title =
+      sc.title + "   ·   " + to_string(sc.mode) + "   ·   " + sc.input_source;
+  const float title_w = size.x - right_w - ImGui::GetCursorPosX();
+  ImGui::TextUnformatted(elide_middle(title, title_w).c_str());
+  if (ImGui::IsItemHovered() && ImGui::CalcTextSize(title.c_str()).x > title_w)
+    ImGui::SetTooltip("%s", title.c_str());
   ImGui::SameLine(std::max(ImGui::GetCursorPosX(), size.x - right_w));
   if (ImGui::Button("Open... (Ctrl+O)")) ui.open_dialog.open = true;
   ImGui::SameLine();
@@ -118,7 +144,8 @@ void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui,
 }
 
 // The HUD under the authority bar: deviation, time in B, RTI time, fallbacks, misses.
-void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVec2 size) {
+// Returns the screen y of its bottom edge.
+float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVec2 size) {
   ImGui::SetNextWindowPos(pos);
   ImGui::Begin("##hud", nullptr, kOverlay | ImGuiWindowFlags_AlwaysAutoResize);
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
@@ -137,11 +164,19 @@ void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVe
   const std::size_t n = h.size() - from;
   const double dev = s ? channel_value(*s, "deviation") : 0.0;
   ImGui::PushFont(mono_font());
-  if (sc.mode == ModeKind::mixed_initiative)
-    ImGui::Text("deviation %.3f m (r %.2f)   in B %5.1f %% of the last %.0f s", dev,
-                sc.ball_radius,
-                n ? 100.0 * double(in_ball) / double(n) : 100.0,
-                n ? h.newest().t - h[from].t + sc.dt : 0.0);
+  if (sc.mode == ModeKind::mixed_initiative) {
+    char deviation[64], ball[64];
+    std::snprintf(deviation, sizeof deviation, "deviation %.3f m (r %.2f)", dev, sc.ball_radius);
+    std::snprintf(ball, sizeof ball, "in B %5.1f %% of the last %.0f s",
+                  n ? 100.0 * double(in_ball) / double(n) : 100.0,
+                  n ? h.newest().t - h[from].t + sc.dt : 0.0);
+    // One line where the arena is wide enough, two where it is not.
+    ImGui::TextUnformatted(deviation);
+    const float one_line = ImGui::CalcTextSize(deviation).x + ImGui::CalcTextSize("   ").x +
+                           ImGui::CalcTextSize(ball).x;
+    if (one_line <= size.x - 16) ImGui::SameLine(0, ImGui::CalcTextSize("   ").x);
+    ImGui::TextUnformatted(ball);
+  }
   ImGui::Text("RTI %5.0f us   fallbacks %lld", s ? s->stats.total_us : 0.0,
               static_cast<long long>(run.fallbacks));
   ImGui::SameLine();
@@ -150,7 +185,9 @@ void hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVe
   ImGui::Text("  deadline misses %lld", static_cast<long long>(run.deadline_misses));
   if (run.deadline_misses > 0) ImGui::PopStyleColor();
   ImGui::PopFont();
+  const float bottom = ImGui::GetCursorScreenPos().y;
   ImGui::End();
+  return bottom;
 }
 
 // What each score field means (README, Scoring), for the score card.
@@ -333,10 +370,14 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   const float view_w = d.x - right;
   const float hud_w = std::min(0.6f * view_w, 640.0f);
   const float hud_x = std::max(0.5f * (view_w - hud_w), panel ? panel_w + 16 : 0.0f);
-  hud(sc, h, run, ImVec2(hud_x, top + 8), ImVec2(std::min(hud_w, view_w - hud_x - 8), 110));
+  const float hud_bottom =
+      hud(sc, h, run, ImVec2(hud_x, top + 8), ImVec2(std::min(hud_w, view_w - hud_x - 8), 110));
 
-  if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty()) {
-    const float w = 300, ht = 170;
+  // The sticks below the HUD, shrunk (down to a readable size) when the window is short.
+  const float sticks_ht = std::min(170.0f, d.y - bottom - 8 - hud_bottom);
+  if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty() &&
+      sticks_ht >= 100.0f) {
+    const float ht = sticks_ht, w = ht * 300.0f / 170.0f;
     ImGui::SetNextWindowPos(ImVec2(0.5f * (view_w - w), d.y - bottom - ht - 8));
     ImGui::SetNextWindowSize(ImVec2(w, ht));
     ImGui::Begin("##sticks", nullptr, kOverlay);

@@ -28,8 +28,8 @@ void RealtimeRunner::stop() {
 }
 
 RealtimeStats RealtimeRunner::stats() const {
-  RealtimeStats st{steps_.load(), misses_.load(), worst_lateness_us_.load(),
-                   worst_step_us_.load(), 0.0, fifo_.load()};
+  RealtimeStats st{steps_.load(),         misses_.load(),         late_starts_.load(),
+                   worst_lateness_us_.load(), worst_step_us_.load(), 0.0, fifo_.load()};
   // The smallest bin edge below which 99 % of the steps fall.
   std::uint64_t total = 0;
   for (const auto& b : step_bins_) total += b.load(std::memory_order_relaxed);
@@ -76,7 +76,9 @@ void RealtimeRunner::loop() {
     ring_.push(session_->mode().telemetry());
     const double step_us = std::chrono::duration<double, std::micro>(ended - started).count();
     const double period_us = 1e6 * dt / std::max(1e-3, speed_.load(std::memory_order_relaxed));
-    if (late_us > 0.1 * 1e6 * dt || step_us > 1e6 * dt) misses_.fetch_add(1);
+    const bool missed = late_us + step_us > period_us || step_us > 1e6 * dt;
+    if (missed) misses_.fetch_add(1);
+    else if (late_us > 0.1 * 1e6 * dt) late_starts_.fetch_add(1);
     if (late_us > worst_lateness_us_.load()) worst_lateness_us_.store(late_us);
     if (step_us > worst_step_us_.load()) worst_step_us_.store(step_us);
     step_bins_[std::size_t(std::min(double(kBins - 1), step_us / kBinUs))].fetch_add(
@@ -84,8 +86,8 @@ void RealtimeRunner::loop() {
     steps_.fetch_add(1);
     const auto period =
         std::chrono::duration_cast<clock::duration>(std::chrono::duration<double, std::micro>(period_us));
-    // A late step restarts the schedule from its own start: no burst of catch-up steps.
-    next = (late_us > 0.1 * 1e6 * dt ? started : next) + period;
+    // A missed deadline restarts the schedule from the step's end: no burst of catch-up steps.
+    next = (missed ? ended : next) + period;
   }
   running_.store(false);
 }

@@ -131,10 +131,23 @@ check "... and writes nothing" test -z "$(ls "$work" | grep nodisplay)"
 if command -v xvfb-run >/dev/null 2>&1; then
   # A random first display number: parallel runs on one machine do not race for :99.
   xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1280x800x24" "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" \
-    --pilot novice --duration 2 --exit-at-end --screenshot 1.5:"$work/window.png" >"$work/win.out" 2>&1
+    --pilot novice --duration 2 --exit-at-end --screenshot 1.5:"$work/window.png" \
+    --record "$work/window.mcap" --report "$work/window.json" >"$work/win.out" 2>&1
   check "the window flies and closes itself" test $? -eq 0
   check "... with a frame of it" test -s "$work/window.png"
   check "... and the real-time summary" grep -q "real time:" "$work/win.out"
+  # Recorded in the window, in real time: nothing lost, and `score` of the file gives the live
+  # score to the bit (timing fields included: score takes them from the recording).
+  check "... recorded without losing a step" grep -q "recorded $work/window.mcap$" "$work/win.out"
+  "$mixpilot" score "$work/window.mcap" --json "$work/window_score.json" >"$work/win.score" 2>&1
+  check "the window's recording replays exactly" grep -q "exact" "$work/win.score"
+  check "the window's report and score of its recording agree exactly" \
+    diff <(fields "$work/window.json") <(fields "$work/window_score.json")
+  # `replay` in the window plays the recording to its end and closes itself.
+  xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1280x800x24" "$mixpilot" replay "$work/window.mcap" \
+    --exit-at-end --screenshot 1:"$work/replay_window.png" >"$work/rwin.out" 2>&1
+  check "replay in the window plays to the end and closes itself" test $? -eq 0
+  check "... with a frame of it" test -s "$work/replay_window.png"
 fi
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --duration -3 >"$work/e2" 2>&1
 check "negative duration is a usage error" test $? -eq 2
