@@ -115,7 +115,10 @@ void Offscreen::frame(const std::function<void()>& build, float dt) {
   ImGui::Render();
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);
-  glClearColor(0.086f, 0.098f, 0.118f, 1.0f);
+  {
+    const ImVec4 c = ImGui::ColorConvertU32ToFloat4(ui::colour::kPane);
+    glClearColor(c.x, c.y, c.z, 1.0f);
+  }
   glClear(GL_COLOR_BUFFER_BIT);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   glFinish();

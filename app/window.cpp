@@ -96,7 +96,10 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     glViewport(0, 0, w, h);
-    glClearColor(0.086f, 0.098f, 0.118f, 1.0f);
+    {
+      const ImVec4 c = ImGui::ColorConvertU32ToFloat4(ui::colour::kPane);
+      glClearColor(c.x, c.y, c.z, 1.0f);
+    }
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     const double shown = app.shown_time();

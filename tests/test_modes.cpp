@@ -223,5 +223,24 @@ const ModeCase kCases[] = {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, EveryMode, testing::ValuesIn(kCases), print_case);
 
+// A session length given apart from the file (fly --duration) obeys the file's own rule: the
+// helix reference climbs out of mi_helix_slow's 2.5 m arena at 113.998 s (z = 0.6 + 0.016667 t).
+TEST(MakeMode, ASessionLengthThatTakesTheReferenceOutOfTheArenaIsRefused) {
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix_slow.toml";
+  for (const double seconds : {113.9, 300.0}) {
+    ModeRequest request;
+    request.duration = seconds;
+    std::string error;
+    const auto mode = load_mode(path, std::move(request), error);
+    if (seconds < 114.0) {
+      EXPECT_TRUE(mode) << error;
+    } else {
+      EXPECT_FALSE(mode);
+      EXPECT_NE(error.find("flies the reference out of the arena at t = 113.997 s"), std::string::npos)
+          << error;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mixpilot

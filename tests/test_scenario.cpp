@@ -100,13 +100,19 @@ TEST(Scenario, ShippedMiHelixLoads) {
 
 // SPEC 5.4: every obstacle clear of the reference by more than r + the quadrotor's radius,
 // with ~0.1 m to spare (a pilot anywhere inside B keeps clearance), but near enough to matter.
-TEST(Scenario, MiHelixObstaclesClearTheReference) {
+// mi_helix_endurance's five coils are checked the same way.
+class ShippedHelix : public testing::TestWithParam<const char*> {};
+INSTANTIATE_TEST_SUITE_P(Scenario, ShippedHelix,
+                         testing::Values("mi_helix", "mi_helix_endurance"));
+
+TEST_P(ShippedHelix, ObstaclesClearTheReference) {
   std::string error;
-  const auto sc = load_scenario(kMiHelix, error);
+  const auto sc = load_scenario(
+      std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/" + GetParam() + ".toml", error);
   ASSERT_TRUE(sc) << error;
   const double required = sc->controller.ph.r + sc->controller.vehicle_radius;
   EXPECT_NEAR(required, 0.475, 1e-12);
-  constexpr int kSamples = 300000;  // 0.1 ms: ≤ 21 µm of arc between samples
+  const int kSamples = int(sc->duration * 1e4);  // 0.1 ms: ≤ 11 µm of arc between samples
   double nearest = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < sc->arena.obstacles.size(); ++j) {
     const Obstacle& o = sc->arena.obstacles[j];
@@ -247,7 +253,7 @@ TEST(Scenario, OutOfRange) {
             "t.toml:7:10: arena.obstacles[0].radius: value outside (0, 100], got 0.0");
   EXPECT_EQ(error_of("[reference]\nclimb_rate = 0.2\n"),
             "t.toml:5:1: reference: expected a helix inside the arena over [0, duration], but "
-            "it leaves it at t = 12.503 s, at (-0.330, -0.944, 3.001)");
+            "it leaves it at t = 12.500 s, at (-0.331, -0.944, 3.000)");
 }
 
 TEST(Scenario, MissingRequiredKey) {

@@ -33,11 +33,12 @@ const char* to_string(RunState s) {
 
 namespace {
 
-// Fixed panes stay behind (ImGui puts each such window at the back when it is created);
-// overlays come after them and never take the focus.
+// Fixed panes stay behind (ImGui puts each such window at the back when it is created) and
+// show the frame's clear colour, colour::kPane; overlays come after them and never take the
+// focus.
 constexpr ImGuiWindowFlags kPane = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
                                    ImGuiWindowFlags_NoSavedSettings |
-                                   ImGuiWindowFlags_NoBringToFrontOnFocus;
+                                   ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoBackground;
 constexpr ImGuiWindowFlags kOverlay = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
                                       ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoInputs |
                                       ImGuiWindowFlags_NoFocusOnAppearing |

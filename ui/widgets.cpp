@@ -162,7 +162,9 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
       }
     }
     flush();
-    dl->PathStroke(s.colour, 0, 1.5f);
+    // An integer width lets ImGui draw the line from its anti-aliased texture: a third of the
+    // triangles of a fractional width, which a software rasterizer feels.
+    dl->PathStroke(s.colour, 0, 2.0f);
   }
   char buf[96];
   std::snprintf(buf, sizeof buf, "%.3g", hi - pad);

@@ -1,5 +1,7 @@
 #include "core/modes/make_mode.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 #include "core/modes/mi_mode.hpp"
@@ -15,11 +17,30 @@ namespace mixpilot {
 
 namespace {
 
+// Seconds to the millisecond, without trailing zeros ("113.907", "300").
+std::string seconds_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", std::floor(s * 1000.0) / 1000.0);
+  std::string t(buf);
+  while (t.back() == '0') t.pop_back();
+  if (t.back() == '.') t.pop_back();
+  return t;
+}
+
 std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& source_name,
                                    ModeRequest& request, std::string& error) {
   std::optional<Scenario> scenario = parse_scenario(text, source_name, error);
   if (!scenario) return nullptr;
-  if (request.duration) scenario->duration = *request.duration;
+  if (request.duration) {
+    // The same rule as the file's own duration: the reference stays inside the arena.
+    if (const auto t = reference_leaves_arena(*scenario, *request.duration)) {
+      error = source_name + ": a session of " + seconds_text(*request.duration) +
+              " s flies the reference out of the arena at t = " + seconds_text(*t) +
+              " s; this scenario allows at most " + seconds_text(*t) + " s";
+      return nullptr;
+    }
+    scenario->duration = *request.duration;
+  }
   std::unique_ptr<PilotSource> pilot = std::move(request.pilot_source);
   if (!pilot) {
     const std::string& name =

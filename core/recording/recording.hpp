@@ -150,7 +150,7 @@ struct SessionInfo {
   std::string scenario_path;
   uint64_t seed = 0;
   std::string pilot;          // pilot source, as in PilotCommandMsg::source (mixed initiative)
-  std::string trainee;        // the person flying, as typed in the app ("" unknown)
+  std::string trainee = {};   // the person flying, as typed in the app ("" unknown)
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by

@@ -83,11 +83,22 @@ PilotProfile read_pilot(Section s, const std::string& name) {
 // sinusoids and a line: sampling at ≤ 1 mrad of phase misses at most ~R·5e-7 m of excursion.
 std::optional<double> helix_leaves(const HelixReference& h, double duration,
                                    const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const auto outside = [&](double t) {
+    const Eigen::Vector3d p = h.position(t);
+    return (p.array() < lo.array()).any() || (p.array() > hi.array()).any();
+  };
   const int n = std::max(1000, int(std::ceil(std::abs(h.angular_rate) * duration / 1e-3)));
   for (int i = 0; i <= n; ++i) {
-    const double t = duration * i / n;
-    const Eigen::Vector3d p = h.position(t);
-    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return t;
+    double t = duration * i / n;
+    if (!outside(t)) continue;
+    // Bisect down to the crossing between the last sample inside and this one.
+    double in = i > 0 ? duration * (i - 1) / n : 0.0;
+    if (i == 0) return 0.0;
+    for (int k = 0; k < 40; ++k) {
+      const double mid = 0.5 * (in + t);
+      (outside(mid) ? t : in) = mid;
+    }
+    return t;
   }
   return std::nullopt;
 }
@@ -278,6 +289,10 @@ bool read_text_file(const std::string& path, std::string& text, std::string& err
   }
   text = s.str();
   return true;
+}
+
+std::optional<double> reference_leaves_arena(const Scenario& sc, double duration) {
+  return helix_leaves(sc.reference, duration, sc.arena.min, sc.arena.max);
 }
 
 std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,

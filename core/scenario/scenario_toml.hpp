@@ -35,4 +35,9 @@ bool read_text_file(const std::string& path, std::string& text, std::string& err
 std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
                                          std::string& error);
 
+// First time in [0, duration] at which the helix reference leaves the arena box, if any
+// (the loader refuses such a file; a session length given apart, e.g. on the command line,
+// is checked with this).
+[[nodiscard]] std::optional<double> reference_leaves_arena(const Scenario& sc, double duration);
+
 }  // namespace mixpilot
