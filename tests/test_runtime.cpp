@@ -117,14 +117,16 @@ TEST(RealtimeRunner, PauseStopsStepsAndResumeGoesOn) {
 }
 
 // A step that ends after its period is a deadline miss, counted once: the schedule restarts
-// from its end, so the steps after it are on time again. Steps that take part of the period
-// are not, and the p99 step time reflects them, not the one outlier.
+// from its end, so the steps after it are on time again (were it kept, the six steps due during
+// the 100 ms overrun would all end late). Steps that take part of the period are not misses, and
+// the p99 step time reflects them, not the one outlier. The ordinary steps are kept light so a
+// sanitizer build on a loaded machine stays far inside the period; a few stray misses are allowed.
 TEST(RealtimeRunner, ADeadlineMissIsAStepThatEndsAfterItsPeriod) {
   auto mode = short_flight(3.0);  // 200 steps of 15 ms
   ASSERT_TRUE(mode);
   struct Slow : TelemetrySink {
     void on_sample(const Telemetry& s) override {
-      std::this_thread::sleep_for(std::chrono::milliseconds(s.step == 50 ? 40 : 4));
+      std::this_thread::sleep_for(std::chrono::milliseconds(s.step == 50 ? 100 : 1));
     }
   } slow;
   Session session(*mode);
@@ -135,9 +137,10 @@ TEST(RealtimeRunner, ADeadlineMissIsAStepThatEndsAfterItsPeriod) {
   runner.stop();
   const RealtimeStats st = runner.stats();
   EXPECT_EQ(st.steps, 200);
-  EXPECT_EQ(st.deadline_misses, 1);
-  EXPECT_GE(st.worst_step_us, 40000.0);
-  EXPECT_GE(st.p99_step_us, 4000.0);
+  EXPECT_GE(st.deadline_misses, 1);
+  EXPECT_LE(st.deadline_misses, 3);
+  EXPECT_GE(st.worst_step_us, 100000.0);
+  EXPECT_GE(st.p99_step_us, 1000.0);
   EXPECT_LT(st.p99_step_us, 15000.0);
 }
 
