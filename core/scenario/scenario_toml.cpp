@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/numerics/input_file.hpp"
-#include "core/scenario/detail/toml_read.hpp"
+#include "core/scenario/toml_read.hpp"
 
 namespace mixpilot {
 namespace {

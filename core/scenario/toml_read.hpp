@@ -1,6 +1,7 @@
 #pragma once
 // Reading TOML with precise diagnostics (`<file>:<line>:<col>: <key path>: <what was expected>`):
-// shared by every scenario loader. Internal to the scenario layer (detail/): it includes toml++.
+// shared by every scenario loader and by the input settings (input/settings.cpp). It includes
+// toml++: only the readers' .cpp files include it, never a public header.
 //
 // Debian's toml++ is the compiled shared library, built with exceptions: including TUs keep
 // them on (switching them off would select the noex ABI the library does not export) and
