@@ -148,7 +148,8 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
     const double s = static_cast<double>(k);
     joy = {{}, "gamepad0", {0.5f, -0.25f, static_cast<float>(k) * 0.125f, 1.0f}, {1, 0, 0, 1, 3}};
     ASSERT_TRUE(rec.record_joy(k, joy));
-    pilot = {{}, k, 0.01 * s, -0.02 * s, {0.0655, 0.0656, 0.0657, 0.0658}, "experienced"};
+    pilot = {{}, k, 0.01 * s, -0.02 * s, {0.0655, 0.0656, 0.0657, 0.0658}, "experienced",
+             0.125 * static_cast<double>(k % 9), static_cast<uint8_t>(k % 4)};
     ASSERT_TRUE(rec.record_pilot(pilot));
     state.step = k;
     state.x.assign(16, 0.0);
@@ -223,7 +224,8 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.key("units").strs(channels.units).key("values").nums(channels.values).end('}');
   j.key("/pilot/command").begin('{').stamp(t).key("step").num(pilot.step);
   j.key("roll").num(pilot.roll).key("pitch").num(pilot.pitch);
-  j.key("rotor_speed").nums(pilot.rotor_speed).key("source").str(pilot.source).end('}');
+  j.key("rotor_speed").nums(pilot.rotor_speed).key("source").str(pilot.source);
+  j.key("authority").num(pilot.authority).key("input_state").num(pilot.input_state).end('}');
   j.key("/vehicle/state").begin('{').stamp(t).key("step").num(state.step);
   j.key("x").nums(state.x).end('}');
   j.end('}');

@@ -141,7 +141,8 @@ void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eig
 }
 
 RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
-  lambda_used_ = lambda_next_;
+  // The source's authority caps λ (input loss hands the vehicle to the planner, SPEC §6).
+  lambda_used_ = std::min(lambda_next_, std::clamp(pilot.authority, 0.0, 1.0));
   set_stage_data(t, pilot, x);
   rti_.prepare();
   const RtiStatus status = rti_.feedback(x);

@@ -10,11 +10,21 @@
 
 namespace mixpilot {
 
-// The human reference ν^r = (φ_h, θ_h, Ω_h) of SPEC §5.4.
+// A device's link to the pilot (SPEC §6, input loss). While it is not `ok` the planner has the
+// authority: lost (unplugged, or no new input for longer than the timeout), then waiting for
+// the sticks to be re-centred, then handing the authority back gradually.
+enum class InputState : std::uint8_t { ok = 0, lost = 1, recentre = 2, returning = 3 };
+const char* to_string(InputState s);
+
+// The human reference ν^r = (φ_h, θ_h, Ω_h) of SPEC §5.4, and how much authority the source
+// grants: the controller uses min(λ, authority), so 0 hands the vehicle to the planner (as
+// λ = 0) and a ramp back to 1 returns it without a jump.
 struct PilotCommand {
   double roll = 0.0;                                // φ_h [rad]
   double pitch = 0.0;                               // θ_h [rad]
   Eigen::Vector4d rotor_speed = Eigen::Vector4d::Zero();  // Ω_h (scaled units, SPEC §3.3)
+  double authority = 1.0;                           // cap on λ, in [0, 1]
+  InputState input = InputState::ok;
 };
 
 // Raw device input that produced a command (sensor_msgs/Joy in recordings). Fixed capacity,

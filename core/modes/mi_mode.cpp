@@ -132,6 +132,9 @@ bool MiMode::step() {
   const double t = double(step_) * dt_;
   Telemetry& s = telemetry_;
   measure(t);
+  const InputState was = s.pilot.input;
+  s.pilot.authority = 1.0;  // sources without a device leave these as they are
+  s.pilot.input = InputState::ok;
   if (!pilot_->command(step_, t, x_, s.pilot)) {
     finished_ = true;
     return false;
@@ -155,6 +158,7 @@ bool MiMode::step() {
   s.u = u_delay_[std::size_t(step_ + 1) % n];
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (s.stats.overrun) s.events |= kEventOverrun;
+  if (s.pilot.input == InputState::lost && was != InputState::lost) s.events |= kEventInputLost;
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();
 

@@ -34,6 +34,7 @@ enum ModeEvent : std::uint32_t {
   kEventSwitch = 1u << 3,     // the active controller changed (Pendubot NMPC ↔ LQR)
   kEventLost = 1u << 4,       // the vehicle was lost (non-finite or far away): the run ends
   kEventOverrun = 1u << 5,    // the RTI solve overran its deadline: handled as a fallback
+  kEventInputLost = 1u << 6,  // the pilot's device was lost: the planner took the authority
 };
 
 // A named scalar of one step, for plots that do not know the mode. Names and units are string

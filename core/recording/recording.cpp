@@ -54,6 +54,8 @@ constexpr const char kPilotCommandSchema[] =
     "float64 pitch           # theta_h [rad]\n"
     "float64[4] rotor_speed  # Omega_h [kHz, scaled unit]\n"
     "string source           # novice, experienced, reckless, gamepad, replay:<file>, ...\n"
+    "float64 authority       # the source's cap on lambda: 1, 0 while the input is lost\n"
+    "uint8 input_state       # 0 ok, 1 lost, 2 waiting for re-centred sticks, 3 returning\n"
     "\n" MIXPILOT_TIME_DEP;
 
 constexpr const char kVehicleStateSchema[] =
@@ -217,11 +219,16 @@ void encode_body(const PilotCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
   w.write(m.pitch);
   put_array(m.rotor_speed, w);
   w.write_string(m.source);
+  w.write(m.authority);
+  w.write(m.input_state);
 }
 bool decode(std::span<const uint8_t> d, PilotCommandMsg& m, std::string& error) {
   CdrReader r(d);
+  m.authority = 1.0;  // recordings made before the fields existed end after `source`
+  m.input_state = 0;
   (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.roll) && r.read(m.pitch) &&
-      get_array(r, m.rotor_speed) && r.read_string(m.source));
+      get_array(r, m.rotor_speed) && r.read_string(m.source) &&
+      (r.remaining() < 8 || (r.read(m.authority) && r.read(m.input_state))));
   return finish(r, error);
 }
 

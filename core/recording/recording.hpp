@@ -47,6 +47,8 @@ struct PilotCommandMsg {
   double pitch = 0.0;                    // θ_h [rad]
   std::array<double, 4> rotor_speed{};   // Ω_h [kHz, the model's scaled unit]
   std::string source;  // "novice", "experienced", "reckless", "gamepad", "replay:<file>", ...
+  double authority = 1.0;     // the source's cap on λ (PilotCommand::authority)
+  uint8_t input_state = 0;    // InputState: 0 ok, 1 lost, 2 re-centre, 3 returning
   bool operator==(const PilotCommandMsg&) const = default;
 };
 

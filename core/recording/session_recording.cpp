@@ -85,6 +85,8 @@ void RecordingSink::write(const Telemetry& s) {
     pilot_.pitch = s.pilot.pitch;
     for (int i = 0; i < 4; ++i) pilot_.rotor_speed[std::size_t(i)] = s.pilot.rotor_speed(i);
     pilot_.source = pilot_name_;
+    pilot_.authority = s.pilot.authority;
+    pilot_.input_state = static_cast<std::uint8_t>(s.pilot.input);
     recorder_.record_pilot(pilot_);
   }
 
@@ -156,6 +158,8 @@ bool ReplayPilot::command(std::int64_t step, double, const Eigen::VectorXd&, Pil
   out.roll = m.roll;
   out.pitch = m.pitch;
   for (int i = 0; i < 4; ++i) out.rotor_speed(i) = m.rotor_speed[std::size_t(i)];
+  out.authority = m.authority;
+  out.input = m.input_state <= 3 ? static_cast<InputState>(m.input_state) : InputState::lost;
   return true;
 }
 
