@@ -1,0 +1,163 @@
+#include "input/settings.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "core/recording/output_file.hpp"
+#include "core/scenario/toml_read.hpp"
+#include "core/scenario/scenario_toml.hpp"
+
+namespace mixpilot::input {
+
+namespace {
+
+using namespace toml_read;
+
+// The documented ranges (docs/input-settings.md).
+constexpr IntRange kMode{1, 4};
+constexpr Range kMaxTilt = left_open(0, 60);         // [deg]
+constexpr Range kThrustRange = left_open(0, 1);
+constexpr Range kDeadzone = closed(0, 0.5);
+constexpr Range kExpo = closed(0, 1);
+constexpr Range kRate = closed(0.1, 2);
+constexpr Range kTimeout = closed(0.02, 5);          // [s]
+constexpr Range kRecentre = left_open(0, 0.5);
+constexpr Range kReturnTime = closed(0, 10);         // [s]
+constexpr Range kThreshold = left_open(0, 1);
+constexpr Range kStrength = closed(0, 1);
+constexpr Range kKeyboardRamp = closed(0.05, 5);     // [s]
+
+void read_axis(Section a, AxisSettings& s) {
+  a.num("deadzone", s.deadzone, kDeadzone);
+  a.num("expo", s.expo, kExpo);
+  a.num("rate", s.rate, kRate);
+  a.boolean("invert", s.invert);
+  a.finish();
+}
+
+}  // namespace
+
+std::optional<InputSettings> parse_settings(std::string_view text, const std::string& source_name,
+                                            std::string& error) {
+  Diagnostics d(source_name);
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    add_syntax_error(d, e, text);
+    error = d.str();
+    return std::nullopt;
+  }
+  InputSettings s;
+  Section top(d, &root, "", Pos{});
+  top.integer("mode", s.mode, kMode);
+  top.num("max_tilt_deg", s.max_tilt_deg, kMaxTilt);
+  top.num("thrust_range", s.thrust_range, kThrustRange);
+  top.num("input_timeout_s", s.input_timeout_s, kTimeout);
+  top.num("recentre_tolerance", s.recentre_tolerance, kRecentre);
+  top.num("return_time_s", s.return_time_s, kReturnTime);
+  top.num("keyboard_ramp_s", s.keyboard_ramp_s, kKeyboardRamp);
+  if (const toml::node* n = top.take("gamepad", false, "a string")) {
+    if (n->is_string()) s.gamepad = n->as_string()->get();
+    else d.add(pos_of(n->source()), "gamepad", "expected a string, got " + describe(*n));
+  }
+  Section axes = top.sub("axes");
+  read_axis(axes.sub("roll"), s.roll);
+  read_axis(axes.sub("pitch"), s.pitch);
+  read_axis(axes.sub("thrust"), s.thrust);
+  read_axis(axes.sub("yaw"), s.yaw);
+  axes.finish();
+  Section haptic = top.sub("haptic");
+  haptic.boolean("enabled", s.haptic.enabled);
+  haptic.num("threshold", s.haptic.threshold, kThreshold);
+  haptic.num("strength", s.haptic.strength, kStrength);
+  haptic.finish();
+  top.finish();
+  if (!d.empty()) {
+    error = d.str();
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<InputSettings> load_settings(const std::string& path, bool& exists,
+                                           std::string& error) {
+  std::error_code ec;
+  exists = std::filesystem::exists(path, ec);
+  if (!exists) return InputSettings{};
+  std::string text;
+  if (!read_text_file(path, text, error)) return std::nullopt;
+  return parse_settings(text, path, error);
+}
+
+std::string to_toml(const InputSettings& s) {
+  std::string out =
+      "# mixpilot input settings (docs/input-settings.md). Edited by the app's settings panel;\n"
+      "# by hand works too: missing keys keep their defaults.\n";
+  const auto line = [&](const char* key, const std::string& value) {
+    out += std::string(key) + " = " + value + "\n";
+  };
+  const auto num = [](double v) { return fmt(v); };
+  const auto flag = [](bool b) { return std::string(b ? "true" : "false"); };
+  const auto quoted = [](const std::string& v) {
+    std::string q = "\"";
+    for (char c : v) {
+      if (c == '"' || c == '\\') q += '\\';
+      q += c;
+    }
+    return q + '"';
+  };
+  line("mode", std::to_string(s.mode));
+  line("max_tilt_deg", num(s.max_tilt_deg));
+  line("thrust_range", num(s.thrust_range));
+  line("input_timeout_s", num(s.input_timeout_s));
+  line("recentre_tolerance", num(s.recentre_tolerance));
+  line("return_time_s", num(s.return_time_s));
+  line("keyboard_ramp_s", num(s.keyboard_ramp_s));
+  line("gamepad", quoted(s.gamepad));
+  const std::pair<const char*, const AxisSettings*> axes[] = {
+      {"roll", &s.roll}, {"pitch", &s.pitch}, {"thrust", &s.thrust}, {"yaw", &s.yaw}};
+  for (const auto& [name, a] : axes) {
+    out += std::string("\n[axes.") + name + "]\n";
+    line("deadzone", num(a->deadzone));
+    line("expo", num(a->expo));
+    line("rate", num(a->rate));
+    line("invert", flag(a->invert));
+  }
+  out += "\n[haptic]\n";
+  line("enabled", flag(s.haptic.enabled));
+  line("threshold", num(s.haptic.threshold));
+  line("strength", num(s.haptic.strength));
+  return out;
+}
+
+bool save_settings(const std::string& path, const InputSettings& s, std::string& error) {
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
+  if (ec) {
+    error = path + ": cannot create its folder (" + ec.message() + ")";
+    return false;
+  }
+  OutputFile f;
+  if (!f.open(path, /*overwrite=*/true, error)) return false;
+  const std::string text = to_toml(s);
+  if (std::fwrite(text.data(), 1, text.size(), f.stream()) != text.size()) {
+    error = path + ": cannot write (" + std::strerror(errno) + ")";
+    f.discard();
+    return false;
+  }
+  return f.commit(error);
+}
+
+std::string config_dir() {
+  if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x == '/')
+    return std::string(x) + "/mixpilot";
+  const char* home = std::getenv("HOME");
+  return std::string(home && *home ? home : ".") + "/.config/mixpilot";
+}
+std::string default_settings_path() { return config_dir() + "/input.toml"; }
+std::string user_mappings_path() { return config_dir() + "/gamecontrollerdb.txt"; }
+
+}  // namespace mixpilot::input
