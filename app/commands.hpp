@@ -9,5 +9,6 @@ int demo_command();
 int score_command(int argc, char** argv);
 int recover_command(int argc, char** argv);
 int models_command();
+int gamepad_script_command(int argc, char** argv);
 
 }  // namespace mixpilot::cli

@@ -1,7 +1,9 @@
 #include "app/flight.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <thread>
 
 #include "app/cli.hpp"
 #include "app/replay.hpp"
@@ -9,6 +11,8 @@
 #include "core/modes/mi_mode.hpp"
 #include "core/recording/output_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "input/mapping.hpp"
+#include "models/mikrokopter.hpp"
 
 namespace mixpilot::cli {
 
@@ -44,9 +48,101 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
   return f;
 }
 
+// The person's device of --pilot gamepad | keyboard and the pilot that reads it.
+std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& scenario_text,
+                                      const std::string& scenario_source,
+                                      std::shared_ptr<input::Gamepad> gamepad,
+                                      ModeRequest& request, std::string& error) {
+  auto d = std::make_shared<Devices>();
+  if (o.input_values) {
+    d->settings = *o.input_values;
+  } else if (!o.input_settings.empty()) {
+    bool exists = false;
+    const auto s = input::load_settings(o.input_settings, exists, error);
+    if (!s) return nullptr;
+    if (!exists) {
+      error = o.input_settings + ": no such file (--input-settings)";
+      return nullptr;
+    }
+    d->settings = *s;
+  } else {
+    d->settings = load_input_settings("", d->settings_note);
+    if (!d->settings_note.empty())
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, d->settings_note.c_str());
+  }
+  const std::optional<Scenario> sc = parse_scenario(scenario_text, scenario_source, error);
+  if (!sc) return nullptr;
+  input::StickSource* source = nullptr;
+  if (o.pilot == "keyboard") {
+    d->keyboard = std::make_unique<input::KeyboardSource>(d->settings);
+    source = d->keyboard.get();
+  } else {
+    if (!o.gamepad_script.empty()) {
+      auto rows = input::load_script(o.gamepad_script, error);
+      if (!rows) return nullptr;
+      d->script = std::move(*rows);
+      d->virtual_pad = std::make_unique<input::VirtualGamepad>();
+      if (!d->virtual_pad->plug(error)) return nullptr;
+    }
+    if (gamepad) {
+      d->gamepad = std::move(gamepad);
+    } else {
+      d->gamepad = std::make_shared<input::Gamepad>();
+      input::Gamepad::Options go;
+      go.preferred = d->settings.gamepad;
+      go.mappings_file = input::user_mappings_path();
+      if (!d->gamepad->start(go, error)) return nullptr;
+    }
+    if (o.headless) {
+      // SDL reports the pads present at start-up within its first polls.
+      const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
+      while (!d->gamepad->connected() && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!d->gamepad->connected()) {
+        std::string seen;
+        for (const input::GamepadInfo& g : d->gamepad->devices())
+          seen += (seen.empty() ? "" : ", ") + g.name + (g.controller ? "" : " (no mapping)");
+        error = "no gamepad connected" +
+                (seen.empty() ? std::string() : " (SDL sees " + seen + ")") +
+                ": connect one, or fly with --pilot keyboard in the window, or play a script "
+                "with --gamepad-script FILE.csv";
+        return nullptr;
+      }
+    }
+    source = d->gamepad.get();
+  }
+  auto pilot = std::make_unique<input::DevicePilot>(*source, d->settings, sc->controller.dt,
+                                                    models::MikroKopter().hover_speed());
+  d->pilot = pilot.get();
+  request.pilot_source = std::move(pilot);
+  return d;
+}
+
 }  // namespace
 
-std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status) {
+bool is_device_pilot(const std::string& pilot) {
+  return pilot == "gamepad" || pilot == "keyboard";
+}
+
+input::InputSettings load_input_settings(const std::string& path, std::string& note) {
+  const std::string file = path.empty() ? input::default_settings_path() : path;
+  bool exists = false;
+  std::string error;
+  if (const auto s = input::load_settings(file, exists, error)) return *s;
+  note = error + "\n(the default input settings are used until the file is fixed)";
+  return {};
+}
+
+void Devices::started() {
+  if (virtual_pad && !script.empty()) virtual_pad->play(script, input::steady_ns());
+}
+
+void Devices::cue(double lambda) const {
+  if (gamepad) gamepad->set_rumble(input::rumble_intensity(lambda, settings.haptic));
+}
+
+std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status,
+                                     std::shared_ptr<input::Gamepad> gamepad) {
   status = kExitError;  // unless said otherwise below
   std::optional<Flight> f = load_flight(o, error, status);
   if (!f) return std::nullopt;
@@ -64,7 +160,13 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
   } else {
     ModeRequest request;
     request.duration = o.duration;
-    request.pilot_name = o.pilot;
+    if (is_device_pilot(o.pilot)) {
+      f->devices = open_devices(o, f->scenario_text, f->scenario_source, std::move(gamepad),
+                                request, error);
+      if (!f->devices) return std::nullopt;
+    } else {
+      request.pilot_name = o.pilot;
+    }
     f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
   }
   if (!f->mode) return std::nullopt;

@@ -8,7 +8,13 @@
 #include <vector>
 
 #include "app/screenshot.hpp"
+#include "input/device_pilot.hpp"
+#include "input/gamepad.hpp"
+#include "input/keyboard.hpp"
+#include "input/settings.hpp"
+#include "input/virtual_gamepad.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/session.hpp"
 #include "core/modes/report.hpp"
 #include "core/recording/recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
@@ -29,7 +35,28 @@ struct FlyOptions {
   bool realtime = false;           // headless, paced by the wall clock
   bool exit_at_end = false;        // window: start at once, close when the run is over
   bool replay = false;             // `mixpilot replay`: a recording of any mode flown again
+  std::string gamepad_script;      // --gamepad-script: a virtual gamepad plays it
+  std::string input_settings;      // --input-settings (default: the user's input.toml)
+  std::optional<input::InputSettings> input_values;  // the app's settings, instead of a file
   const char* command = "fly";     // for messages
+};
+
+// A person's device flying the session (--pilot gamepad | keyboard, SPEC §6), kept alive for
+// the flight: the stick source the pilot reads and, with --gamepad-script, the virtual pad
+// that plays the script from the start of the flight.
+struct Devices {
+  input::InputSettings settings;
+  std::string settings_note;  // a broken settings file: what was wrong (defaults are used)
+  std::unique_ptr<input::VirtualGamepad> virtual_pad;
+  std::vector<input::ScriptRow> script;
+  std::shared_ptr<input::Gamepad> gamepad;  // one per process: the app's, across flights
+  std::unique_ptr<input::KeyboardSource> keyboard;
+  input::DevicePilot* pilot = nullptr;  // owned by the mode
+
+  // The flight starts now: the script's t = 0.
+  void started();
+  // The haptic cue for the λ of the last step (the control thread calls it; never blocks).
+  void cue(double lambda) const;
 };
 
 // The flight of FlyOptions, set up: the scenario from --scenario or the recording given as
@@ -41,12 +68,33 @@ struct Flight {
   std::optional<RecordingContents> recording;  // --pilot REC.mcap
   std::unique_ptr<Mode> mode;
   std::string pilot;  // mixed initiative: the pilot source's name
+  std::shared_ptr<Devices> devices;  // --pilot gamepad | keyboard
 };
+
+// The haptic cue from the control thread: each step's λ to the gamepad (an atomic store).
+class HapticSink final : public TelemetrySink {
+ public:
+  explicit HapticSink(const Devices& d) : devices_(&d) {}
+  void on_sample(const Telemetry& s) override { devices_->cue(s.lambda); }
+
+ private:
+  const Devices* devices_;
+};
+
+// True for the pilots that are a person's device.
+bool is_device_pilot(const std::string& pilot);
+
+// The input settings at `path` (or the user's default file). A broken file gives the defaults
+// and, in `note`, what was wrong, so the app still starts and says why.
+input::InputSettings load_input_settings(const std::string& path, std::string& note);
 
 // Reads the scenario (and the recording of a replay) and makes the mode; nullopt with the
 // reason and the exit status (kExitError, or kExitReplayMismatch for a --scenario other than
 // the recording's).
-std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status);
+// `gamepad`: the app's running gamepad, used instead of starting one (SDL's joystick state
+// has one owner per process).
+std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status,
+                                     std::shared_ptr<input::Gamepad> gamepad = nullptr);
 
 // What a recording of the flight says about it (its metadata). `trainee` is the person flying,
 // when the app knows.

@@ -46,8 +46,13 @@ constexpr const char* kFlyUsage =
     "                     a recording, whose embedded scenario is then used. Its `mode` picks\n"
     "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
+    "                     gamepad | keyboard (a person; headless only with --realtime) |\n"
     "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
     "                     against the recording); default: the scenario's (mixed_initiative only)\n"
+    "  --gamepad-script FILE.csv  with --pilot gamepad: a virtual gamepad plays the script\n"
+    "                     (docs/input-settings.md) through SDL from the start of the flight\n"
+    "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
+    "                     user's $XDG_CONFIG_HOME/mixpilot/input.toml, docs/input-settings.md)\n"
     "  --headless         run without a window, as fast as possible (default: a window,\n"
     "                     in real time, where a display exists)\n"
     "  --realtime         with --headless: paced by the wall clock, deadline misses counted\n"
@@ -185,11 +190,18 @@ int run_fly(const FlyOptions& o) {
     session.add_sink(&*check);
   }
 
+  std::optional<HapticSink> haptic;
+  if (flight->devices) {
+    haptic.emplace(*flight->devices);
+    session.add_sink(&*haptic);
+  }
+
   catch_interrupts();
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<RealtimeStats> realtime;
   if (o.realtime) {
     RealtimeRunner runner(session, 64);
+    if (flight->devices) flight->devices->started();
     runner.start();
     Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
     Telemetry drained = mode.telemetry();
@@ -308,6 +320,10 @@ int fly_command(int argc, char** argv) {
     } else if (parse_view_option(a, value, o)) {
     } else if (a == "--realtime") {
       o.realtime = true;
+    } else if (a == "--gamepad-script") {
+      o.gamepad_script = value();
+    } else if (a == "--input-settings") {
+      o.input_settings = value();
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
     } else if (a == "--force") {
@@ -318,6 +334,11 @@ int fly_command(int argc, char** argv) {
   }
   if (o.realtime && !o.headless) usage_error(o.command, "--realtime is for --headless runs (a window is always real time)");
   if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
+  if (!o.gamepad_script.empty() && o.pilot != "gamepad")
+    usage_error(o.command, "--gamepad-script plays a virtual gamepad: it goes with --pilot gamepad");
+  if (is_device_pilot(o.pilot) && o.headless && !o.realtime)
+    usage_error(o.command, "--pilot " + o.pilot + " is a person: a headless flight with it needs "
+                           "--realtime (or fly in the window)");
   return run_fly(o);
 }
 

@@ -24,6 +24,7 @@ constexpr const char* kUsage =
     "  replay  show a recording (any mode) in the window, or headless screenshots of it\n"
     "  score   replay and score recorded sessions\n"
     "  recover rebuild a recording cut short by a crash or kill -9\n"
+    "  gamepad-script  a recording's pilot commands as a virtual gamepad's script\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -100,6 +101,7 @@ int main(int argc, char** argv) {
   if (cmd == "replay") return replay_command(argc, argv);
   if (cmd == "score") return score_command(argc, argv);
   if (cmd == "recover") return recover_command(argc, argv);
+  if (cmd == "gamepad-script") return gamepad_script_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

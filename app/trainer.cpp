@@ -55,6 +55,9 @@ bool is_flying(const LiveFlight& f) { return f.started && f.runner->running(); }
 }  // namespace
 
 Trainer::Trainer(FlyOptions o) : options_(std::move(o)) {
+  input_settings_path_ =
+      options_.input_settings.empty() ? input::default_settings_path() : options_.input_settings;
+  input_settings_ = load_input_settings(input_settings_path_, input_.note);
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
   scenario_paths_ = shipped_scenarios();
@@ -88,15 +91,36 @@ std::string Trainer::next_record_path() const {
   return (recordings_folder() / (name + "-" + stamp + ".mcap")).string();
 }
 
+std::shared_ptr<input::Gamepad> Trainer::gamepad(std::string& error) {
+  if (gamepad_) return gamepad_;
+  auto g = std::make_shared<input::Gamepad>();
+  input::Gamepad::Options go;
+  go.preferred = input_settings_.gamepad;
+  go.mappings_file = input::user_mappings_path();
+  if (!g->start(go, error)) return nullptr;
+  return gamepad_ = std::move(g);
+}
+
 std::unique_ptr<LiveFlight> Trainer::make_live(std::string& error, int& status) {
   auto f = std::make_unique<LiveFlight>();
   FlyOptions o = options_;
   o.replay = o.pilot.ends_with(".mcap");  // a recording's pilot: any mode flies it again
-  std::optional<Flight> flight = prepare_flight(o, error, status);
+  o.input_values = input_settings_;
+  std::shared_ptr<input::Gamepad> pad;
+  if (o.pilot == "gamepad") {
+    // A script's virtual pad must exist before SDL's pads are listed: the flight plugs it.
+    if (o.gamepad_script.empty() && !(pad = gamepad(error))) return nullptr;
+  }
+  std::optional<Flight> flight = prepare_flight(o, error, status, pad);
   if (!flight) return nullptr;
   f->flight = std::move(*flight);
+  if (f->flight.devices && f->flight.devices->gamepad) gamepad_ = f->flight.devices->gamepad;
   Mode& mode = *f->flight.mode;
   f->session = std::make_unique<Session>(mode);
+  if (f->flight.devices) {
+    f->haptic.emplace(*f->flight.devices);
+    f->session->add_sink(&*f->haptic);
+  }
   if (f->flight.recording) {
     f->check.emplace(*f->flight.recording);
     f->session->add_sink(&*f->check);
@@ -131,6 +155,8 @@ void Trainer::refresh_choices() {
   if (!live_) return;
   if (const auto* mi = dynamic_cast<const MiMode*>(live_->flight.mode.get())) {
     for (const auto& [name, profile] : mi->scenario().pilots) choices_.pilots.push_back(name);
+    choices_.pilots.push_back("gamepad");
+    choices_.pilots.push_back("keyboard");
     if (options_.pilot.ends_with(".mcap")) choices_.pilots.push_back(options_.pilot);
     const auto it = std::find(choices_.pilots.begin(), choices_.pilots.end(),
                               options_.pilot.empty() ? live_->flight.pilot : options_.pilot);
@@ -166,6 +192,13 @@ void Trainer::start() {
     return;
   }
   if (!live_ || live_->started) return;
+  // A gamepad pilot starts once a pad is connected (the banner asks for one meanwhile).
+  if (live_->flight.devices && live_->flight.devices->gamepad &&
+      !live_->flight.devices->gamepad->connected()) {
+    live_->waiting = true;
+    return;
+  }
+  live_->waiting = false;
   if (choices_.record) {
     const std::string path = next_record_path();
     std::error_code ec;
@@ -184,6 +217,7 @@ void Trainer::start() {
     live_->session->add_sink(&live_->recorder);
   }
   live_->history.clear();  // the initial state shown while ready
+  if (live_->flight.devices) live_->flight.devices->started();
   live_->runner->start();
   live_->started = true;
   say("");
@@ -280,7 +314,30 @@ void Trainer::update_replay(double wall_dt) {
   run_.session = nullptr;
 }
 
+void Trainer::update_input() {
+  const Devices* d = live_ ? live_->flight.devices.get() : nullptr;
+  input_.pilot = d ? (d->keyboard ? "keyboard" : "gamepad") : "";
+  input_.waiting = live_ && live_->waiting;
+  input_.settings = &input_settings_;
+  input_.settings_path = input_settings_path_;
+  if (d && d->keyboard) {
+    input_.connected = true;
+    input_.device = "keyboard";
+  } else if (gamepad_) {
+    input_.connected = gamepad_->connected();
+    input_.device = gamepad_->active_name();
+    input_.live = gamepad_->latest_for_ui().sticks;
+    input_.devices.clear();
+    for (const input::GamepadInfo& g : gamepad_->devices())
+      input_.devices.push_back(g.name + (g.controller ? "" : " (no mapping)"));
+  }
+  run_.input = &input_;
+  // A flight waiting for its gamepad starts when one arrives.
+  if (live_ && live_->waiting && input_.connected) start();
+}
+
 void Trainer::build_frame(double wall_dt) {
+  update_input();
   if (replay_) update_replay(wall_dt);
   else if (live_) update_live();
   static const ui::Scene kEmpty;
@@ -354,7 +411,25 @@ void Trainer::act(const ui::UiRequest& req) {
     }
     return;
   }
+  if (req.apply_settings) {
+    input_settings_ = ui_.draft;
+    if (req.save_settings) {
+      if (input::save_settings(input_settings_path_, input_settings_, error)) {
+        input_.note.clear();
+        say("input settings saved to " + input_settings_path_);
+      } else {
+        say(error, true);
+      }
+    }
+    options_.input_settings.clear();
+    if (live_ && !is_flying(*live_) && live_->flight.devices && !replace_live(error)) say(error, true);
+  }
   if (!live_) return;
+  if (live_->flight.devices && live_->flight.devices->keyboard) {
+    input::KeyboardSource& k = *live_->flight.devices->keyboard;
+    for (int i = 0; i < int(input::Key::count); ++i)
+      k.set_key(input::Key(i), (req.flight_keys >> i) & 1u);
+  }
   if (req.trainee_changed) choices_.trainee = req.trainee;
   if (req.record >= 0 && !is_flying(*live_)) {
     choices_.record = req.record == 1;

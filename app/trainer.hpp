@@ -25,12 +25,14 @@ struct LiveFlight {
   RecordingSink recorder;
   std::string record_path;  // "" when not recording
   std::optional<ReplayCheck> check;  // flying a recording's pilot commands
+  std::optional<HapticSink> haptic;  // a gamepad pilot: λ to the rumble
   std::unique_ptr<RealtimeRunner> runner;
   ui::Scene scene;
   ui::History history;
   Telemetry sample;  // the ring's values are copied into it (sized once)
   std::int64_t fallbacks = 0;
   bool started = false, closed = false;
+  bool waiting = false;  // Start asked for, waiting for the gamepad
   Metrics metrics;   // once the run is over
 };
 
@@ -77,6 +79,8 @@ class Trainer {
   void update_live();
   void update_replay(double wall_dt);
   void say(std::string message, bool error = false);
+  void update_input();
+  std::shared_ptr<input::Gamepad> gamepad(std::string& error);
   std::string next_record_path() const;
 
   FlyOptions options_;
@@ -92,6 +96,10 @@ class Trainer {
   ui::UiState ui_;
   ui::RunInfo run_;
   int status_ = 0;
+  std::shared_ptr<input::Gamepad> gamepad_;  // started when a flight first needs it
+  input::InputSettings input_settings_;      // what the next device flight uses
+  std::string input_settings_path_;
+  ui::InputInfo input_;
 };
 
 }  // namespace mixpilot::cli

@@ -21,9 +21,13 @@
 
 #include "app/flight.hpp"
 #include "app/offscreen.hpp"
+#include "app/replay.hpp"
 #include "app/trainer.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
+#include "input/keyboard.hpp"
+#include "input/mapping.hpp"
+#include "models/mikrokopter.hpp"
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
 
@@ -382,6 +386,193 @@ TEST_F(App, HelpAndOpenDialogFromTheKeyboard) {
   const ImGuiWindow* browser = ImGui::FindWindowByName("Open a scenario or a recording");
   EXPECT_TRUE(browser && browser->Active);
   save_shot(screen_, "open_dialog");
+}
+
+// The score `mixpilot score` gives a recording (app/score.cpp's path).
+Metrics score_of(const std::string& path) {
+  std::string error;
+  const auto rec = read_recording(path, error);
+  EXPECT_TRUE(rec) << error;
+  if (!rec) return {};
+  const std::string* text = cli::embedded_scenario(*rec, path, error);
+  EXPECT_TRUE(text) << error;
+  auto mode = cli::replay_mode(*rec, path, *text, cli::embedded_scenario_source(*rec, path), {},
+                               error);
+  EXPECT_TRUE(mode) << error;
+  if (!mode) return {};
+  Session session(*mode);
+  session.run();
+  return cli::replay_metrics(*mode, *rec);
+}
+
+double metric(const Metrics& m, const std::string& name) {
+  for (const auto& [k, v] : m)
+    if (k == name) return v;
+  ADD_FAILURE() << "no metric " << name;
+  return NAN;
+}
+
+// The user's folders in a fresh place, so no settings of the machine's user leak in.
+void fresh_user_dirs(const char* name) {
+  const auto home = test::fresh_path("app", name);
+  std::filesystem::create_directories(home);
+  setenv("XDG_CONFIG_HOME", (home / "config").c_str(), 1);
+  setenv("XDG_DATA_HOME", (home / "data").c_str(), 1);
+}
+
+// The keyboard pilot from injected key events: the novice's commands on mi_helix followed with
+// key taps, flown in real time through the window's code. No collision, always in B, the
+// raw sticks are recorded, and `score` of the recording is the live score.
+TEST_F(App, TheKeyboardFliesFromInjectedKeys) {
+  fresh_user_dirs("keyboard");
+  constexpr double kSeconds = 12.0, kDt = 0.015;
+  const std::string novice = record("mi_helix.toml", kSeconds, "novice", "kb_novice.mcap");
+  std::string error;
+  const auto nov = read_recording(novice, error);
+  ASSERT_TRUE(nov) << error;
+  const input::InputSettings settings;
+  const double hover = models::MikroKopter().hover_speed();
+  std::vector<input::Controls> wanted;
+  for (const PilotCommandMsg& m : nov->pilot) {
+    PilotCommand c;
+    c.roll = m.roll;
+    c.pitch = m.pitch;
+    for (int i = 0; i < 4; ++i) c.rotor_speed(i) = m.rotor_speed[std::size_t(i)];
+    wanted.push_back(input::controls_for(c, settings, hover));
+  }
+
+  cli::FlyOptions o = live_options("mi_helix.toml", kSeconds, "keyboard");
+  o.record = test::fresh_path("app", "keyboard.mcap").string();
+  cli::Trainer app(o);
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  app.ui_state().score_card_closed = true;
+  app.start();
+  // A person follows the novice's stick with taps: while the stick (as the ramp moves it, which
+  // the person sees on the sticks panel) is short of the target, the key toward the target is
+  // held; near it, none is (the stick drifts back to centre).
+  ImGuiIO& io = ImGui::GetIO();
+  const double rate = 1.0 / settings.keyboard_ramp_s;
+  struct Axis {
+    input::Key plus, minus;
+    double stick = 0;
+    int held = 0;  // +1, -1, 0
+  };
+  Axis axes[4] = {{input::Key::roll_right, input::Key::roll_left},
+                  {input::Key::pitch_forward, input::Key::pitch_back},
+                  {input::Key::thrust_up, input::Key::thrust_down},
+                  {input::Key::yaw_right, input::Key::yaw_left}};
+  int presses = 0;
+  double last_t = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!app.over() && std::chrono::steady_clock::now() < deadline) {
+    const double t = std::max(0.0, app.shown_time());
+    const input::Controls& c = wanted[std::min(std::size_t(t / kDt), wanted.size() - 1)];
+    const double target[4] = {c.roll, c.pitch, c.thrust, c.yaw};
+    for (int i = 0; i < 4; ++i) {
+      Axis& a = axes[i];
+      const double move = rate * (t - last_t);
+      a.stick = a.held ? std::clamp(a.stick + a.held * move, -1.0, 1.0)
+                       : (a.stick > 0 ? std::max(0.0, a.stick - move) : std::min(0.0, a.stick + move));
+      const int want = target[i] > a.stick + 0.02 && target[i] > 0.02    ? 1
+                       : target[i] < a.stick - 0.02 && target[i] < -0.02 ? -1
+                                                                          : 0;
+      presses += want != 0 && want != a.held;
+      a.held = want;
+      io.KeysDown[ui::kFlightKeys[int(a.plus)]] = want > 0;
+      io.KeysDown[ui::kFlightKeys[int(a.minus)]] = want < 0;
+    }
+    last_t = t;
+    frame(app);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  for (const int key : ui::kFlightKeys) io.KeysDown[key] = false;
+  ASSERT_TRUE(app.over());
+  EXPECT_GT(presses, 3) << "the novice's commands gave hardly any key presses";
+  const Metrics live = app.live()->metrics;
+  EXPECT_EQ(app.finish(), 0);
+
+  EXPECT_EQ(metric(live, "collisions"), 0.0);
+  EXPECT_EQ(metric(live, "time_in_ball"), 1.0);
+  const auto r = read_recording(o.record, error);
+  ASSERT_TRUE(r) << error;
+  ASSERT_EQ(r->joy.size(), r->states.size());
+  EXPECT_EQ(r->pilot.front().source, "keyboard");
+  // The keys moved the sticks, in ramps: no step between two control steps is larger than the
+  // ramp allows (full deflection in keyboard_ramp_s).
+  double most = 0, biggest_step = 0;
+  for (std::size_t j = 0; j < r->joy.size(); ++j) {
+    most = std::max(most, double(std::abs(r->joy[j].axes[2])));
+    if (j > 0)
+      biggest_step = std::max(biggest_step,
+                              double(std::abs(r->joy[j].axes[2] - r->joy[j - 1].axes[2])));
+  }
+  std::printf("%d key presses; the roll stick reached %.2f\n", presses, most);
+  EXPECT_GT(most, 0.05);
+  EXPECT_LE(biggest_step, kDt / settings.keyboard_ramp_s + 1e-6);
+  const Metrics scored = score_of(o.record);
+  for (const char* k : {"skill", "progress", "time_in_ball", "max_deviation_m", "rms_deviation_m",
+                        "mean_lambda", "min_lambda", "collisions", "override_rms"})
+    EXPECT_EQ(metric(scored, k), metric(live, k)) << k;
+}
+
+// I opens the input settings: each axis's curve, the stick mode, the haptic cue.
+TEST_F(App, TheInputSettingsPanel) {
+  fresh_user_dirs("settings");
+  cli::Trainer app(live_options("mi_helix.toml", 2.0, "keyboard"));
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  frame(app);
+  key(app, 'I');
+  EXPECT_TRUE(app.ui_state().show_settings);
+  frame(app);
+  frame(app);
+  const ImGuiWindow* panel = ImGui::FindWindowByName("Input settings (I)");
+  ASSERT_TRUE(panel && panel->Active);
+  save_shot(screen_, "input_settings");
+  // Defaults changes the draft, Apply hands it to the next flight.
+  app.ui_state().draft.mode = 1;
+  const auto apply = locate(app, "Input settings (I)", "Apply");
+  ASSERT_TRUE(apply);
+  click(app, *apply);
+  ASSERT_TRUE(app.run_info().input && app.run_info().input->settings);
+  EXPECT_EQ(app.run_info().input->settings->mode, 1);
+  key(app, 'I');
+  EXPECT_FALSE(app.ui_state().show_settings);
+}
+
+// The gamepad unplugged mid-flight: the banner says so, over the arena, in the critical colour.
+TEST_F(App, InputLossIsShownOverTheArena) {
+  fresh_user_dirs("loss");
+  const auto csv = test::fresh_path("app", "loss.csv");
+  std::ofstream(csv) << "t,left_x,left_y,right_x,right_y\n0,0,0,0.3,0\n0.5,unplug\n";
+  cli::FlyOptions o = live_options("mi_helix.toml", 3.0, "gamepad");
+  o.gamepad_script = csv.string();
+  cli::Trainer app(o);
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  app.ui_state().score_card_closed = true;
+  app.start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (app.shown_time() < 1.0 && std::chrono::steady_clock::now() < deadline) {
+    frame(app);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  app.live()->runner->set_paused(true);
+  frame(app);
+  frame(app);
+  ASSERT_GE(app.shown_time(), 1.0);
+  save_shot(screen_, "input_lost");
+  const std::vector<std::uint8_t> p = screen_.pixels();
+  // The banner's frame: the critical colour along a row near the arena's middle height.
+  const Rgb red = rgb_of(ui::colour::kCritical);
+  int hits = 0;
+  for (int y = int(kH * 0.3); y < int(kH * 0.7); ++y)
+    for (int x = kW / 4; x < 3 * kW / 4; ++x) hits += colour_near(p, ImVec2(float(x), float(y)), red, 0, 8);
+  EXPECT_GT(hits, 400) << "no input-loss banner in the critical colour";
+  app.live()->runner->set_paused(false);
 }
 
 }  // namespace

@@ -325,7 +325,12 @@ void keys(UiState& ui, UiRequest& req, const RunInfo& run, const History& h) {
   if (pressed('2')) ui.camera = Camera::orbit;
   if (pressed('3')) ui.camera = Camera::top;
   if (pressed('4')) ui.camera = Camera::side;
-  if (pressed('D')) ui.show_sticks = !ui.show_sticks;
+  const bool keyboard_flies = run.input && run.input->pilot == "keyboard" && !run.replay;
+  if (pressed('D') && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
+  if (pressed('I') && run.input) {
+    ui.show_settings = !ui.show_settings;
+    ui.draft_loaded = false;
+  }
   if (pressed('P')) set_plots_paused(ui, h, !ui.plots_paused);
 }
 
@@ -403,8 +408,11 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   if (run.metrics.empty()) ui.score_card_closed = false;
   else if (!ui.score_card_closed) score_card(run, ui, d);
   if (ui.show_help) help_sheet(ui, d);
+  draw_input_banner(h, run, vmin, vmax);
+  draw_input_settings(run, ui, req);
   draw_open_dialog(ui, req);
   keys(ui, req, run, h);
+  if (run.input && run.input->pilot == "keyboard" && !run.replay) req.flight_keys = held_flight_keys();
   return req;
 }
 

@@ -8,6 +8,8 @@
 
 #include <imgui.h>
 
+#include "input/mapping.hpp"
+#include "input/settings.hpp"
 #include "ui/scene.hpp"
 
 namespace mixpilot::ui {
@@ -20,7 +22,7 @@ enum class RunState { ready, flying, paused, finished, replay, loading, lost };
 const char* to_string(RunState s);
 
 // Events a replay's timeline marks and jumps to (UI.md §6).
-enum class EventKind { collision, fallback, low_lambda, lost };
+enum class EventKind { collision, fallback, low_lambda, lost, input_lost };
 const char* to_string(EventKind k);
 
 struct TimelineEvent {
@@ -49,6 +51,20 @@ struct SessionChoices {
   std::string trainee;                 // the person flying
 };
 
+// A person's device flying the session (SPEC §6): for the session panel, the input settings
+// panel and the input-loss banner.
+struct InputInfo {
+  std::string pilot;                 // "gamepad" | "keyboard" ("" : the pilot is no device)
+  std::string device;                // the gamepad in use ("" none)
+  std::vector<std::string> devices;  // every joystick SDL sees ("name", "name (no mapping)")
+  bool connected = false;            // a gamepad is connected (the keyboard always is)
+  bool waiting = false;              // Start was asked for: waiting for a gamepad
+  input::StickAxes live;             // the sticks now, for the curves
+  const input::InputSettings* settings = nullptr;
+  std::string settings_path;         // where Save writes
+  std::string note;                  // the settings file is broken: what was wrong
+};
+
 struct RunInfo {
   RunState state = RunState::ready;
   double speed = 1.0;            // real-time factor (slow motion < 1)
@@ -61,6 +77,7 @@ struct RunInfo {
   Metrics metrics;               // the score card at the end of a flight (empty: none yet)
   const SessionChoices* session = nullptr;  // the session panel (nullptr: none, e.g. headless)
   const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
+  const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
 };
 
 // A file browser's state (File → Open): the folder shown and what it holds.
@@ -86,6 +103,9 @@ struct UiState {
   bool score_card_closed = false;
   OpenDialog open_dialog;
   char trainee[64] = "";
+  bool show_settings = false;        // the input settings panel (I)
+  input::InputSettings draft;        // the settings being edited there
+  bool draft_loaded = false;
 };
 
 // What the user asked for in this frame (buttons, keys); the app acts on it.
@@ -105,6 +125,9 @@ struct UiRequest {
   double seek = -1.0;          // ≥ 0: move the playhead there [s]
   int jump = 0;                // −1 / +1: previous / next event
   double lambda_threshold = -1.0;  // ≥ 0: a new threshold for "λ below" events
+  unsigned flight_keys = 0;        // bit k: input::Key k is held (the keyboard pilot)
+  bool apply_settings = false;     // use UiState::draft from the next flight on
+  bool save_settings = false;      // ... and write it to InputInfo::settings_path
 };
 
 // The events of a flight for a replay's timeline: collisions, fallbacks (overruns included),
@@ -124,6 +147,11 @@ void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max);
 
 // Freezes the plots at the newest time of `h` (or lets them roll again).
 void set_plots_paused(UiState& ui, const History& h, bool paused);
+
+// The keys that fly with the keyboard pilot (input/keyboard.hpp), as GLFW key codes, indexed
+// by input::Key: W S A D and the arrows.
+inline constexpr int kFlightKeys[] = {'W', 'S', 'A', 'D', 265 /*up*/, 264 /*down*/,
+                                      263 /*left*/, 262 /*right*/};
 
 // GLFW's key code for F1: the window's backend and the headless renderer both use GLFW's key
 // codes (ImGui 1.86 has no ImGuiKey for F1).

@@ -41,6 +41,18 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
     ImGui::SetNextItemWidth(-80);
     if (combo("pilot", c.pilots, c.pilot, chosen)) req.pilot = chosen;
   }
+  if (run.input && !run.input->pilot.empty()) {
+    if (run.input->pilot == "keyboard")
+      ImGui::TextDisabled("keys: W/S thrust, A/D yaw, arrows tilt");
+    else if (run.input->connected)
+      ImGui::TextDisabled("gamepad: %s", run.input->device.c_str());
+    else
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCaution), "no gamepad connected");
+  }
+  if (run.input && ImGui::Button("Input settings... (I)")) {
+    ui.show_settings = true;
+    ui.draft_loaded = false;
+  }
   if (ImGui::Button("Open file... (Ctrl+O)")) ui.open_dialog.open = true;
   ImGui::SetNextItemWidth(-80);
   if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())

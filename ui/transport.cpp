@@ -15,6 +15,7 @@ const char* to_string(EventKind k) {
     case EventKind::fallback: return "fallback";
     case EventKind::low_lambda: return "λ below threshold";
     case EventKind::lost: return "lost";
+    case EventKind::input_lost: return "input lost";
   }
   return "?";
 }
@@ -26,6 +27,7 @@ std::vector<TimelineEvent> timeline_events(const History& h, double lambda_thres
     if (s.events & kEventCollision) out.push_back({s.t, EventKind::collision});
     if (s.events & (kEventFallback | kEventOverrun)) out.push_back({s.t, EventKind::fallback});
     if (s.events & kEventLost) out.push_back({s.t, EventKind::lost});
+    if (s.events & kEventInputLost) out.push_back({s.t, EventKind::input_lost});
     if (s.mode == ModeKind::mixed_initiative && s.lambda < lambda_threshold &&
         (i == 0 || h[i - 1].lambda >= lambda_threshold))
       out.push_back({s.t, EventKind::low_lambda});
@@ -54,11 +56,13 @@ ImU32 event_colour(EventKind k) {
     case EventKind::fallback: return colour::kCaution;
     case EventKind::low_lambda: return colour::kPlanner;
     case EventKind::lost: return colour::kCritical;
+    case EventKind::input_lost: return colour::kPilot;
   }
   return colour::kText;
 }
 
-// A tick's shape tells its kind without colour: collision ▲, fallback ■, λ below ▼, lost ✕.
+// A tick's shape tells its kind without colour: collision ▲, fallback ■, λ below ▼, lost ✕,
+// input lost ○.
 void tick(ImDrawList* dl, float x, float top, float bottom, EventKind k) {
   const ImU32 c = event_colour(k);
   const float s = 5.0f;
@@ -76,6 +80,9 @@ void tick(ImDrawList* dl, float x, float top, float bottom, EventKind k) {
     case EventKind::lost:
       dl->AddLine(ImVec2(x - s, top - s), ImVec2(x + s, top + s), c, 2.0f);
       dl->AddLine(ImVec2(x - s, top + s), ImVec2(x + s, top - s), c, 2.0f);
+      break;
+    case EventKind::input_lost:
+      dl->AddCircle(ImVec2(x, top), s, c, 12, 2.0f);
       break;
   }
 }
@@ -128,7 +135,8 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
     req.lambda_threshold = threshold;
   // The legend: each tick's shape and colour.
   ImGui::SameLine();
-  for (EventKind k : {EventKind::collision, EventKind::fallback, EventKind::low_lambda, EventKind::lost}) {
+  for (EventKind k : {EventKind::collision, EventKind::fallback, EventKind::low_lambda,
+                      EventKind::lost, EventKind::input_lost}) {
     const ImVec2 p = ImGui::GetCursorScreenPos();
     const float lh = ImGui::GetTextLineHeight();
     tick(dl, p.x + 6, p.y + 0.5f * lh, p.y + lh, k);

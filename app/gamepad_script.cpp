@@ -1,0 +1,134 @@
+// mixpilot gamepad-script: a recording's pilot commands as a virtual gamepad's script, so a
+// recorded flight (an emulated pilot's, a person's) can be flown again through the real SDL
+// path with `fly --pilot gamepad --gamepad-script`.
+#include <cstdio>
+#include <string>
+
+#include "app/cli.hpp"
+#include "app/commands.hpp"
+#include "app/flight.hpp"
+#include "app/replay.hpp"
+#include "core/scenario/scenario_toml.hpp"
+#include "core/recording/output_file.hpp"
+#include "core/recording/recording.hpp"
+#include "input/mapping.hpp"
+#include "models/mikrokopter.hpp"
+
+namespace mixpilot::cli {
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: mixpilot gamepad-script REC.mcap -o OUT.csv [--input-settings FILE] [--force]\n"
+    "\n"
+    "Writes the pilot commands of a mixed-initiative recording as a virtual gamepad's script\n"
+    "(docs/input-settings.md): one row per control step with the stick positions that give\n"
+    "each command through the stick mapping of the input settings (the inverse of deadzone,\n"
+    "expo and rate; commands beyond full deflection are clamped to it).\n"
+    "\n"
+    "  -o OUT.csv             where to write\n"
+    "  --input-settings FILE  the settings the script will be flown with (default: the\n"
+    "                         user's input.toml, or the defaults)\n"
+    "  --force                overwrite an existing OUT\n"
+    "\n"
+    "exit status: 0 written, 1 unreadable recording or settings, 2 usage\n";
+
+}  // namespace
+
+int gamepad_script_command(int argc, char** argv) {
+  std::string in, out, settings_path;
+  bool force = false;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error("gamepad-script", a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return kExitOk;
+    } else if (a == "-o") {
+      out = value();
+    } else if (a == "--input-settings") {
+      settings_path = value();
+    } else if (a == "--force") {
+      force = true;
+    } else if (!a.empty() && a[0] == '-') {
+      usage_error("gamepad-script", "unknown option '" + a + "'");
+    } else if (in.empty()) {
+      in = a;
+    } else {
+      usage_error("gamepad-script", "one recording at a time, got '" + in + "' and '" + a + "'");
+    }
+  }
+  if (in.empty()) usage_error("gamepad-script", "which recording? (mixpilot gamepad-script REC.mcap -o OUT.csv)");
+  if (out.empty()) usage_error("gamepad-script", "-o OUT.csv is required");
+  std::string error;
+  input::InputSettings settings;
+  if (!settings_path.empty()) {
+    bool exists = false;
+    const auto s = input::load_settings(settings_path, exists, error);
+    if (!s || !exists) {
+      std::fprintf(stderr, "mixpilot gamepad-script: %s\n",
+                   s ? (settings_path + ": no such file").c_str() : error.c_str());
+      return kExitError;
+    }
+    settings = *s;
+  } else {
+    std::string note;
+    settings = load_input_settings("", note);
+    if (!note.empty()) std::fprintf(stderr, "mixpilot gamepad-script: %s\n", note.c_str());
+  }
+  const auto rec = read_recording(in, error);
+  if (!rec) {
+    std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
+    return kExitError;
+  }
+  if (rec->pilot.empty()) {
+    std::fprintf(stderr, "mixpilot gamepad-script: %s holds no pilot commands (a mixed_initiative "
+                 "recording has them)\n", in.c_str());
+    return kExitError;
+  }
+  const std::string* text = embedded_scenario(*rec, in, error);
+  const auto scenario =
+      text ? parse_scenario(*text, embedded_scenario_source(*rec, in), error) : std::nullopt;
+  if (!scenario) {
+    std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
+    return kExitError;
+  }
+  const double dt = scenario->controller.dt;
+  OutputFile f;
+  if (!f.open(out, force, error)) {
+    std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
+    return kExitError;
+  }
+  const double hover = models::MikroKopter().hover_speed();
+  std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n", in.c_str(),
+               settings.mode);
+  std::fprintf(f.stream(), "t,left_x,left_y,right_x,right_y\n");
+  for (std::size_t k = 0; k < rec->pilot.size(); ++k) {
+    const PilotCommandMsg& m = rec->pilot[k];
+    PilotCommand c;
+    c.roll = m.roll;
+    c.pitch = m.pitch;
+    c.rotor_speed = Eigen::Vector4d(m.rotor_speed[0], m.rotor_speed[1], m.rotor_speed[2],
+                                    m.rotor_speed[3]);
+    input::Controls shaped = input::controls_for(c, settings, hover);
+    const input::Controls raw{input::unshape(shaped.roll, settings.roll),
+                              input::unshape(shaped.pitch, settings.pitch),
+                              input::unshape(shaped.thrust, settings.thrust), 0.0};
+    const input::StickAxes s = input::unassign(raw, settings.mode);
+    // SDL's convention in the script: y down positive.
+    std::fprintf(f.stream(), "%.6f,%.6f,%.6f,%.6f,%.6f\n", double(m.step) * dt, s.left_x,
+                 -s.left_y, s.right_x, -s.right_y);
+  }
+  if (!f.commit(error)) {
+    std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
+    return kExitError;
+  }
+  std::printf("mixpilot gamepad-script: %zu rows (%.1f s) written to %s\n", rec->pilot.size(),
+              double(rec->pilot.size()) * dt, out.c_str());
+  return kExitOk;
+}
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,359 @@
+// The input layer (SPEC §6): the stick mapping and its inverse, the settings file, the
+// wait-free hand-over, the input-loss rule, the keyboard's ramp, the haptic cue, and SDL's real
+// path through a virtual gamepad (no hardware, no display).
+#include <gtest/gtest.h>
+
+#include <SDL2/SDL.h>
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include "input/device_pilot.hpp"
+#include "input/gamepad.hpp"
+#include "input/keyboard.hpp"
+#include "input/latest.hpp"
+#include "input/mapping.hpp"
+#include "input/settings.hpp"
+#include "input/virtual_gamepad.hpp"
+#include "models/mikrokopter.hpp"
+#include "temp_files.hpp"
+
+namespace mixpilot::input {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+TEST(Shape, DeadzoneExpoRateAndInversion) {
+  const AxisSettings a{0.1, 0.5, 1.0, false};
+  EXPECT_EQ(shape(0.0, a), 0.0);
+  EXPECT_EQ(shape(0.1, a), 0.0);  // the deadzone's edge
+  EXPECT_EQ(shape(-0.05, a), 0.0);
+  EXPECT_DOUBLE_EQ(shape(1.0, a), 1.0);
+  EXPECT_DOUBLE_EQ(shape(-1.0, a), -1.0);
+  // Half-way past the deadzone: r = 0.5 → (1 − e) r + e r³ = 0.25 + 0.0625.
+  EXPECT_DOUBLE_EQ(shape(0.55, a), 0.3125);
+  EXPECT_DOUBLE_EQ(shape(-0.55, a), -0.3125);
+  // Odd and non-decreasing.
+  for (double x = -1; x <= 1; x += 0.01) {
+    EXPECT_DOUBLE_EQ(shape(-x, a), -shape(x, a));
+    EXPECT_LE(shape(x, a), shape(x + 0.01, a) + 1e-15);
+  }
+  AxisSettings inv = a;
+  inv.invert = true;
+  EXPECT_DOUBLE_EQ(shape(0.55, inv), -0.3125);
+  AxisSettings fast = a;
+  fast.rate = 2.0;
+  EXPECT_DOUBLE_EQ(shape(0.55, fast), 0.625);
+  EXPECT_EQ(shape(1.0, fast), 1.0);  // clamped
+  EXPECT_EQ(shape(3.0, a), 1.0);     // raw values beyond ±1 are clamped first
+}
+
+TEST(Shape, UnshapeIsItsInverse) {
+  for (const AxisSettings a : {AxisSettings{}, AxisSettings{0.2, 0.9, 0.7, true},
+                               AxisSettings{0.0, 0.0, 1.0, false}}) {
+    for (double y = -0.99 * a.rate; y <= 0.99 * a.rate; y += 0.013) {
+      if (std::abs(y) > 1) continue;
+      EXPECT_NEAR(shape(unshape(y, a), a), y, 1e-12) << y;
+    }
+    EXPECT_EQ(unshape(0.0, a), 0.0);
+  }
+}
+
+TEST(StickModes, EachModePlacesTheControlsAndUnassignInvertsIt) {
+  const StickAxes s{0.1, 0.2, 0.3, 0.4};  // left x, left y, right x, right y
+  // Mode 2 (SPEC §6): left vertical = thrust, left horizontal = yaw, right = pitch + roll.
+  const Controls m2 = assign(s, 2);
+  EXPECT_EQ(m2.thrust, 0.2);
+  EXPECT_EQ(m2.yaw, 0.1);
+  EXPECT_EQ(m2.pitch, 0.4);
+  EXPECT_EQ(m2.roll, 0.3);
+  const Controls m1 = assign(s, 1);  // left: pitch + yaw; right: thrust + roll
+  EXPECT_EQ(m1.pitch, 0.2);
+  EXPECT_EQ(m1.yaw, 0.1);
+  EXPECT_EQ(m1.thrust, 0.4);
+  EXPECT_EQ(m1.roll, 0.3);
+  const Controls m3 = assign(s, 3);  // left: pitch + roll; right: thrust + yaw
+  EXPECT_EQ(m3.pitch, 0.2);
+  EXPECT_EQ(m3.roll, 0.1);
+  EXPECT_EQ(m3.thrust, 0.4);
+  EXPECT_EQ(m3.yaw, 0.3);
+  const Controls m4 = assign(s, 4);  // left: thrust + roll; right: pitch + yaw
+  EXPECT_EQ(m4.thrust, 0.2);
+  EXPECT_EQ(m4.roll, 0.1);
+  EXPECT_EQ(m4.pitch, 0.4);
+  EXPECT_EQ(m4.yaw, 0.3);
+  for (int mode = 1; mode <= 4; ++mode) {
+    const StickAxes back = unassign(assign(s, mode), mode);
+    EXPECT_EQ(back.left_x, s.left_x);
+    EXPECT_EQ(back.left_y, s.left_y);
+    EXPECT_EQ(back.right_x, s.right_x);
+    EXPECT_EQ(back.right_y, s.right_y);
+  }
+}
+
+// Angle mode and Remark 3: full stick = max tilt; centre thrust = hover; F_z,h = 4 C_T Ω_h².
+TEST(Command, AngleModeAndThrustAroundHover) {
+  const models::MikroKopter model;
+  const double hover = model.hover_speed();
+  InputSettings s;
+  PilotCommand c;
+  to_command(Controls{1.0, -0.5, 0.0, 0.7}, s, hover, c);
+  EXPECT_DOUBLE_EQ(c.roll, 30 * kDeg);
+  EXPECT_DOUBLE_EQ(c.pitch, -15 * kDeg);
+  EXPECT_DOUBLE_EQ(c.rotor_speed(0), hover);  // yaw does not enter ν^r
+  const double hover_thrust = model.p.m * model.p.g;
+  for (const double thrust : {-1.0, -0.3, 0.4, 1.0}) {
+    to_command(Controls{0, 0, thrust, 0}, s, hover, c);
+    const double F = 4 * model.p.C_T * c.rotor_speed(0) * c.rotor_speed(0);
+    EXPECT_NEAR(F, hover_thrust * (1 + s.thrust_range * thrust), 1e-12 * hover_thrust);
+    EXPECT_EQ(c.rotor_speed(1), c.rotor_speed(0));
+    const Controls back = controls_for(c, s, hover);
+    EXPECT_NEAR(back.thrust, thrust, 1e-12);
+  }
+}
+
+TEST(Haptic, IntensityGrowsAsLambdaFallsBelowTheThreshold) {
+  const HapticSettings h{true, 0.5, 0.8};
+  EXPECT_EQ(rumble_intensity(0.9, h), 0.0);
+  EXPECT_EQ(rumble_intensity(0.5, h), 0.0);
+  EXPECT_DOUBLE_EQ(rumble_intensity(0.25, h), 0.4);
+  EXPECT_DOUBLE_EQ(rumble_intensity(0.0, h), 0.8);
+  EXPECT_EQ(rumble_intensity(0.1, HapticSettings{false, 0.5, 0.8}), 0.0);
+}
+
+TEST(Settings, DefaultsRoundTripThroughTheFile) {
+  InputSettings s;
+  s.mode = 1;
+  s.roll.expo = 0.55;
+  s.yaw.invert = true;
+  s.haptic.enabled = false;
+  s.gamepad = "Pad \"X\"";
+  std::string error;
+  const auto back = parse_settings(to_toml(s), "x.toml", error);
+  ASSERT_TRUE(back) << error;
+  EXPECT_EQ(back->mode, 1);
+  EXPECT_EQ(back->roll.expo, 0.55);
+  EXPECT_TRUE(back->yaw.invert);
+  EXPECT_FALSE(back->haptic.enabled);
+  EXPECT_EQ(back->gamepad, "Pad \"X\"");
+  EXPECT_EQ(back->thrust.expo, 0.0);
+}
+
+TEST(Settings, EveryBadValueIsReportedWithItsPosition) {
+  std::string error;
+  const auto bad = [&](const std::string& text) {
+    error.clear();
+    EXPECT_FALSE(parse_settings(text, "in.toml", error));
+    return error;
+  };
+  EXPECT_EQ(bad("mode = 5\n"), "in.toml:1:8: mode: value outside [1, 4], got 5");
+  EXPECT_EQ(bad("max_tilt_deg = 90\n"), "in.toml:1:16: max_tilt_deg: value outside (0, 60], got 90");
+  EXPECT_EQ(bad("max_tilt_deg = nan\n"),
+            "in.toml:1:16: max_tilt_deg: expected a finite number, got nan");
+  EXPECT_EQ(bad("[axes.roll]\ndeadzone = 0.7\n"),
+            "in.toml:2:12: axes.roll.deadzone: value outside [0, 0.5], got 0.7");
+  EXPECT_EQ(bad("[axes.pitch]\ninvert = 1\n"),
+            "in.toml:2:10: axes.pitch.invert: expected true or false, got 1");
+  EXPECT_EQ(bad("[haptic]\nthreshold = 0\n"),
+            "in.toml:2:13: haptic.threshold: value outside (0, 1], got 0");
+  EXPECT_EQ(bad("input_timeout_s = \"fast\"\n"),
+            "in.toml:1:19: input_timeout_s: expected a number, got the string \"fast\"");
+  EXPECT_NE(bad("[axes.rol]\n").find("in.toml:1:7: axes.rol: unknown key (did you mean \"roll\"?)"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(bad("mode = \n").find("in.toml:1:"), std::string::npos) << error;  // TOML syntax
+}
+
+TEST(Settings, AMissingFileGivesTheDefaultsAndSavedFilesLoad) {
+  const std::string dir = test::fresh_path("input", "settings").string();
+  bool exists = true;
+  std::string error;
+  const auto none = load_settings(dir + "/none.toml", exists, error);
+  ASSERT_TRUE(none) << error;
+  EXPECT_FALSE(exists);
+  InputSettings s;
+  s.max_tilt_deg = 20;
+  const std::string path = dir + "/sub/input.toml";
+  ASSERT_TRUE(save_settings(path, s, error)) << error;
+  const auto back = load_settings(path, exists, error);
+  ASSERT_TRUE(back) << error;
+  EXPECT_TRUE(exists);
+  EXPECT_EQ(back->max_tilt_deg, 20.0);
+}
+
+TEST(Latest, TheReaderAlwaysSeesAWholeAndNewerValue) {
+  struct Pair {
+    std::uint64_t a = 0, b = 0;
+  };
+  Latest<Pair> l;
+  EXPECT_EQ(l.read().a, 0u);
+  l.publish({1, 1});
+  l.publish({2, 2});
+  EXPECT_EQ(l.read().a, 2u);
+  EXPECT_EQ(l.read().a, 2u);
+  constexpr std::uint64_t kLast = 200000;
+  std::thread writer([&] {
+    for (std::uint64_t i = 3; i <= kLast; ++i) l.publish({i, i});
+  });
+  std::uint64_t seen = 2;
+  while (seen < kLast) {
+    const Pair p = l.read();
+    ASSERT_EQ(p.a, p.b);  // never torn
+    ASSERT_GE(p.a, seen);  // never older
+    seen = p.a;
+  }
+  writer.join();
+}
+
+// A stick source the test sets by hand.
+struct FakeSource : StickSource {
+  StickReading r;
+  std::string name() const override { return "fake"; }
+  const StickReading& latest() override { return r; }
+};
+
+TEST(DevicePilot, LossGivesThePlannerTheAuthorityAtOnceAndItReturnsGradually) {
+  FakeSource src;
+  src.r.connected = true;
+  src.r.alive_ns = steady_ns() + 3'600'000'000'000;  // alive throughout
+  InputSettings s;
+  s.return_time_s = 0.15;  // 10 steps of 15 ms
+  const double hover = models::MikroKopter().hover_speed();
+  DevicePilot pilot(src, s, 0.015, hover);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(16);
+  PilotCommand c;
+  src.r.sticks.right_x = 0.5;
+  ASSERT_TRUE(pilot.command(0, 0, x, c));
+  EXPECT_EQ(c.input, InputState::ok);
+  EXPECT_EQ(c.authority, 1.0);
+  EXPECT_GT(c.roll, 0.0);
+
+  src.r.connected = false;  // unplugged
+  ASSERT_TRUE(pilot.command(1, 0, x, c));
+  EXPECT_EQ(c.input, InputState::lost);
+  EXPECT_EQ(c.authority, 0.0);
+  EXPECT_EQ(c.roll, 0.0);
+  EXPECT_EQ(c.rotor_speed(0), hover);
+
+  src.r.connected = true;  // back, but the stick is still deflected
+  for (int k = 2; k < 5; ++k) {
+    ASSERT_TRUE(pilot.command(k, 0, x, c));
+    EXPECT_EQ(c.input, InputState::recentre);
+    EXPECT_EQ(c.authority, 0.0);
+  }
+  src.r.sticks.right_x = 0.04;  // inside the deadzone: centred
+  double previous = 0.0;
+  for (int k = 5; k < 14; ++k) {
+    ASSERT_TRUE(pilot.command(k, 0, x, c));
+    EXPECT_EQ(c.input, InputState::returning) << k;
+    EXPECT_NEAR(c.authority - previous, 0.1, 1e-12) << k;
+    previous = c.authority;
+  }
+  ASSERT_TRUE(pilot.command(14, 0, x, c));
+  EXPECT_EQ(c.input, InputState::ok);
+  EXPECT_EQ(c.authority, 1.0);
+}
+
+TEST(DevicePilot, ASilentDeviceIsLostAfterTheTimeout) {
+  FakeSource src;
+  src.r.connected = true;
+  InputSettings s;
+  DevicePilot pilot(src, s, 0.015, models::MikroKopter().hover_speed());
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(16);
+  PilotCommand c;
+  src.r.alive_ns = steady_ns();
+  ASSERT_TRUE(pilot.command(0, 0, x, c));
+  EXPECT_EQ(c.input, InputState::ok);
+  src.r.alive_ns = steady_ns() - std::int64_t(1.5 * s.input_timeout_s * 1e9);
+  ASSERT_TRUE(pilot.command(1, 0, x, c));
+  EXPECT_EQ(c.input, InputState::lost);
+  EXPECT_EQ(c.authority, 0.0);
+}
+
+TEST(Keyboard, KeysRampTheControlsInEveryStickMode) {
+  for (int mode = 1; mode <= 4; ++mode) {
+    InputSettings s;
+    s.mode = mode;
+    s.keyboard_ramp_s = 0.3;  // 20 steps of 15 ms to full deflection
+    KeyboardSource k(s);
+    k.set_key(Key::roll_right, true);
+    k.set_key(Key::thrust_down, true);
+    for (int i = 1; i <= 25; ++i) {
+      k.advance(0.015);
+      const Controls c = assign(k.latest().sticks, mode);
+      EXPECT_NEAR(c.roll, std::min(1.0, i / 20.0), 1e-12) << "mode " << mode << " step " << i;
+      EXPECT_NEAR(c.thrust, -std::min(1.0, i / 20.0), 1e-12);
+      EXPECT_EQ(c.pitch, 0.0);
+      EXPECT_EQ(c.yaw, 0.0);
+    }
+    k.set_key(Key::roll_right, false);
+    k.advance(0.015);
+    EXPECT_NEAR(assign(k.latest().sticks, mode).roll, 0.95, 1e-12);  // back, ramped too
+    EXPECT_TRUE(k.latest().connected);
+  }
+}
+
+TEST(Script, RowsAndTheirErrors) {
+  std::string error;
+  const auto ok = parse_script("# a script\nt,left_x,left_y,right_x,right_y\n0,0,0,0,0\n"
+                               "0.5,0,-1,0.25,0\n1.0,unplug\n2.0,plug\n", "s.csv", error);
+  ASSERT_TRUE(ok) << error;
+  ASSERT_EQ(ok->size(), 4u);
+  EXPECT_EQ((*ok)[1].values[1], -1.0f);
+  EXPECT_EQ((*ok)[2].kind, ScriptRow::unplug);
+  EXPECT_EQ((*ok)[3].kind, ScriptRow::plug);
+  EXPECT_FALSE(parse_script("0,0,0,0,0\n0.1,0,0,2,0\n", "s.csv", error));
+  EXPECT_EQ(error, "s.csv:2: column 4: expected a number in [-1, 1], got \"2\"");
+  EXPECT_FALSE(parse_script("1,0,0,0,0\n0.5,0,0,0,0\n", "s.csv", error));
+  EXPECT_EQ(error, "s.csv:2: time 0.5 is earlier than the row before");
+  EXPECT_FALSE(parse_script("0,0,0\n", "s.csv", error));
+  EXPECT_NE(error.find("s.csv:1: expected t,left_x"), std::string::npos) << error;
+  EXPECT_FALSE(parse_script("# nothing\n", "s.csv", error));
+}
+
+// Waits (up to 2 s) for `done`.
+template <class F>
+bool eventually(F done) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+// SDL's whole path without hardware: the virtual pad is found as a game controller, its axes
+// arrive (up and right positive), unplugging and plugging are seen, and the rumble the
+// Gamepad plays reaches the pad's callback.
+TEST(Gamepad, AVirtualPadThroughSdl) {
+  VirtualGamepad pad;
+  std::string error;
+  ASSERT_TRUE(pad.plug(error)) << error;
+  Gamepad g;
+  ASSERT_TRUE(g.start({}, error)) << error;
+  ASSERT_TRUE(eventually([&] { return g.connected(); }));
+  EXPECT_EQ(g.active_name(), "mixpilot virtual gamepad");
+  pad.set_axis(SDL_CONTROLLER_AXIS_RIGHTX, 0.5);
+  pad.set_axis(SDL_CONTROLLER_AXIS_LEFTY, -1.0);  // SDL: up is negative
+  ASSERT_TRUE(eventually([&] { return g.latest().sticks.right_x > 0.49; }));
+  EXPECT_NEAR(g.latest().sticks.right_x, 0.5, 1e-4);
+  EXPECT_NEAR(g.latest().sticks.left_y, 1.0, 1e-4);
+  EXPECT_NEAR(g.latest().joy.axes[1], -1.0, 1e-4);
+  EXPECT_EQ(g.latest().joy.num_axes, 6);
+
+  g.set_rumble(0.5);
+  ASSERT_TRUE(eventually([&] { return !pad.rumbles().empty(); }));
+  EXPECT_NEAR(pad.rumbles().back().intensity, 0.5, 1.0 / 256);
+
+  pad.unplug();
+  ASSERT_TRUE(eventually([&] { return !g.connected(); }));
+  EXPECT_FALSE(g.latest().connected);
+  ASSERT_TRUE(pad.plug(error)) << error;
+  ASSERT_TRUE(eventually([&] { return g.connected(); }));
+  g.stop();
+}
+
+}  // namespace
+}  // namespace mixpilot::input

@@ -1,0 +1,198 @@
+// The input settings panel and the input-loss banner (SPEC §6).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "input/keyboard.hpp"
+#include "ui/panels.hpp"
+#include "ui/theme.hpp"
+
+namespace mixpilot::ui {
+
+namespace {
+
+// One axis's response: raw stick (x) → shaped output (y), both in [-1, 1], with the live stick
+// as a dot on the curve.
+void axis_curve(const char* id, const input::AxisSettings& a, double live, ImVec2 size) {
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const ImVec2 min = ImGui::GetCursorScreenPos();
+  const ImVec2 max(min.x + size.x, min.y + size.y);
+  ImGui::InvisibleButton(id, size);
+  dl->AddRectFilled(min, max, colour::kBackground);
+  const auto px = [&](double x, double y) {
+    return ImVec2(float(min.x + (x + 1) * 0.5 * size.x), float(max.y - (y + 1) * 0.5 * size.y));
+  };
+  dl->AddLine(px(-1, 0), px(1, 0), colour::kGrid);
+  dl->AddLine(px(0, -1), px(0, 1), colour::kGrid);
+  constexpr int kPoints = 48;
+  for (int i = 0; i <= kPoints; ++i) dl->PathLineTo(px(-1 + 2.0 * i / kPoints, input::shape(-1 + 2.0 * i / kPoints, a)));
+  dl->PathStroke(colour::kPilot, 0, 2.0f);
+  const double x = std::clamp(live, -1.0, 1.0);
+  dl->AddCircleFilled(px(x, input::shape(x, a)), 4.0f, colour::kCaution);
+}
+
+bool slider(const char* label, double& v, double lo, double hi, const char* format) {
+  float f = float(v);
+  if (!ImGui::SliderFloat(label, &f, float(lo), float(hi), format, ImGuiSliderFlags_AlwaysClamp))
+    return false;
+  v = double(f);
+  return true;
+}
+
+}  // namespace
+
+unsigned held_flight_keys() {
+  const ImGuiIO& io = ImGui::GetIO();
+  if (io.WantCaptureKeyboard || io.KeyCtrl) return 0;
+  unsigned keys = 0;
+  for (int k = 0; k < int(input::Key::count); ++k)
+    if (ImGui::IsKeyDown(kFlightKeys[k])) keys |= 1u << k;
+  return keys;
+}
+
+void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
+  if (!ui.show_settings || !run.input || !run.input->settings) return;
+  const InputInfo& in = *run.input;
+  if (!ui.draft_loaded) {
+    ui.draft = *in.settings;
+    ui.draft_loaded = true;
+  }
+  input::InputSettings& s = ui.draft;
+  const ImVec2 d = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(std::min(760.0f, d.x - 40), 0), ImGuiCond_Appearing);
+  bool open = true;
+  if (!ImGui::Begin("Input settings (I)", &open, ImGuiWindowFlags_NoSavedSettings |
+                                                     ImGuiWindowFlags_NoCollapse)) {
+    ImGui::End();
+    ui.show_settings = open;
+    return;
+  }
+  if (!in.note.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+    ImGui::PushTextWrapPos(0);
+    ImGui::TextUnformatted(in.note.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::PopStyleColor();
+  }
+  // The device.
+  if (in.pilot == "keyboard") {
+    ImGui::TextUnformatted("Keyboard: W/S thrust, A/D yaw, arrows pitch and roll (keys ramp).");
+  } else {
+    ImGui::Text("Gamepad: %s", in.connected ? in.device.c_str() : "none connected");
+  }
+  if (!in.devices.empty()) {
+    ImGui::TextDisabled("SDL sees:");
+    for (const std::string& dev : in.devices) {
+      ImGui::SameLine();
+      ImGui::TextDisabled("%s;", dev.c_str());
+    }
+  }
+  ImGui::Separator();
+
+  const char* modes[] = {"Mode 1 (left: pitch + yaw, right: thrust + roll)",
+                         "Mode 2 (left: thrust + yaw, right: pitch + roll)",
+                         "Mode 3 (left: pitch + roll, right: thrust + yaw)",
+                         "Mode 4 (left: thrust + roll, right: pitch + yaw)"};
+  int mode = s.mode - 1;
+  ImGui::SetNextItemWidth(420);
+  if (ImGui::Combo("stick mode", &mode, modes, 4)) s.mode = mode + 1;
+  ImGui::SetNextItemWidth(200);
+  slider("max tilt [deg]", s.max_tilt_deg, 5, 60, "%.0f");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(200);
+  slider("thrust range (x hover)", s.thrust_range, 0.05, 1, "%.2f");
+
+  // Each axis: its shaping and its curve with the live stick.
+  const input::Controls raw = input::assign(in.live, s.mode);
+  const std::pair<const char*, input::AxisSettings*> axes[] = {
+      {"roll", &s.roll}, {"pitch", &s.pitch}, {"thrust", &s.thrust}, {"yaw", &s.yaw}};
+  const double live[] = {raw.roll, raw.pitch, raw.thrust, raw.yaw};
+  if (ImGui::BeginTable("axes", 4, ImGuiTableFlags_SizingStretchSame)) {
+    for (int i = 0; i < 4; ++i) {
+      ImGui::TableNextColumn();
+      input::AxisSettings& a = *axes[i].second;
+      ImGui::PushID(i);
+      ImGui::Text("%s  %+.2f", axes[i].first, input::shape(live[i], a));
+      const float w = ImGui::GetContentRegionAvail().x;
+      axis_curve("curve", a, live[i], ImVec2(w, w * 0.75f));
+      ImGui::SetNextItemWidth(w * 0.55f);
+      slider("deadzone", a.deadzone, 0, 0.5, "%.2f");
+      ImGui::SetNextItemWidth(w * 0.55f);
+      slider("expo", a.expo, 0, 1, "%.2f");
+      ImGui::SetNextItemWidth(w * 0.55f);
+      slider("rate", a.rate, 0.1, 2, "%.2f");
+      ImGui::Checkbox("invert", &a.invert);
+      ImGui::PopID();
+    }
+    ImGui::EndTable();
+  }
+  ImGui::Separator();
+  ImGui::SetNextItemWidth(160);
+  slider("input timeout [s]", s.input_timeout_s, 0.02, 1, "%.2f");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(160);
+  slider("return time [s]", s.return_time_s, 0, 5, "%.1f");
+  ImGui::Checkbox("haptic cue", &s.haptic.enabled);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!s.haptic.enabled);
+  ImGui::SetNextItemWidth(160);
+  slider("below lambda", s.haptic.threshold, 0.05, 1, "%.2f");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(160);
+  slider("strength", s.haptic.strength, 0, 1, "%.2f");
+  ImGui::EndDisabled();
+  ImGui::Separator();
+  ImGui::TextDisabled("Changes apply from the next flight.");
+  if (ImGui::Button("Apply")) req.apply_settings = true;
+  ImGui::SameLine();
+  if (ImGui::Button("Save")) req.apply_settings = req.save_settings = true;
+  ImGui::SameLine();
+  ImGui::TextDisabled("to %s", in.settings_path.c_str());
+  ImGui::SameLine();
+  if (ImGui::Button("Defaults")) s = input::InputSettings{};
+  ImGui::End();
+  if (!open) {
+    ui.show_settings = false;
+    ui.draft_loaded = false;
+  }
+}
+
+void draw_input_banner(const History& h, const RunInfo& run, ImVec2 min, ImVec2 max) {
+  const bool waiting = run.input && run.input->waiting;
+  const InputState state = h.empty() ? InputState::ok : h.newest().pilot.input;
+  if (!waiting && state == InputState::ok) return;
+  char text[160];
+  ImU32 c = colour::kCritical;
+  switch (state) {
+    case InputState::lost:
+      std::snprintf(text, sizeof text, "INPUT LOST: the planner flies. Reconnect the %s.",
+                    run.input && !run.input->pilot.empty() ? run.input->pilot.c_str() : "device");
+      break;
+    case InputState::recentre:
+      std::snprintf(text, sizeof text, "The %s is back: centre the sticks to take control.",
+                    run.input && !run.input->pilot.empty() ? run.input->pilot.c_str() : "device");
+      c = colour::kCaution;
+      break;
+    case InputState::returning:
+      std::snprintf(text, sizeof text, "Control returning to the pilot: %.0f %%",
+                    100.0 * h.newest().pilot.authority);
+      c = colour::kCaution;
+      break;
+    default:
+      std::snprintf(text, sizeof text,
+                    "Connect a gamepad to start (or pick the keyboard as the pilot).");
+      c = colour::kCaution;
+      break;
+  }
+  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  const float scale = 1.4f;
+  const ImVec2 ts = ImGui::CalcTextSize(text);
+  const ImVec2 size(ts.x * scale + 32, ts.y * scale + 20);
+  const ImVec2 p(0.5f * (min.x + max.x - size.x), min.y + 0.42f * (max.y - min.y));
+  dl->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), colour::rgb(0x10, 0x10, 0x10, 230), 6.0f);
+  dl->AddRect(p, ImVec2(p.x + size.x, p.y + size.y), c, 6.0f, 0, 2.5f);
+  dl->AddText(ImGui::GetFont(), ImGui::GetFontSize() * scale, ImVec2(p.x + 16, p.y + 10), c, text);
+}
+
+}  // namespace mixpilot::ui
