@@ -323,13 +323,48 @@ void Trainer::update_input() {
   if (d && d->keyboard) {
     input_.connected = true;
     input_.device = "keyboard";
-  } else if (gamepad_) {
-    input_.connected = gamepad_->connected();
-    input_.device = gamepad_->active_name();
-    input_.live = gamepad_->latest_for_ui().sticks;
+  }
+  // The settings panel lists SDL's joysticks, whatever flies.
+  if (!gamepad_ && ui_.show_settings) {
+    std::string error;
+    if (!gamepad(error)) input_.message = error;
+  }
+  if (gamepad_) {
+    if (!d || !d->keyboard) {
+      input_.connected = gamepad_->connected();
+      input_.device = gamepad_->active_name();
+      input_.live = gamepad_->latest_for_ui().sticks;
+    }
     input_.devices.clear();
-    for (const input::GamepadInfo& g : gamepad_->devices())
-      input_.devices.push_back(g.name + (g.controller ? "" : " (no mapping)"));
+    input_.active = -1;
+    for (const input::GamepadInfo& g : gamepad_->devices()) {
+      input_.devices.push_back({g.instance, g.name, g.controller});
+      if (g.controller && g.name == gamepad_->active_name()) input_.active = g.instance;
+    }
+  }
+  if (wizard_ && gamepad_) {
+    wizard_raw_ = gamepad_->raw();
+    wizard_->feed(wizard_raw_);
+    ui::InputInfo::Wizard& w = input_.wizard.emplace();
+    w.device = wizard_device_;
+    w.step = wizard_->current();
+    w.steps = wizard_->steps().size();
+    w.done = wizard_->done();
+    if (!w.done) {
+      w.prompt = wizard_->steps()[w.step].prompt;
+      w.optional = wizard_->steps()[w.step].optional;
+    }
+    w.hint = wizard_->hint();
+    w.bindings = wizard_->bindings();
+    w.mapping = wizard_->mapping();
+    w.raw = &wizard_raw_;
+  } else {
+    input_.wizard.reset();
+  }
+  if (gamepad_ && !wizard_) {
+    std::string error;
+    const int added = gamepad_->mapping_status(error);
+    if (added < 0) input_.message = error;
   }
   run_.input = &input_;
   // A flight waiting for its gamepad starts when one arrives.
@@ -411,6 +446,7 @@ void Trainer::act(const ui::UiRequest& req) {
     }
     return;
   }
+  act_on_input(req);
   if (req.apply_settings) {
     input_settings_ = ui_.draft;
     if (req.save_settings) {
@@ -458,6 +494,40 @@ void Trainer::act(const ui::UiRequest& req) {
     } else {
       say(error, true);
     }
+  }
+}
+
+void Trainer::act_on_input(const ui::UiRequest& req) {
+  if (!gamepad_) return;
+  if (req.use_gamepad >= -1) gamepad_->choose(req.use_gamepad);
+  if (req.map_gamepad >= 0) {
+    for (const input::GamepadInfo& g : gamepad_->devices()) {
+      if (g.instance != req.map_gamepad) continue;
+      wizard_.emplace(input_settings_.mode, g.guid, g.name);
+      wizard_device_ = g.name;
+      gamepad_->watch(g.instance);
+      input_.message.clear();
+    }
+  }
+  if (!wizard_) return;
+  if (req.wizard_skip) (void)wizard_->skip();
+  if (req.wizard_back) wizard_->back();
+  if (req.wizard_save) {
+    const std::string line = wizard_->mapping();
+    const std::string path = input::user_mappings_path();
+    std::string error;
+    if (line.empty()) return;
+    if (input::save_mapping(path, line, error)) {
+      gamepad_->add_mapping(line);
+      input_.message = wizard_device_ + " is mapped (saved in " + path + ").";
+    } else {
+      input_.message = error;
+    }
+  }
+  if (req.wizard_save || req.wizard_cancel) {
+    gamepad_->watch(-1);
+    wizard_.reset();
+    input_.wizard.reset();
   }
 }
 

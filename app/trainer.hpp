@@ -14,6 +14,7 @@
 #include "app/replay_tape.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
+#include "input/mapping_wizard.hpp"
 #include "ui/screen.hpp"
 
 namespace mixpilot::cli {
@@ -100,6 +101,10 @@ class Trainer {
   input::InputSettings input_settings_;      // what the next device flight uses
   std::string input_settings_path_;
   ui::InputInfo input_;
+  std::optional<input::MappingWizard> wizard_;  // mapping a joystick SDL does not know
+  std::string wizard_device_;
+  input::RawJoystick wizard_raw_;  // the newest raw reading (the wizard panel shows it)
+  void act_on_input(const ui::UiRequest& req);
 };
 
 }  // namespace mixpilot::cli

@@ -114,6 +114,63 @@ void Gamepad::close_device() {
   active_.clear();
 }
 
+void Gamepad::add_mapping(const std::string& line) {
+  std::lock_guard<std::mutex> lock(mapping_mutex_);
+  pending_mapping_ = line;
+  mapping_status_ = 0;
+  mapping_error_.clear();
+}
+
+int Gamepad::mapping_status(std::string& error) const {
+  std::lock_guard<std::mutex> lock(mapping_mutex_);
+  error = mapping_error_;
+  return mapping_status_;
+}
+
+bool Gamepad::apply_pending_mapping() {
+  std::string line;
+  {
+    std::lock_guard<std::mutex> lock(mapping_mutex_);
+    if (pending_mapping_.empty()) return false;
+    line.swap(pending_mapping_);
+  }
+  const int added = SDL_GameControllerAddMapping(line.c_str());
+  const std::string why = added < 0 ? SDL_GetError() : "";
+  refresh_devices();
+  std::lock_guard<std::mutex> lock(mapping_mutex_);
+  mapping_status_ = added < 0 ? -1 : 1;
+  mapping_error_ = added < 0 ? "SDL refused the mapping (" + why + ")" : "";
+  return true;
+}
+
+void Gamepad::update_watch() {
+  const std::int32_t want = watched_.load(std::memory_order_relaxed);
+  auto* js = static_cast<SDL_Joystick*>(joystick_);
+  if (js && (want != raw_reading_.instance || !SDL_JoystickGetAttached(js))) {
+    SDL_JoystickClose(js);
+    js = nullptr;
+    joystick_ = nullptr;
+    raw_reading_ = RawJoystick{};
+    raw_.publish(raw_reading_);
+  }
+  if (!js && want >= 0) {
+    for (int i = 0; i < SDL_NumJoysticks(); ++i)
+      if (SDL_JoystickGetDeviceInstanceID(i) == want) js = SDL_JoystickOpen(i);
+    if (!js) return;
+    joystick_ = js;
+    raw_reading_.instance = want;
+  }
+  if (!js) return;
+  RawJoystick& r = raw_reading_;
+  r.num_axes = std::min(SDL_JoystickNumAxes(js), RawJoystick::kMaxAxes);
+  r.num_buttons = std::min(SDL_JoystickNumButtons(js), RawJoystick::kMaxButtons);
+  r.num_hats = std::min(SDL_JoystickNumHats(js), RawJoystick::kMaxHats);
+  for (int a = 0; a < r.num_axes; ++a) r.axes[std::size_t(a)] = axis_value(SDL_JoystickGetAxis(js, a));
+  for (int b = 0; b < r.num_buttons; ++b) r.buttons[std::size_t(b)] = SDL_JoystickGetButton(js, b) != 0;
+  for (int h = 0; h < r.num_hats; ++h) r.hats[std::size_t(h)] = SDL_JoystickGetHat(js, h);
+  raw_.publish(r);
+}
+
 void Gamepad::run() {
   // Just below the control thread (which asks for priority 10) when the system allows it.
   sched_param p{};
@@ -155,7 +212,9 @@ void Gamepad::run() {
     const bool rechoose = w != wanted;
     if (rechoose && controller_ && w != instance_) close_device();
     wanted = w;
-    if (changed_devices) refresh_devices();
+    if (apply_pending_mapping()) changed_devices = true;  // a pad it names can open now
+    else if (changed_devices) refresh_devices();
+    update_watch();
     // Hot-plug: a pad that arrives is taken at once; otherwise look again every second.
     if (!controller_ && (changed_devices || rechoose || polls_ % polls_per_second == 0)) open_device(wanted);
 
@@ -191,6 +250,8 @@ void Gamepad::run() {
     polls_.fetch_add(1, std::memory_order_relaxed);
   }
   close_device();
+  if (joystick_) SDL_JoystickClose(static_cast<SDL_Joystick*>(joystick_));
+  joystick_ = nullptr;
 }
 
 }  // namespace mixpilot::input

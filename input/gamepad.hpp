@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "input/latest.hpp"
+#include "input/mapping_wizard.hpp"
 #include "input/source.hpp"
 
 namespace mixpilot::input {
@@ -61,6 +62,16 @@ class Gamepad final : public StickSource {
   // Any thread: use this SDL instance from now on (-1: the first connected).
   void choose(std::int32_t instance) { wanted_.store(instance, std::memory_order_relaxed); }
 
+  // The mapping wizard's view: the raw joystick `instance` (-1: none) as SDL's Joystick API
+  // reports it, read with raw() by one reader (the UI).
+  void watch(std::int32_t instance) { watched_.store(instance, std::memory_order_relaxed); }
+  const RawJoystick& raw() { return raw_.read(); }
+  // Adds an SDL mapping line now (the device thread applies it; a pad it names becomes usable
+  // at once). mapping_status(): 0 nothing asked or pending, 1 added, -1 refused (with SDL's
+  // reason in `error`).
+  void add_mapping(const std::string& line);
+  int mapping_status(std::string& error) const;
+
   // UI: every joystick SDL sees, and the one in use.
   std::vector<GamepadInfo> devices() const;
   std::string active_name() const;
@@ -73,6 +84,8 @@ class Gamepad final : public StickSource {
   bool open_device(std::int32_t wanted);
   void close_device();
   void refresh_devices();
+  void update_watch();
+  bool apply_pending_mapping();  // true when one was applied
 
   Options options_;
   std::thread thread_;
@@ -84,9 +97,16 @@ class Gamepad final : public StickSource {
   std::atomic<std::int32_t> wanted_{-1};
   std::atomic<std::uint64_t> polls_{0};
   Latest<StickReading> for_control_, for_ui_;
+  std::atomic<std::int32_t> watched_{-1};
+  Latest<RawJoystick> raw_;
+  mutable std::mutex mapping_mutex_;  // the UI's requests; never taken by the control thread
+  std::string pending_mapping_, mapping_error_;
+  int mapping_status_ = 0;
 
   // Device thread only.
   void* controller_ = nullptr;  // SDL_GameController*
+  void* joystick_ = nullptr;    // SDL_Joystick* the wizard watches
+  RawJoystick raw_reading_;
   std::int32_t instance_ = -1;
   StickReading reading_;
   float rumble_sent_ = 0.0f;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <SDL2/SDL.h>
 #include <imgui.h>
 #include <imgui_internal.h>
 
@@ -26,6 +27,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "input/keyboard.hpp"
+#include "input/virtual_gamepad.hpp"
 #include "input/mapping.hpp"
 #include "models/mikrokopter.hpp"
 #include "ui/panels.hpp"
@@ -573,6 +575,119 @@ TEST_F(App, InputLossIsShownOverTheArena) {
     for (int x = kW / 4; x < 3 * kW / 4; ++x) hits += colour_near(p, ImVec2(float(x), float(y)), red, 0, 8);
   EXPECT_GT(hits, 400) << "no input-loss banner in the critical colour";
   app.live()->runner->set_paused(false);
+}
+
+// A joystick SDL does not know, mapped from the settings panel: Map it... opens the wizard,
+// the user moves each stick as asked and skips the buttons, Save writes the SDL line into the
+// user's mappings and the pad is usable at once.
+TEST_F(App, TheMappingWizardMakesAnUnknownJoystickAGamepad) {
+  fresh_user_dirs("wizard");
+  ASSERT_EQ(SDL_InitSubSystem(SDL_INIT_JOYSTICK), 0) << SDL_GetError();
+  SDL_VirtualJoystickDesc desc{};
+  desc.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
+  desc.type = SDL_JOYSTICK_TYPE_UNKNOWN;
+  desc.naxes = 4;
+  desc.nbuttons = 6;
+  desc.vendor_id = 0x1209;  // USB ids, as a real joystick has
+  desc.product_id = 0x0002;
+  desc.name = "mixpilot unknown stick";
+  const int index = SDL_JoystickAttachVirtualEx(&desc);
+  ASSERT_GE(index, 0) << SDL_GetError();
+  SDL_Joystick* js = SDL_JoystickOpen(index);
+  ASSERT_TRUE(js);
+  const auto set = [&](int axis, double v) {
+    SDL_JoystickSetVirtualAxis(js, axis, Sint16(std::lround(v * 32767)));
+  };
+  for (int a = 0; a < 4; ++a) set(a, 0.0);
+
+  cli::Trainer app(live_options("mi_helix.toml", 2.0, "keyboard"));
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  key(app, 'I');
+  const auto listed = [&] {
+    for (int i = 0; i < 100; ++i) {
+      frame(app, 0.0);
+      for (const auto& d : app.run_info().input->devices)
+        if (d.name == "mixpilot unknown stick") return !d.mapped;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  };
+  ASSERT_TRUE(listed()) << "the panel does not list the unknown joystick as unmapped";
+  frame(app, 0.0);
+  save_shot(screen_, "input_settings_unknown_pad");
+  const auto map = locate(app, "Input settings (I)", "Map it...##mixpilot unknown stick");
+  ASSERT_TRUE(map);
+  click(app, *map);
+  frame(app, 0.0);
+  ASSERT_TRUE(app.run_info().input->wizard);
+  // The user follows the prompts: each stick as asked, then lets go.
+  const auto wizard = [&] { return *app.run_info().input->wizard; };
+  const auto until = [&](auto done) {
+    for (int i = 0; i < 200 && !done(); ++i) {
+      frame(app, 0.0);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return done();
+  };
+  for (int i = 0; i < 10; ++i) frame(app, 0.0);  // the rest position
+  const std::pair<int, double> moves[] = {{1, -1.0}, {0, 1.0}, {3, -1.0}, {2, 1.0}};
+  for (const auto& [axis, v] : moves) {
+    const std::size_t step = wizard().step;
+    set(axis, v);
+    ASSERT_TRUE(until([&] { return !wizard().hint.empty(); })) << wizard().prompt;
+    if (axis == 3) save_shot(screen_, "mapping_wizard");
+    set(axis, 0.0);
+    ASSERT_TRUE(until([&] { return wizard().step == step + 1; })) << wizard().prompt;
+  }
+  EXPECT_TRUE(wizard().optional) << "the buttons can be skipped";
+  while (!wizard().done) {
+    const auto skip = locate(app, "Map a gamepad", "Skip");
+    ASSERT_TRUE(skip);
+    click(app, *skip);
+  }
+  EXPECT_NE(wizard().mapping.find("lefty:a1,leftx:a0,righty:a3,rightx:a2,platform:Linux,"),
+            std::string::npos)
+      << wizard().mapping;
+  const auto save = locate(app, "Map a gamepad", "Save");
+  ASSERT_TRUE(save);
+  click(app, *save);
+  frame(app, 0.0);
+  EXPECT_FALSE(app.run_info().input->wizard);
+  std::ifstream in(std::string(std::getenv("XDG_CONFIG_HOME")) + "/mixpilot/gamecontrollerdb.txt");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line)) << "nothing in the user's mappings";
+  EXPECT_NE(line.find(",mixpilot unknown stick,"), std::string::npos) << line;
+  EXPECT_TRUE(until([&] {
+    for (const auto& d : app.run_info().input->devices)
+      if (d.name == "mixpilot unknown stick") return d.mapped;
+    return false;
+  })) << "SDL does not know the pad after Save";
+  frame(app, 0.0);
+  save_shot(screen_, "input_settings_mapped");
+  // Another pad arrives: Select picks it for the gamepad flights.
+  input::VirtualGamepad pad;
+  ASSERT_TRUE(pad.plug(error)) << error;
+  ASSERT_TRUE(until([&] {
+    for (const auto& d : app.run_info().input->devices)
+      if (d.name == "mixpilot virtual gamepad") return true;
+    return false;
+  }));
+  frame(app, 0.0);
+  const auto select = locate(app, "Input settings (I)", "Select##mixpilot virtual gamepad");
+  ASSERT_TRUE(select);
+  click(app, *select);
+  const auto selected = [&] {
+    for (const auto& d : app.run_info().input->devices)
+      if (d.instance == app.run_info().input->active) return d.name;
+    return std::string("none");
+  };
+  EXPECT_TRUE(until([&] { return selected() == "mixpilot virtual gamepad"; })) << selected();
+  pad.unplug();
+  SDL_JoystickClose(js);
+  SDL_JoystickDetachVirtual(index);
+  SDL_QuitSubSystem(SDL_INIT_JOYSTICK);
 }
 
 }  // namespace

@@ -5,13 +5,18 @@
 
 #include <SDL2/SDL.h>
 
+#include <algorithm>
 #include <chrono>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <cmath>
 #include <numbers>
 #include <thread>
 
 #include "input/device_pilot.hpp"
 #include "input/gamepad.hpp"
+#include "input/mapping_wizard.hpp"
 #include "input/keyboard.hpp"
 #include "input/latest.hpp"
 #include "input/mapping.hpp"
@@ -353,6 +358,153 @@ TEST(Gamepad, AVirtualPadThroughSdl) {
   ASSERT_TRUE(pad.plug(error)) << error;
   ASSERT_TRUE(eventually([&] { return g.connected(); }));
   g.stop();
+}
+
+// The wizard from made-up readings: sticks (one inverted), a button, a hat, a trigger resting
+// at −1, a skipped step, a control bound twice, and the line SDL gets.
+TEST(MappingWizard, BuildsTheSdlLineFromWhatMoved) {
+  MappingWizard w(2, "03000000aaaa0000bbbb000000000000", "Odd, Stick");
+  RawJoystick rest;
+  rest.num_axes = 6;
+  rest.num_buttons = 4;
+  rest.num_hats = 1;
+  rest.axes[5] = -1.0f;  // a trigger at rest
+  w.feed(rest);
+  const auto move = [&](auto change) {
+    RawJoystick r = rest;
+    change(r);
+    w.feed(r);
+    w.feed(rest);  // let go
+  };
+  ASSERT_EQ(w.steps()[0].target, "lefty");  // Mode 2: thrust on the left stick
+  EXPECT_NE(w.steps()[0].prompt.find("thrust stick up"), std::string::npos);
+  EXPECT_FALSE(w.skip()) << "a stick cannot be skipped";
+  move([](RawJoystick& r) { r.axes[1] = -1.0f; });  // up is negative: plain
+  move([](RawJoystick& r) { r.axes[0] = 0.9f; });   // right is positive: plain
+  EXPECT_EQ(w.current(), 2u);
+  move([](RawJoystick& r) { r.axes[0] = 0.9f; });   // already the yaw: refused
+  EXPECT_EQ(w.current(), 2u);
+  EXPECT_NE(w.hint().find("already leftx"), std::string::npos) << w.hint();
+  move([](RawJoystick& r) { r.axes[3] = 1.0f; });   // pitch up grows: inverted
+  move([](RawJoystick& r) { r.axes[2] = -0.8f; });  // roll right shrinks: inverted
+  EXPECT_TRUE(w.mapping().find("rightx:a2~") != std::string::npos);
+  move([](RawJoystick& r) { r.buttons[1] = true; });  // a
+  EXPECT_TRUE(w.skip());                              // b skipped
+  move([](RawJoystick& r) { r.hats[0] = 1; });        // x on the hat's up
+  // A half-moved axis is not a press; nothing happens.
+  RawJoystick half = rest;
+  half.axes[4] = 0.3f;
+  w.feed(half);
+  EXPECT_EQ(w.steps()[w.current()].target, "y");
+  while (w.steps()[w.current()].target != "lefttrigger") ASSERT_TRUE(w.skip());
+  move([](RawJoystick& r) { r.axes[5] = 1.0f; });  // from −1: the whole axis
+  move([](RawJoystick& r) { r.axes[4] = 0.9f; });  // from 0: the positive half
+  EXPECT_TRUE(w.done());
+  EXPECT_EQ(w.mapping(),
+            "03000000aaaa0000bbbb000000000000,Odd  Stick,lefty:a1,leftx:a0,righty:a3~,rightx:a2~,"
+            "a:b1,x:h0.1,lefttrigger:a5,righttrigger:+a4,platform:Linux,");
+  w.back();
+  EXPECT_FALSE(w.done());
+  EXPECT_EQ(w.mapping().find("righttrigger"), std::string::npos);
+}
+
+TEST(MappingWizard, TheLineIsUnfinishedUntilEveryStickIsBound) {
+  MappingWizard w(1, "03000000cccc", "pad");
+  RawJoystick rest;
+  rest.num_axes = 4;
+  w.feed(rest);
+  EXPECT_EQ(w.steps()[0].target, "righty");  // Mode 1: thrust on the right stick
+  EXPECT_EQ(w.mapping(), "");
+}
+
+// The mappings file keeps other pads' lines and replaces this pad's.
+TEST(MappingWizard, SaveReplacesThePadsLineOnly) {
+  const auto dir = test::fresh_path("input", "mappings");
+  const std::string path = (dir / "sub" / "gamecontrollerdb.txt").string();
+  std::string error;
+  ASSERT_TRUE(save_mapping(path, "0300aaaa,one,a:b0,platform:Linux,", error)) << error;
+  ASSERT_TRUE(save_mapping(path, "0300bbbb,two,a:b1,platform:Linux,", error)) << error;
+  ASSERT_TRUE(save_mapping(path, "0300aaaa,one,a:b2,platform:Linux,", error)) << error;
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), "0300bbbb,two,a:b1,platform:Linux,\n0300aaaa,one,a:b2,platform:Linux,\n");
+}
+
+// End to end through SDL: a virtual joystick SDL has no mapping for is watched raw, mapped by
+// the wizard, and from then on reads as a gamepad with its axes where the wizard put them.
+TEST(MappingWizard, AJoystickSdlDoesNotKnowBecomesAGamepad) {
+  ASSERT_EQ(SDL_InitSubSystem(SDL_INIT_JOYSTICK), 0) << SDL_GetError();
+  SDL_VirtualJoystickDesc desc{};
+  desc.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
+  desc.type = SDL_JOYSTICK_TYPE_UNKNOWN;
+  desc.naxes = 5;
+  desc.nbuttons = 8;
+  desc.nhats = 1;
+  desc.name = "mixpilot odd joystick";
+  // USB ids, as every real USB joystick has (SDL 2.26 matches no added mapping to a GUID
+  // made from the name alone, which is what a virtual joystick without ids gets).
+  desc.vendor_id = 0x1209;
+  desc.product_id = 0x0001;
+  const int index = SDL_JoystickAttachVirtualEx(&desc);
+  ASSERT_GE(index, 0) << SDL_GetError();
+  SDL_Joystick* js = SDL_JoystickOpen(index);
+  ASSERT_TRUE(js) << SDL_GetError();
+  const auto set = [&](int axis, double v) {
+    SDL_JoystickSetVirtualAxis(js, axis, Sint16(std::lround(std::clamp(v, -1.0, 1.0) * 32767)));
+  };
+  for (int a = 0; a < 5; ++a) set(a, 0.0);
+
+  Gamepad g;
+  std::string error;
+  ASSERT_TRUE(g.start({}, error)) << error;
+  std::optional<GamepadInfo> odd;
+  ASSERT_TRUE(eventually([&] {
+    for (const GamepadInfo& d : g.devices())
+      if (d.name == "mixpilot odd joystick") odd = d;
+    return odd.has_value();
+  }));
+  EXPECT_FALSE(odd->controller) << "SDL knows this joystick already";
+  EXPECT_FALSE(g.connected());
+
+  g.watch(odd->instance);
+  ASSERT_TRUE(eventually([&] { return g.raw().instance == odd->instance && g.raw().num_axes == 5; }));
+  MappingWizard w(2, odd->guid, odd->name);
+  // The sticks on odd axes: thrust a4 (up grows), yaw a3, pitch a1, roll a0 (right shrinks).
+  const std::pair<int, double> moves[] = {{4, 1.0}, {3, 1.0}, {1, -1.0}, {0, -1.0}};
+  w.feed(g.raw());
+  for (const auto& [axis, v] : moves) {
+    set(axis, v);
+    ASSERT_TRUE(eventually([&] {
+      w.feed(g.raw());
+      return !w.hint().empty();
+    })) << w.steps()[w.current()].prompt;
+    set(axis, 0.0);
+    const std::size_t step = w.current();
+    ASSERT_TRUE(eventually([&] {
+      w.feed(g.raw());
+      return w.current() == step + 1;
+    }));
+  }
+  const std::string line = w.mapping();
+  ASSERT_FALSE(line.empty());
+  EXPECT_NE(line.find("lefty:a4~,leftx:a3,righty:a1,rightx:a0~,"), std::string::npos) << line;
+
+  g.watch(-1);
+  g.add_mapping(line);
+  ASSERT_TRUE(eventually([&] { return g.mapping_status(error) != 0; }));
+  ASSERT_EQ(g.mapping_status(error), 1) << error;
+  ASSERT_TRUE(eventually([&] { return g.connected(); })) << line;
+  EXPECT_EQ(g.active_name(), "mixpilot odd joystick");
+  set(0, -0.5);  // roll half right (inverted raw axis)
+  set(4, 0.5);   // thrust half up
+  ASSERT_TRUE(eventually([&] { return g.latest().sticks.right_x > 0.45; }));
+  EXPECT_NEAR(g.latest().sticks.right_x, 0.5, 1e-3);
+  EXPECT_NEAR(g.latest().sticks.left_y, 0.5, 1e-3);
+  g.stop();
+  SDL_JoystickClose(js);
+  SDL_JoystickDetachVirtual(index);
+  SDL_QuitSubSystem(SDL_INIT_JOYSTICK);
 }
 
 }  // namespace

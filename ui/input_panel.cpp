@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "input/keyboard.hpp"
 #include "ui/panels.hpp"
@@ -60,7 +61,9 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   input::InputSettings& s = ui.draft;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSize(ImVec2(std::min(760.0f, d.x - 40), 0), ImGuiCond_Appearing);
+  // Its width is fixed, its height always fits what it holds (devices come and go).
+  ImGui::SetNextWindowSize(ImVec2(std::min(760.0f, d.x - 40), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.98f);
   bool open = true;
   if (!ImGui::Begin("Input settings (I)", &open, ImGuiWindowFlags_NoSavedSettings |
                                                      ImGuiWindowFlags_NoCollapse)) {
@@ -75,19 +78,28 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
     ImGui::PopTextWrapPos();
     ImGui::PopStyleColor();
   }
-  // The device.
-  if (in.pilot == "keyboard") {
+  // The device: the gamepad in use, the others SDL sees, a mapping for those it does not know.
+  if (in.pilot == "keyboard")
     ImGui::TextUnformatted("Keyboard: W/S thrust, A/D yaw, arrows pitch and roll (keys ramp).");
-  } else {
+  else
     ImGui::Text("Gamepad: %s", in.connected ? in.device.c_str() : "none connected");
+  if (in.devices.empty()) {
+    ImGui::TextDisabled("SDL sees no joystick. Plug one in: it shows here at once.");
   }
-  if (!in.devices.empty()) {
-    ImGui::TextDisabled("SDL sees:");
-    for (const std::string& dev : in.devices) {
-      ImGui::SameLine();
-      ImGui::TextDisabled("%s;", dev.c_str());
+  for (const InputInfo::Device& dev : in.devices) {
+    // Labels carry the device's name as their id ("Map it...##name"), so tests can find them.
+    if (dev.mapped) {
+      ImGui::BeginDisabled(dev.instance == in.active);
+      const std::string use = (dev.instance == in.active ? "selected##" : "Select##") + dev.name;
+      if (ImGui::Button(use.c_str())) req.use_gamepad = dev.instance;
+      ImGui::EndDisabled();
+    } else if (ImGui::Button(("Map it...##" + dev.name).c_str())) {
+      req.map_gamepad = dev.instance;
     }
+    ImGui::SameLine();
+    ImGui::Text("%s%s", dev.name.c_str(), dev.mapped ? "" : "  (SDL has no mapping for it)");
   }
+  if (!in.message.empty()) ImGui::TextWrapped("%s", in.message.c_str());
   ImGui::Separator();
 
   const char* modes[] = {"Mode 1 (left: pitch + yaw, right: thrust + roll)",
@@ -156,6 +168,71 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
     ui.show_settings = false;
     ui.draft_loaded = false;
   }
+}
+
+void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
+  if (!run.input || !run.input->wizard) return;
+  const InputInfo::Wizard& w = *run.input->wizard;
+  const ImVec2 d = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, d.x - 40), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.98f);
+  ImGui::SetNextWindowFocus();
+  ImGui::Begin("Map a gamepad", nullptr,
+               ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::Text("%s", w.device.c_str());
+  ImGui::ProgressBar(float(w.step) / float(std::max<std::size_t>(1, w.steps)), ImVec2(-1, 0),
+                     w.done ? "done" : "");
+  ImGui::Spacing();
+  if (w.done) {
+    ImGui::TextWrapped("Every control is bound. Save writes this SDL mapping into your mappings "
+                       "and uses the pad at once:");
+  } else {
+    ImGui::SetWindowFontScale(1.3f);
+    ImGui::PushStyleColor(ImGuiCol_Text, colour::kPilot);
+    ImGui::TextWrapped("%zu/%zu  %s", w.step + 1, w.steps, w.prompt.c_str());
+    ImGui::PopStyleColor();
+    ImGui::SetWindowFontScale(1.0f);
+  }
+  ImGui::TextDisabled("%s", w.hint.empty() ? " " : w.hint.c_str());
+  // What the device reports, raw: axes as bars, pressed buttons, hats.
+  if (const input::RawJoystick* r = w.raw; r && r->instance >= 0) {
+    for (int a = 0; a < r->num_axes; ++a) {
+      char label[24];
+      std::snprintf(label, sizeof label, "a%d %+.2f", a, double(r->axes[std::size_t(a)]));
+      ImGui::ProgressBar(0.5f * (r->axes[std::size_t(a)] + 1.0f), ImVec2(140, 0), label);
+      if (a % 4 != 3 && a + 1 < r->num_axes) ImGui::SameLine();
+    }
+    std::string pressed;
+    for (int b = 0; b < r->num_buttons; ++b)
+      if (r->buttons[std::size_t(b)]) pressed += " b" + std::to_string(b);
+    for (int h = 0; h < r->num_hats; ++h)
+      if (r->hats[std::size_t(h)]) pressed += " h" + std::to_string(h) + "." + std::to_string(r->hats[std::size_t(h)]);
+    ImGui::Text("pressed:%s", pressed.empty() ? " none" : pressed.c_str());
+  } else {
+    ImGui::TextDisabled("(waiting for the device)");
+  }
+  ImGui::Separator();
+  std::string bound;
+  for (const std::string& b : w.bindings) bound += b + "  ";
+  ImGui::TextWrapped("bound: %s", bound.empty() ? "nothing yet" : bound.c_str());
+  if (!w.mapping.empty() && w.done) ImGui::TextWrapped("%s", w.mapping.c_str());
+  ImGui::BeginDisabled(w.done || !w.optional);
+  if (ImGui::Button("Skip")) req.wizard_skip = true;
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(w.step == 0);
+  if (ImGui::Button("Back")) req.wizard_back = true;
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(w.mapping.empty());
+  if (ImGui::Button("Save")) req.wizard_save = true;
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+    req.wizard_cancel = true;
+  ImGui::End();
 }
 
 void draw_input_banner(const History& h, const RunInfo& run, ImVec2 min, ImVec2 max) {

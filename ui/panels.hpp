@@ -34,6 +34,8 @@ void list_folder(OpenDialog& dialog);
 // The input settings panel (ui.show_settings, run.input): stick mode, tilt and thrust, each
 // axis's curve with the live stick on it, input loss, haptic cue; Apply / Save.
 void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req);
+// The mapping wizard (while InputInfo::wizard is set): the prompt, the raw device, the line.
+void draw_mapping_wizard(const RunInfo& run, UiRequest& req);
 // The input-loss banner over the view while the pilot's device is lost or not yet back.
 void draw_input_banner(const History& history, const RunInfo& run, ImVec2 min, ImVec2 max);
 // The flight keys held now (bit k: input::Key k).

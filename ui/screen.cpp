@@ -410,6 +410,7 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   if (ui.show_help) help_sheet(ui, d);
   draw_input_banner(h, run, vmin, vmax);
   draw_input_settings(run, ui, req);
+  draw_mapping_wizard(run, req);
   draw_open_dialog(ui, req);
   keys(ui, req, run, h);
   if (run.input && run.input->pilot == "keyboard" && !run.replay) req.flight_keys = held_flight_keys();

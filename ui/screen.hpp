@@ -3,12 +3,15 @@
 // the session buttons and the authority bar; the session panel; the arena (3D) or Pendubot (2D)
 // view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A function of the scene, the telemetry history
 // and the UI's own state; what the user asked for comes back as a UiRequest.
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <imgui.h>
 
 #include "input/mapping.hpp"
+#include "input/mapping_wizard.hpp"
 #include "input/settings.hpp"
 #include "ui/scene.hpp"
 
@@ -56,13 +59,31 @@ struct SessionChoices {
 struct InputInfo {
   std::string pilot;                 // "gamepad" | "keyboard" ("" : the pilot is no device)
   std::string device;                // the gamepad in use ("" none)
-  std::vector<std::string> devices;  // every joystick SDL sees ("name", "name (no mapping)")
+  struct Device {
+    std::int32_t instance = -1;  // SDL's instance id
+    std::string name;
+    bool mapped = false;         // SDL has a mapping (else the wizard can make one)
+  };
+  std::vector<Device> devices;       // every joystick SDL sees
+  std::int32_t active = -1;          // the instance in use
   bool connected = false;            // a gamepad is connected (the keyboard always is)
   bool waiting = false;              // Start was asked for: waiting for a gamepad
   input::StickAxes live;             // the sticks now, for the curves
   const input::InputSettings* settings = nullptr;
   std::string settings_path;         // where Save writes
   std::string note;                  // the settings file is broken: what was wrong
+  std::string message;               // what the last mapping did ("" none)
+  // The mapping wizard, while it runs (SPEC §6).
+  struct Wizard {
+    std::string device;
+    std::string prompt, hint;
+    std::size_t step = 0, steps = 0;
+    bool optional = false, done = false;
+    std::vector<std::string> bindings;
+    std::string mapping;  // the SDL line once every stick is bound
+    const input::RawJoystick* raw = nullptr;
+  };
+  std::optional<Wizard> wizard;
 };
 
 struct RunInfo {
@@ -128,6 +149,9 @@ struct UiRequest {
   unsigned flight_keys = 0;        // bit k: input::Key k is held (the keyboard pilot)
   bool apply_settings = false;     // use UiState::draft from the next flight on
   bool save_settings = false;      // ... and write it to InputInfo::settings_path
+  std::int32_t use_gamepad = -2;   // fly with this SDL instance (-1: the first; -2: no change)
+  std::int32_t map_gamepad = -1;   // start the mapping wizard for this SDL instance
+  bool wizard_skip = false, wizard_back = false, wizard_cancel = false, wizard_save = false;
 };
 
 // The events of a flight for a replay's timeline: collisions, fallbacks (overruns included),
