@@ -46,7 +46,7 @@ constexpr const char* kFlyUsage =
     "                     a recording, whose embedded scenario is then used. Its `mode` picks\n"
     "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
-    "                     gamepad | keyboard (a person; headless only with --realtime) |\n"
+    "                     gamepad (headless only with --realtime) | keyboard (window) |\n"
     "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
     "                     against the recording); default: the scenario's (mixed_initiative only)\n"
     "  --gamepad-script FILE.csv  with --pilot gamepad: a virtual gamepad plays the script\n"
@@ -182,7 +182,9 @@ int run_fly(const FlyOptions& o) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
-    session.add_sink(&*screenshots);
+    // Rendered on this thread (its GL context's): a real-time flight hands the telemetry over
+    // through the runner's ring, so the control thread never renders.
+    if (!o.realtime) session.add_sink(&*screenshots);
   }
   std::optional<ReplayCheck> check;
   if (flight->recording) {
@@ -200,18 +202,22 @@ int run_fly(const FlyOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<RealtimeStats> realtime;
   if (o.realtime) {
-    RealtimeRunner runner(session, 64);
+    RealtimeRunner runner(session, 1024);
     if (flight->devices) flight->devices->started();
     runner.start();
     Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
     Telemetry drained = mode.telemetry();
+    const auto drain = [&] {
+      while (runner.telemetry().pop(drained))
+        if (screenshots) screenshots->on_sample(drained);
+    };
     while (runner.running() && !interrupted()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      while (runner.telemetry().pop(drained)) {
-      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      drain();
       progress.update(mode.steps_done());
     }
     runner.stop();
+    drain();
     realtime = runner.stats();
   } else {
     Progress progress("fly " + mode.scenario_name(), mode.steps_total());
@@ -336,6 +342,8 @@ int fly_command(int argc, char** argv) {
   if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
   if (!o.gamepad_script.empty() && o.pilot != "gamepad")
     usage_error(o.command, "--gamepad-script plays a virtual gamepad: it goes with --pilot gamepad");
+  if (o.pilot == "keyboard" && o.headless)
+    usage_error(o.command, "--pilot keyboard takes its keys from the window: fly without --headless");
   if (is_device_pilot(o.pilot) && o.headless && !o.realtime)
     usage_error(o.command, "--pilot " + o.pilot + " is a person: a headless flight with it needs "
                            "--realtime (or fly in the window)");

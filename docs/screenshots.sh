@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
-# one per mode and one of a replay, 800x450. Usage: docs/screenshots.sh [path/to/mixpilot]
+# one per mode, one of a replay and one of input loss, 800x450; the input settings panel at
+# 1280x720 (an app test renders it). Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 m=${1:-build/release/app/mixpilot}
@@ -20,4 +21,14 @@ trap 'rm -rf "$tmp"' EXIT
   --record "$tmp/reckless.mcap" >/dev/null
 "$m" replay "$tmp/reckless.mcap" --headless --screenshot 6:$out/replay.png --size 800x450 \
   --force >/dev/null
+# A person's gamepad (a scripted SDL virtual pad) unplugged at 1 s: the planner flies.
+printf 't,left_x,left_y,right_x,right_y\n0,0,0,0.3,0\n1.0,unplug\n' >"$tmp/unplug.csv"
+XDG_CONFIG_HOME="$tmp/config" "$m" fly --scenario scenarios/mi_helix.toml --pilot gamepad \
+  --gamepad-script "$tmp/unplug.csv" --headless --realtime --duration 2 \
+  --screenshot 1.6:$out/input_lost.png --size 800x450 --force >/dev/null
+# The input settings panel, from the app test that opens it (MIXPILOT_SHOT_DIR).
+tests=$(dirname "$m")/../tests
+MIXPILOT_SHOT_DIR="$tmp" XDG_CONFIG_HOME="$tmp/config" "$tests/test_app" \
+  --gtest_filter=App.TheInputSettingsPanel >/dev/null
+cp "$tmp/input_settings.png" $out/input_settings.png
 ls -l $out

@@ -263,8 +263,8 @@ void draw_input_banner(const History& h, const RunInfo& run, ImVec2 min, ImVec2 
       break;
   }
   ImDrawList* dl = ImGui::GetForegroundDrawList();
-  const float scale = 1.4f;
   const ImVec2 ts = ImGui::CalcTextSize(text);
+  const float scale = std::clamp((max.x - min.x - 48) / std::max(ts.x, 1.0f), 1.0f, 1.4f);
   const ImVec2 size(ts.x * scale + 32, ts.y * scale + 20);
   const ImVec2 p(0.5f * (min.x + max.x - size.x), min.y + 0.42f * (max.y - min.y));
   dl->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), colour::rgb(0x10, 0x10, 0x10, 230), 6.0f);
