@@ -58,6 +58,9 @@ Trainer::Trainer(FlyOptions o) : options_(std::move(o)) {
   input_settings_path_ =
       options_.input_settings.empty() ? input::default_settings_path() : options_.input_settings;
   input_settings_ = load_input_settings(input_settings_path_, input_.note);
+  if (!input_.note.empty())
+    say(input_settings_path_ + " has errors: the default input settings are used (I shows them)",
+        true);
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
   scenario_paths_ = shipped_scenarios();

@@ -544,6 +544,36 @@ TEST_F(App, TheInputSettingsPanel) {
   EXPECT_FALSE(app.ui_state().show_settings);
 }
 
+// A broken settings file: the app starts with the defaults and says what is wrong, where.
+TEST_F(App, ABrokenSettingsFileGivesTheDefaultsAndSaysWhy) {
+  fresh_user_dirs("broken_settings");
+  const std::string dir = std::string(std::getenv("XDG_CONFIG_HOME")) + "/mixpilot";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/input.toml") << "mode = 7\n[axes.roll]\nexpo = 2\n";
+  cli::Trainer app(live_options("mi_helix.toml", 2.0, "keyboard"));
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  frame(app, 0.0);
+  EXPECT_TRUE(app.run_info().message_is_error);
+  EXPECT_NE(app.run_info().message.find("the default input settings are used (I shows them)"),
+            std::string::npos)
+      << app.run_info().message;
+  save_shot(screen_, "input_settings_broken_start");
+  key(app, 'I');
+  frame(app, 0.0);
+  const ui::InputInfo& in = *app.run_info().input;
+  EXPECT_EQ(in.settings->mode, 2);
+  EXPECT_EQ(in.settings->roll.expo, input::InputSettings{}.roll.expo);
+  EXPECT_NE(in.note.find("input.toml:1:8: mode: value outside [1, 4], got 7"), std::string::npos)
+      << in.note;
+  EXPECT_NE(in.note.find("input.toml:3:8: axes.roll.expo: value outside [0, 1], got 2"),
+            std::string::npos)
+      << in.note;
+  EXPECT_NE(in.note.find("the default input settings are used"), std::string::npos) << in.note;
+  save_shot(screen_, "input_settings_broken");
+}
+
 // The gamepad unplugged mid-flight: the banner says so, over the arena, in the critical colour.
 TEST_F(App, InputLossIsShownOverTheArena) {
   fresh_user_dirs("loss");

@@ -171,6 +171,45 @@ TEST(Settings, EveryBadValueIsReportedWithItsPosition) {
   EXPECT_NE(bad("mode = \n").find("in.toml:1:"), std::string::npos) << error;  // TOML syntax
 }
 
+// Every key of the file, each given a value it must refuse: the error names the key, its line
+// and column, and what was expected.
+TEST(Settings, EveryKeyRefusesWhatIsOutsideItsRange) {
+  struct Case {
+    std::string table, key, value, expected;
+  };
+  std::vector<Case> cases = {
+      {"", "mode", "0", "value outside [1, 4]"},
+      {"", "max_tilt_deg", "0", "value outside (0, 60]"},
+      {"", "thrust_range", "1.5", "value outside (0, 1]"},
+      {"", "input_timeout_s", "0.01", "value outside [0.02, 5]"},
+      {"", "recentre_tolerance", "0", "value outside (0, 0.5]"},
+      {"", "return_time_s", "11", "value outside [0, 10]"},
+      {"", "keyboard_ramp_s", "0.01", "value outside [0.05, 5]"},
+      {"", "gamepad", "5", "expected a string"},
+      {"haptic", "enabled", "3", "expected true or false"},
+      {"haptic", "threshold", "1.5", "value outside (0, 1]"},
+      {"haptic", "strength", "-0.5", "value outside [0, 1]"},
+  };
+  for (const char* axis : {"roll", "pitch", "thrust", "yaw"}) {
+    const std::string t = std::string("axes.") + axis;
+    cases.push_back({t, "deadzone", "0.6", "value outside [0, 0.5]"});
+    cases.push_back({t, "expo", "-0.1", "value outside [0, 1]"});
+    cases.push_back({t, "rate", "3", "value outside [0.1, 2]"});
+    cases.push_back({t, "invert", "\"yes\"", "expected true or false"});
+  }
+  for (const Case& c : cases) {
+    const std::string text =
+        (c.table.empty() ? "" : "[" + c.table + "]\n") + c.key + " = " + c.value + "\n";
+    const int line = c.table.empty() ? 1 : 2;
+    const std::string where = "in.toml:" + std::to_string(line) + ":" +
+                              std::to_string(c.key.size() + 4) + ": " +
+                              (c.table.empty() ? "" : c.table + ".") + c.key + ": " + c.expected;
+    std::string error;
+    EXPECT_FALSE(parse_settings(text, "in.toml", error)) << text;
+    EXPECT_NE(error.find(where), std::string::npos) << "wanted: " << where << "\ngot: " << error;
+  }
+}
+
 TEST(Settings, AMissingFileGivesTheDefaultsAndSavedFilesLoad) {
   const std::string dir = test::fresh_path("input", "settings").string();
   bool exists = true;
