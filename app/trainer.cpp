@@ -348,7 +348,7 @@ void Trainer::update_input() {
   if (wizard_ && gamepad_) {
     wizard_raw_ = gamepad_->raw();
     wizard_->feed(wizard_raw_);
-    ui::InputInfo::Wizard& w = input_.wizard.emplace();
+    ui::WizardView& w = input_.wizard.emplace();
     w.device = wizard_device_;
     w.step = wizard_->current();
     w.steps = wizard_->steps().size();

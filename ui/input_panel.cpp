@@ -86,7 +86,7 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   if (in.devices.empty()) {
     ImGui::TextDisabled("SDL sees no joystick. Plug one in: it shows here at once.");
   }
-  for (const InputInfo::Device& dev : in.devices) {
+  for (const InputDevice& dev : in.devices) {
     // Labels carry the device's name as their id ("Map it...##name"), so tests can find them.
     if (dev.mapped) {
       ImGui::BeginDisabled(dev.instance == in.active);
@@ -172,7 +172,7 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
 
 void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
   if (!run.input || !run.input->wizard) return;
-  const InputInfo::Wizard& w = *run.input->wizard;
+  const WizardView& w = *run.input->wizard;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, d.x - 40), 0), ImGuiCond_Always);

@@ -54,17 +54,30 @@ struct SessionChoices {
   std::string trainee;                 // the person flying
 };
 
+// A joystick SDL sees.
+struct InputDevice {
+  std::int32_t instance = -1;  // SDL's instance id
+  std::string name;
+  bool mapped = false;         // SDL has a mapping (else the wizard can make one)
+};
+
+// The mapping wizard's state for its panel (SPEC §6).
+struct WizardView {
+  std::string device;
+  std::string prompt, hint;
+  std::size_t step = 0, steps = 0;
+  bool optional = false, done = false;
+  std::vector<std::string> bindings;
+  std::string mapping;  // the SDL line once every stick is bound
+  const input::RawJoystick* raw = nullptr;
+};
+
 // A person's device flying the session (SPEC §6): for the session panel, the input settings
 // panel and the input-loss banner.
 struct InputInfo {
   std::string pilot;                 // "gamepad" | "keyboard" ("" : the pilot is no device)
   std::string device;                // the gamepad in use ("" none)
-  struct Device {
-    std::int32_t instance = -1;  // SDL's instance id
-    std::string name;
-    bool mapped = false;         // SDL has a mapping (else the wizard can make one)
-  };
-  std::vector<Device> devices;       // every joystick SDL sees
+  std::vector<InputDevice> devices;  // every joystick SDL sees
   std::int32_t active = -1;          // the instance in use
   bool connected = false;            // a gamepad is connected (the keyboard always is)
   bool waiting = false;              // Start was asked for: waiting for a gamepad
@@ -73,17 +86,7 @@ struct InputInfo {
   std::string settings_path;         // where Save writes
   std::string note;                  // the settings file is broken: what was wrong
   std::string message;               // what the last mapping did ("" none)
-  // The mapping wizard, while it runs (SPEC §6).
-  struct Wizard {
-    std::string device;
-    std::string prompt, hint;
-    std::size_t step = 0, steps = 0;
-    bool optional = false, done = false;
-    std::vector<std::string> bindings;
-    std::string mapping;  // the SDL line once every stick is bound
-    const input::RawJoystick* raw = nullptr;
-  };
-  std::optional<Wizard> wizard;
+  std::optional<WizardView> wizard;  // the mapping wizard, while it runs
 };
 
 struct RunInfo {
