@@ -10,5 +10,6 @@ int score_command(int argc, char** argv);
 int recover_command(int argc, char** argv);
 int models_command();
 int gamepad_script_command(int argc, char** argv);
+int joy_publish_command(int argc, char** argv);
 
 }  // namespace mixpilot::cli

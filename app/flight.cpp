@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -76,6 +77,29 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
   if (o.pilot == "keyboard") {
     d->keyboard = std::make_unique<input::KeyboardSource>(d->settings);
     source = d->keyboard.get();
+  } else if (o.pilot.starts_with("dds")) {
+    // Nothing leaves this machine unless the user configures DDS: without CYCLONEDDS_URI the
+    // project's loopback configuration is used.
+    if (const char* uri = std::getenv("CYCLONEDDS_URI"); !uri || !*uri)
+      setenv("CYCLONEDDS_URI", net::loopback_config_uri().c_str(), 1);
+    net::JoyPeer::Options po;
+    po.domain = o.domain;
+    po.topic = net::dds_topic(o.pilot.size() > 4 ? o.pilot.substr(4) : "joy");
+    d->peer = std::make_unique<net::JoyPeer>();
+    if (!d->peer->start(po, error)) return nullptr;
+    if (o.headless) {
+      // A headless flight starts with the peer's first sane sample (or gives up).
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (!d->peer->heard() && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!d->peer->heard()) {
+        error = "no sensor_msgs/msg/Joy on " + po.topic + " in DDS domain " +
+                std::to_string(po.domain) + " within 10 s: start the publisher (e.g. mixpilot "
+                "joy-publish --from REC.mcap --domain " + std::to_string(po.domain) + ")";
+        return nullptr;
+      }
+    }
+    source = d->peer.get();
   } else {
     if (!o.gamepad_script.empty()) {
       auto rows = input::load_script(o.gamepad_script, error);
@@ -121,7 +145,7 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
 }  // namespace
 
 bool is_device_pilot(const std::string& pilot) {
-  return pilot == "gamepad" || pilot == "keyboard";
+  return pilot == "gamepad" || pilot == "keyboard" || pilot == "dds" || pilot.starts_with("dds:");
 }
 
 input::InputSettings load_input_settings(const std::string& path, std::string& note) {
@@ -210,6 +234,46 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
     if (!check_output_path(shot, o.force, error)) return false;
   }
   return true;
+}
+
+void print_peer(const net::JoyPeer& peer) {
+  const net::JoyPeerStats s = peer.stats();
+  std::printf("  peer %s (domain %u): %llu samples taken; rejected %llu bad values, %llu bad "
+              "sizes, %llu stale, %llu of another publisher (%u publishers heard)\n",
+              peer.options().topic.c_str(), unsigned(peer.options().domain),
+              (unsigned long long)s.accepted, (unsigned long long)s.bad_value,
+              (unsigned long long)s.bad_size, (unsigned long long)s.stale,
+              (unsigned long long)s.other_publisher, s.publishers);
+  if (s.latency_samples > 0)
+    std::printf("  peer latency, publisher stamp to the control step's read: p50 %.1f ms, "
+                "p99 %.1f ms (%llu samples)\n",
+                s.latency_p50_ms, s.latency_p99_ms, (unsigned long long)s.latency_samples);
+  if (s.publishers > 1)
+    std::printf("  WARNING: %u publishers on %s; only the first one heard flew\n", s.publishers,
+                peer.options().topic.c_str());
+}
+
+std::array<double, 4> sdl_axes_for(const PilotCommandMsg& m, const input::InputSettings& settings) {
+  PilotCommand c;
+  c.roll = m.roll;
+  c.pitch = m.pitch;
+  c.rotor_speed = Eigen::Vector4d(m.rotor_speed[0], m.rotor_speed[1], m.rotor_speed[2],
+                                  m.rotor_speed[3]);
+  const input::Controls shaped =
+      input::controls_for(c, settings, models::MikroKopter().hover_speed());
+  const input::Controls raw{input::unshape(shaped.roll, settings.roll),
+                            input::unshape(shaped.pitch, settings.pitch),
+                            input::unshape(shaped.thrust, settings.thrust), 0.0};
+  const input::StickAxes s = input::unassign(raw, settings.mode);
+  return {s.left_x, -s.left_y, s.right_x, -s.right_y};
+}
+
+std::uint32_t parse_domain(const char* command, const std::string& text) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || v < 0 || v > 232)
+    usage_error(command, "--domain expects a DDS domain id from 0 to 232, got '" + text + "'");
+  return std::uint32_t(v);
 }
 
 void print_realtime(const RealtimeStats& st, double dt) {

@@ -2,6 +2,7 @@
 // One flight as the command line asks for it (`mixpilot fly`, `replay`, `demo`): the options,
 // the scenario and recording they name, and the mode made from them. Shared by the headless
 // path (app/fly.cpp) and the window (app/window.cpp).
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "input/device_pilot.hpp"
 #include "input/gamepad.hpp"
 #include "input/keyboard.hpp"
+#include "input/net/joy_peer.hpp"
 #include "input/settings.hpp"
 #include "input/virtual_gamepad.hpp"
 #include "core/modes/mode.hpp"
@@ -38,6 +40,7 @@ struct FlyOptions {
   std::string gamepad_script;      // --gamepad-script: a virtual gamepad plays it
   std::string input_settings;      // --input-settings (default: the user's input.toml)
   std::optional<input::InputSettings> input_values;  // the app's settings, instead of a file
+  std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
   const char* command = "fly";     // for messages
 };
 
@@ -51,6 +54,7 @@ struct Devices {
   std::vector<input::ScriptRow> script;
   std::shared_ptr<input::Gamepad> gamepad;  // one per process: the app's, across flights
   std::unique_ptr<input::KeyboardSource> keyboard;
+  std::unique_ptr<net::JoyPeer> peer;  // --pilot dds[:TOPIC]
   input::DevicePilot* pilot = nullptr;  // owned by the mode
 
   // The flight starts now: the script's t = 0.
@@ -108,6 +112,14 @@ Labels report_labels(const Flight& f, bool was_interrupted);
 // The summary's real-time line: deadline misses, worst start lateness, p99 and longest step,
 // and the control thread's scheduling.
 void print_realtime(const RealtimeStats& st, double dt);
+// The network pilot's line: samples taken, rejected by reason, publishers, latency.
+void print_peer(const net::JoyPeer& peer);
+// The stick positions (SDL's axes: left x, left y down, right x, right y down) that give a
+// recorded pilot command through `settings` (the inverse of the shaping; clamped at full
+// deflection): how gamepad-script and joy-publish fly a recording through a device path.
+std::array<double, 4> sdl_axes_for(const PilotCommandMsg& m, const input::InputSettings& settings);
+// --domain's value: 0-232 (DDS's domain id range); a usage error otherwise.
+std::uint32_t parse_domain(const char* command, const std::string& text);
 
 // The shortest text of `t` ("%g").
 std::string seconds_text(double t);

@@ -47,12 +47,17 @@ constexpr const char* kFlyUsage =
     "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
     "                     gamepad (headless only with --realtime) | keyboard (window) |\n"
+    "                     dds[:TOPIC] (sensor_msgs/msg/Joy from the network, default\n"
+    "                     topic joy; headless only with --realtime) |\n"
     "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
     "                     against the recording); default: the scenario's (mixed_initiative only)\n"
     "  --gamepad-script FILE.csv  with --pilot gamepad: a virtual gamepad plays the script\n"
     "                     (docs/input-settings.md) through SDL from the start of the flight\n"
     "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
     "                     user's $XDG_CONFIG_HOME/mixpilot/input.toml, docs/input-settings.md)\n"
+    "  --domain N         DDS domain of --pilot dds (0-232, default 0). DDS stays on this\n"
+    "                     machine unless CYCLONEDDS_URI names another configuration\n"
+    "                     (docs/network.md)\n"
     "  --headless         run without a window, as fast as possible (default: a window,\n"
     "                     in real time, where a display exists)\n"
     "  --realtime         with --headless: paced by the wall clock, deadline misses counted\n"
@@ -235,6 +240,7 @@ int run_fly(const FlyOptions& o) {
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
   if (realtime) print_realtime(*realtime, mode.dt());
+  if (flight->devices && flight->devices->peer) print_peer(*flight->devices->peer);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
     const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)
@@ -330,6 +336,8 @@ int fly_command(int argc, char** argv) {
       o.gamepad_script = value();
     } else if (a == "--input-settings") {
       o.input_settings = value();
+    } else if (a == "--domain") {
+      o.domain = parse_domain(o.command, value());
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
     } else if (a == "--force") {

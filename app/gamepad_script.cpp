@@ -1,6 +1,7 @@
 // mixpilot gamepad-script: a recording's pilot commands as a virtual gamepad's script, so a
 // recorded flight (an emulated pilot's, a person's) can be flown again through the real SDL
 // path with `fly --pilot gamepad --gamepad-script`.
+#include <array>
 #include <cstdio>
 #include <string>
 
@@ -102,25 +103,14 @@ int gamepad_script_command(int argc, char** argv) {
     std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
     return kExitError;
   }
-  const double hover = models::MikroKopter().hover_speed();
   std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n", in.c_str(),
                settings.mode);
   std::fprintf(f.stream(), "t,left_x,left_y,right_x,right_y\n");
   for (std::size_t k = 0; k < rec->pilot.size(); ++k) {
     const PilotCommandMsg& m = rec->pilot[k];
-    PilotCommand c;
-    c.roll = m.roll;
-    c.pitch = m.pitch;
-    c.rotor_speed = Eigen::Vector4d(m.rotor_speed[0], m.rotor_speed[1], m.rotor_speed[2],
-                                    m.rotor_speed[3]);
-    input::Controls shaped = input::controls_for(c, settings, hover);
-    const input::Controls raw{input::unshape(shaped.roll, settings.roll),
-                              input::unshape(shaped.pitch, settings.pitch),
-                              input::unshape(shaped.thrust, settings.thrust), 0.0};
-    const input::StickAxes s = input::unassign(raw, settings.mode);
-    // SDL's convention in the script: y down positive.
-    std::fprintf(f.stream(), "%.6f,%.6f,%.6f,%.6f,%.6f\n", double(m.step) * dt, s.left_x,
-                 -s.left_y, s.right_x, -s.right_y);
+    const std::array<double, 4> a = sdl_axes_for(m, settings);
+    std::fprintf(f.stream(), "%.6f,%.6f,%.6f,%.6f,%.6f\n", double(m.step) * dt, a[0], a[1], a[2],
+                 a[3]);
   }
   if (!f.commit(error)) {
     std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());

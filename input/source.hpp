@@ -15,6 +15,7 @@ struct StickReading {
   std::int64_t changed_ns = 0;  // steady clock when the input last changed
   std::int64_t alive_ns = 0;    // steady clock of the device's last sign of life
   std::uint64_t serial = 0;     // counts changes
+  std::int64_t stamp_ns = 0;    // the sender's stamp (system clock; network peers), 0 none
   bool connected = false;
 };
 

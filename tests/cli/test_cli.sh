@@ -199,5 +199,16 @@ check "recover writes the target" test -f "$work/killed.mcap"
 "$mixpilot" score "$work/killed.mcap" >"$work/killed.score" 2>&1
 check "the recovered recording replays exactly" grep -q "exact" "$work/killed.score"
 
+# A vehicle that leaves the arena is lost: the flight ends there, the summary and the report
+# say so. (A 3 s input delay: the hover command arrives too late and the vehicle falls.)
+sed 's/^input_delay = 0.0/input_delay = 3.0/' "$src/scenarios/mi_helix.toml" >"$work/falls.toml"
+"$mixpilot" fly --scenario "$work/falls.toml" --pilot novice --headless --duration 10 \
+  --report "$work/falls.json" >"$work/falls.out" 2>&1
+check "a lost flight exits 0 (a result, not an error)" test $? -eq 0
+check "... the summary says LOST" grep -q "LOST: the vehicle was lost at t = " "$work/falls.out"
+check "... the report has lost = 1" grep -q '"lost": 1,' "$work/falls.json"
+check "... and when, before the 10 s asked for" \
+  sh -c "grep -Eq '\"lost_at_s\": [0-9]\.' '$work/falls.json'"
+
 echo "$pass passed, $fails failed"
 test "$fails" -eq 0

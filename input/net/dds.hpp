@@ -1,0 +1,45 @@
+#pragma once
+// Cyclone DDS for mixpilot's network peers (SPEC §9): a participant in a domain, and the check
+// that the configuration in force keeps traffic on this machine. Cyclone reads its
+// configuration from CYCLONEDDS_URI; without one it discovers peers by multicast on every
+// interface, which tests, demos and CI must never do (assets/dds-loopback.xml).
+#include <cstdint>
+#include <string>
+
+namespace mixpilot::net {
+
+// Whether CYCLONEDDS_URI names a configuration that keeps DDS on loopback: interface `lo`,
+// multicast off, the peer 127.0.0.1. `why` says what is missing otherwise.
+[[nodiscard]] bool loopback_only(std::string& why);
+
+// The project's loopback configuration, as a CYCLONEDDS_URI value ("" when not found).
+std::string loopback_config_uri();
+
+// A domain participant; deleting it deletes every reader, writer and topic it made.
+class Participant {
+ public:
+  Participant() = default;
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  [[nodiscard]] bool open(std::uint32_t domain, std::string& error);
+  void close();
+  std::int32_t handle() const { return handle_; }  // dds_entity_t
+  std::uint32_t domain() const { return domain_; }
+
+ private:
+  std::int32_t handle_ = 0;
+  std::uint32_t domain_ = 0;
+};
+
+// "rt/joy" from "joy", "/joy" or "rt/joy" (ROS 2's topic prefix rule).
+std::string dds_topic(const std::string& ros_name);
+
+// A DDS return code's text.
+std::string dds_error(std::int32_t rc);
+
+// System-clock nanoseconds (ROS time: the stamps of ROS 2 headers).
+std::int64_t system_ns();
+
+}  // namespace mixpilot::net

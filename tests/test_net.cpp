@@ -1,0 +1,254 @@
+// Network peers over Cyclone DDS (SPEC §9), on loopback only: the ROS 2 type and topic names,
+// sensor_msgs/Joy as a pilot source mapped like a gamepad, malformed samples and a second
+// publisher rejected and counted, a silent peer as an input loss, and two processes
+// (joy-publish and fly --pilot dds) flying a recording's sticks.
+//
+// Every test refuses to run unless CYCLONEDDS_URI keeps DDS on loopback (CTest sets it to
+// assets/dds-loopback.xml), and each test process uses its own domain id.
+#include <gtest/gtest.h>
+
+#include <dds/dds.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "input/device_pilot.hpp"
+#include "input/net/dds.hpp"
+#include "input/net/joy_peer.hpp"
+#include "models/mikrokopter.hpp"
+#include "ros2_msgs.h"
+#include "temp_files.hpp"
+
+namespace mixpilot::net {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A domain of this process's own (DDS ids 0-232; 0 is the default, left to users).
+std::uint32_t my_domain() { return 1 + std::uint32_t(getpid()) % 232; }
+
+class Net : public testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!loopback_only(why)) FAIL() << "refusing to run a DDS test: " << why;
+    domain_ = my_domain();
+  }
+  template <class F>
+  static bool eventually(F done, double seconds = 5) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!done()) {
+      if (std::chrono::steady_clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return true;
+  }
+  std::uint32_t domain_ = 0;
+};
+
+TEST(NetConfig, TheLoopbackCheckRefusesWhatWouldLeaveTheMachine) {
+  const char* before = std::getenv("CYCLONEDDS_URI");
+  const std::string saved = before ? before : "";
+  std::string why;
+  unsetenv("CYCLONEDDS_URI");
+  EXPECT_FALSE(loopback_only(why));
+  EXPECT_NE(why.find("multicast"), std::string::npos) << why;
+  setenv("CYCLONEDDS_URI", "<General><AllowMulticast>false</AllowMulticast></General>", 1);
+  EXPECT_FALSE(loopback_only(why));
+  EXPECT_NE(why.find("loopback"), std::string::npos) << why;
+  setenv("CYCLONEDDS_URI",
+         "<General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces></General>", 1);
+  EXPECT_FALSE(loopback_only(why));
+  EXPECT_NE(why.find("multicast"), std::string::npos) << why;
+  setenv("CYCLONEDDS_URI", loopback_config_uri().c_str(), 1);
+  EXPECT_TRUE(loopback_only(why)) << why;
+  if (before) setenv("CYCLONEDDS_URI", saved.c_str(), 1);
+  else unsetenv("CYCLONEDDS_URI");
+}
+
+// ROS 2's names: rt/<topic>, <pkg>::msg::dds_::<Type>_.
+TEST_F(Net, TopicAndTypeNamesAreRos2s) {
+  EXPECT_EQ(dds_topic("joy"), "rt/joy");
+  EXPECT_EQ(dds_topic("/joy"), "rt/joy");
+  EXPECT_EQ(dds_topic("rt/joy"), "rt/joy");
+  Participant p;
+  std::string error;
+  ASSERT_TRUE(p.open(domain_, error)) << error;
+  const dds_entity_t t =
+      dds_create_topic(p.handle(), &sensor_msgs_msg_dds__Joy__desc, "rt/joy", nullptr, nullptr);
+  ASSERT_GT(t, 0);
+  char name[128];
+  ASSERT_GE(dds_get_type_name(t, name, sizeof name), 0);
+  EXPECT_STREQ(name, "sensor_msgs::msg::dds_::Joy_");
+  ASSERT_GE(dds_get_name(t, name, sizeof name), 0);
+  EXPECT_STREQ(name, "rt/joy");
+}
+
+// A Joy from the network drives the sticks exactly as a gamepad's axes would.
+TEST_F(Net, JoyAxesMapLikeAGamepad) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_map"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_map", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  ASSERT_TRUE(w.write({0.5f, -1.0f, 0.25f, 0.5f, -1.0f, -1.0f}, {1, 0, 1}, system_ns(), "pad", error));
+  ASSERT_TRUE(eventually([&] { return peer.heard(); }));
+  const input::StickReading& r = peer.latest();
+  EXPECT_TRUE(r.connected);
+  EXPECT_DOUBLE_EQ(r.sticks.left_x, 0.5);
+  EXPECT_DOUBLE_EQ(r.sticks.left_y, 1.0);   // SDL's y points down: −1 is up
+  EXPECT_DOUBLE_EQ(r.sticks.right_x, 0.25);
+  EXPECT_DOUBLE_EQ(r.sticks.right_y, -0.5);
+  EXPECT_EQ(r.joy.num_axes, 6);
+  EXPECT_EQ(r.joy.num_buttons, 3);
+  peer.stop();
+}
+
+// Each kind of bad sample is rejected, counted under its reason, and never reaches the sticks;
+// a second publisher is reported and not mixed in.
+TEST_F(Net, MalformedSamplesAndASecondPublisherAreRejectedAndCounted) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_bad"}, error)) << error;
+  JoyWriter w, other;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_bad", error)) << error;
+  ASSERT_TRUE(other.open(domain_, "rt/joy_bad", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0 && other.matched() > 0; }));
+  const std::vector<std::int32_t> none;
+  const auto send = [&](JoyWriter& wr, std::vector<float> axes, std::int64_t stamp,
+                        std::vector<std::int32_t> buttons = {}) {
+    ASSERT_TRUE(wr.write(axes, buttons, stamp, "pad", error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));  // one sample per take
+  };
+  const std::int64_t now = system_ns();
+  send(w, {0.1f, 0, 0.2f, 0}, now);  // good: the pilot's writer from now on
+  ASSERT_TRUE(eventually([&] { return peer.stats().accepted == 1; }));
+  send(w, {NAN, 0, 0, 0}, system_ns());
+  send(w, {0, INFINITY, 0, 0}, system_ns());
+  send(w, {0, 0, 1.5f, 0}, system_ns());
+  send(w, {0, 0, 0}, system_ns());                            // too few axes
+  send(w, std::vector<float>(9, 0.0f), system_ns());          // too many axes
+  send(w, {0, 0, 0, 0}, system_ns(), std::vector<std::int32_t>(33, 1));  // too many buttons
+  send(w, std::vector<float>(100000, 0.0f), system_ns());     // huge
+  send(w, {0, 0, 0, 0}, system_ns() - 2'000'000'000);         // 2 s old
+  send(w, {0, 0, 0, 0}, system_ns() + 2'000'000'000);         // 2 s ahead
+  send(w, {0, 0, 0, 0}, now - 1'000'000);                     // older than the last taken
+  send(other, {0.9f, 0.9f, 0.9f, 0.9f}, system_ns());         // a second publisher
+  ASSERT_TRUE(eventually([&] {
+    const JoyPeerStats s = peer.stats();
+    return s.bad_value + s.bad_size + s.stale + s.other_publisher >= 11;
+  }));
+  const JoyPeerStats s = peer.stats();
+  EXPECT_EQ(s.accepted, 1u);
+  EXPECT_EQ(s.bad_value, 3u);
+  EXPECT_EQ(s.bad_size, 4u);
+  EXPECT_EQ(s.stale, 3u);
+  EXPECT_EQ(s.other_publisher, 1u);
+  EXPECT_EQ(s.publishers, 2u);
+  const input::StickReading& r = peer.latest();
+  EXPECT_FLOAT_EQ(float(r.sticks.left_x), 0.1f);  // still the one good sample
+  EXPECT_FLOAT_EQ(float(r.sticks.right_x), 0.2f);
+  peer.stop();
+}
+
+// A peer that stops publishing is an input loss: the planner gets the authority at once.
+TEST_F(Net, ASilentPeerIsAnInputLoss) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_silent"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_silent", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  input::InputSettings settings;
+  input::DevicePilot pilot(peer, settings, 0.015, models::MikroKopter().hover_speed());
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(16);
+  PilotCommand c;
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_TRUE(w.write({0, 0, 0.3f, 0}, {}, system_ns(), "pad", error));
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+  }
+  ASSERT_TRUE(pilot.command(0, 0, x, c));
+  EXPECT_EQ(c.input, InputState::ok);
+  EXPECT_GT(c.roll, 0.0);
+  std::this_thread::sleep_for(std::chrono::duration<double>(settings.input_timeout_s + 0.05));
+  ASSERT_TRUE(pilot.command(1, 0, x, c));
+  EXPECT_EQ(c.input, InputState::lost);
+  EXPECT_EQ(c.authority, 0.0);
+  peer.stop();
+}
+
+// --- Two processes ----------------------------------------------------------------------
+
+const std::string kSrc = MIXPILOT_SOURCE_DIR;
+const std::string kMixpilot = MIXPILOT_BINARY;
+
+int run(const std::string& args, const fs::path& dir, const std::string& out = "out.txt") {
+  const std::string cmd = "env XDG_CONFIG_HOME='" + (dir / "config").string() + "' '" +
+                          kMixpilot + "' " + args + " >'" + (dir / out).string() + "' 2>&1";
+  const int rc = std::system(cmd.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::map<std::string, double> numbers(const std::string& json) {
+  std::map<std::string, double> out;
+  const std::regex re("\"([a-z_0-9]+)\": (-?[0-9.eE+-]+)");
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
+    out[(*it)[1]] = std::stod((*it)[2]);
+  return out;
+}
+
+// joy-publish sends the novice's sticks from its recording; fly --pilot dds flies them in real
+// time in another process. The score is the local replay's within what the timing explains
+// (which step each sample lands in), and the end-to-end latency is reported.
+TEST_F(Net, TwoProcessesFlyARecordingsSticksOverDds) {
+  const fs::path dir = test::fresh_path("net", "two_processes");
+  fs::create_directories(dir);
+  const fs::path nov = dir / "novice.mcap", local = dir / "local.json", remote = dir / "dds.json";
+  ASSERT_EQ(run("fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot novice --headless "
+                "--duration 12 --record " + nov.string() + " --report " + local.string(), dir), 0)
+      << read_file(dir / "out.txt");
+  const std::string d = std::to_string(domain_);
+  const std::string publish = "env XDG_CONFIG_HOME='" + (dir / "config").string() + "' '" +
+                              kMixpilot + "' joy-publish --from " + nov.string() + " --domain " +
+                              d + " --topic joy_two --wait 20 >'" + (dir / "pub.txt").string() +
+                              "' 2>&1 &";
+  ASSERT_EQ(std::system(publish.c_str()), 0);
+  ASSERT_EQ(run("fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot dds:joy_two "
+                "--domain " + d + " --headless --realtime --duration 11.5 --report " +
+                remote.string(), dir, "fly.txt"), 0)
+      << read_file(dir / "fly.txt") << read_file(dir / "pub.txt");
+  const std::string out = read_file(dir / "fly.txt");
+  std::printf("%s", out.c_str());
+  EXPECT_NE(out.find("0 bad values, 0 bad sizes, 0 stale, 0 of another publisher"),
+            std::string::npos);
+  EXPECT_NE(out.find("peer latency"), std::string::npos);
+  const auto a = numbers(read_file(local)), b = numbers(read_file(remote));
+  std::printf("local skill %.2f, over DDS %.2f; mean λ %.4f vs %.4f; max deviation %.4f vs %.4f m\n",
+              a.at("skill"), b.at("skill"), a.at("mean_lambda"), b.at("mean_lambda"),
+              a.at("max_deviation_m"), b.at("max_deviation_m"));
+  EXPECT_EQ(b.at("collisions"), 0.0);
+  EXPECT_EQ(b.at("time_in_ball"), 1.0);
+  // The samples land up to a step apart from the recorded ones and the first steps fly before
+  // the stream lines up: close, not equal.
+  EXPECT_NEAR(b.at("skill"), a.at("skill"), 5.0);
+  EXPECT_NEAR(b.at("mean_lambda"), a.at("mean_lambda"), 0.05);
+}
+
+}  // namespace
+}  // namespace mixpilot::net
