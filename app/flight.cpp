@@ -78,10 +78,7 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
     d->keyboard = std::make_unique<input::KeyboardSource>(d->settings);
     source = d->keyboard.get();
   } else if (o.pilot.starts_with("dds")) {
-    // Nothing leaves this machine unless the user configures DDS: without CYCLONEDDS_URI the
-    // project's loopback configuration is used.
-    if (const char* uri = std::getenv("CYCLONEDDS_URI"); !uri || !*uri)
-      setenv("CYCLONEDDS_URI", net::loopback_config_uri().c_str(), 1);
+    net::use_loopback_unless_configured();
     net::JoyPeer::Options po;
     po.domain = o.domain;
     po.topic = net::dds_topic(o.pilot.size() > 4 ? o.pilot.substr(4) : "joy");

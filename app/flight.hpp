@@ -41,6 +41,7 @@ struct FlyOptions {
   std::string input_settings;      // --input-settings (default: the user's input.toml)
   std::optional<input::InputSettings> input_values;  // the app's settings, instead of a file
   std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
+  bool publish = false;            // --publish: telemetry out over DDS
   const char* command = "fly";     // for messages
 };
 

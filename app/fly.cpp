@@ -16,6 +16,7 @@
 #include "app/trainer.hpp"
 #include "app/window.hpp"
 #include "core/runtime/realtime_runner.hpp"
+#include "input/net/telemetry_publisher.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
@@ -55,9 +56,11 @@ constexpr const char* kFlyUsage =
     "                     (docs/input-settings.md) through SDL from the start of the flight\n"
     "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
     "                     user's $XDG_CONFIG_HOME/mixpilot/input.toml, docs/input-settings.md)\n"
-    "  --domain N         DDS domain of --pilot dds (0-232, default 0). DDS stays on this\n"
-    "                     machine unless CYCLONEDDS_URI names another configuration\n"
-    "                     (docs/network.md)\n"
+    "  --publish          publish the telemetry over DDS at the control rate (ROS 2 types:\n"
+    "                     rt/mixpilot/pose, lambda, predicted_path, reference_path)\n"
+    "  --domain N         DDS domain of --pilot dds and --publish (0-232, default 0). DDS\n"
+    "                     stays on this machine unless CYCLONEDDS_URI names another\n"
+    "                     configuration (docs/network.md)\n"
     "  --headless         run without a window, as fast as possible (default: a window,\n"
     "                     in real time, where a display exists)\n"
     "  --realtime         with --headless: paced by the wall clock, deadline misses counted\n"
@@ -197,6 +200,17 @@ int run_fly(const FlyOptions& o) {
     session.add_sink(&*check);
   }
 
+  std::optional<net::TelemetryPublisher> publisher;
+  if (o.publish) {
+    net::use_loopback_unless_configured();
+    publisher.emplace();
+    if (!publisher->start(o.domain, mode.telemetry(), error)) {
+      std::fprintf(stderr, "mixpilot %s: --publish: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+    session.add_sink(&*publisher);
+  }
+
   std::optional<HapticSink> haptic;
   if (flight->devices) {
     haptic.emplace(*flight->devices);
@@ -241,6 +255,12 @@ int run_fly(const FlyOptions& o) {
               flown / std::max(wall, 1e-9));
   if (realtime) print_realtime(*realtime, mode.dt());
   if (flight->devices && flight->devices->peer) print_peer(*flight->devices->peer);
+  if (publisher) {
+    publisher->stop();
+    std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
+                (unsigned long long)publisher->published(), unsigned(o.domain),
+                (unsigned long long)publisher->dropped());
+  }
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
     const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)
@@ -336,6 +356,8 @@ int fly_command(int argc, char** argv) {
       o.gamepad_script = value();
     } else if (a == "--input-settings") {
       o.input_settings = value();
+    } else if (a == "--publish") {
+      o.publish = true;
     } else if (a == "--domain") {
       o.domain = parse_domain(o.command, value());
     } else if (a == "--allow-mismatch") {

@@ -112,8 +112,7 @@ int joy_publish_command(int argc, char** argv) {
     }
   }
 
-  if (const char* uri = std::getenv("CYCLONEDDS_URI"); !uri || !*uri)
-    setenv("CYCLONEDDS_URI", net::loopback_config_uri().c_str(), 1);
+  net::use_loopback_unless_configured();
   net::JoyWriter writer;
   const std::string dds_name = net::dds_topic(topic);
   if (!writer.open(domain, dds_name, error)) {

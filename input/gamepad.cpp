@@ -91,6 +91,10 @@ bool Gamepad::open_device(std::int32_t wanted) {
   if (pick < 0) return false;
   SDL_GameController* gc = SDL_GameControllerOpen(pick);
   if (!gc) return false;
+  if (!SDL_GameControllerGetAttached(gc)) {  // a device SDL still lists but that is gone
+    SDL_GameControllerClose(gc);
+    return false;
+  }
   controller_ = gc;
   instance_ = SDL_JoystickInstanceID(SDL_GameControllerGetJoystick(gc));
   const char* n = SDL_GameControllerName(gc);
@@ -220,6 +224,8 @@ void Gamepad::run() {
 
     const std::int64_t now = steady_ns();
     reading_.alive_ns = now;
+    // Gone before SDL's removal event arrives: lost at once, not a poll of zeros later.
+    if (controller_ && !SDL_GameControllerGetAttached(as_controller(controller_))) close_device();
     if (SDL_GameController* gc = as_controller(controller_)) {
       JoyInput j;
       j.num_axes = SDL_CONTROLLER_AXIS_MAX;  // LX, LY, RX, RY, LT, RT (SDL: y down positive)

@@ -250,5 +250,53 @@ TEST_F(Net, TwoProcessesFlyARecordingsSticksOverDds) {
   EXPECT_NEAR(b.at("mean_lambda"), a.at("mean_lambda"), 0.05);
 }
 
+// fly --publish in one process; an independent subscriber (tests/net/dds_echo.c: C, its own
+// types from the same IDL, none of mixpilot's code) in another sees the four topics with ROS 2's
+// type names and plausible values.
+TEST_F(Net, AnIndependentSubscriberReceivesTheTelemetry) {
+  const fs::path dir = test::fresh_path("net", "telemetry");
+  fs::create_directories(dir);
+  const std::string d = std::to_string(domain_);
+  const std::string echo = std::string("'") + DDS_ECHO + "' " + d + " 6 >'" +
+                           (dir / "echo.txt").string() + "' 2>&1 &";
+  ASSERT_EQ(std::system(echo.c_str()), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the subscriber is up
+  ASSERT_EQ(run("fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot novice --headless "
+                "--realtime --duration 3 --publish --domain " + d, dir, "fly.txt"), 0)
+      << read_file(dir / "fly.txt");
+  EXPECT_NE(read_file(dir / "fly.txt").find("published 200 steps on rt/mixpilot/* (domain " + d +
+                                            "; 0 dropped)"),
+            std::string::npos)
+      << read_file(dir / "fly.txt");
+  std::this_thread::sleep_for(std::chrono::seconds(4));  // the subscriber's 6 s are over
+  const std::string out = read_file(dir / "echo.txt");
+  std::printf("%s", out.c_str());
+  EXPECT_NE(out.find("pose type geometry_msgs::msg::dds_::PoseStamped_"), std::string::npos);
+  EXPECT_NE(out.find("lambda type std_msgs::msg::dds_::Float64_"), std::string::npos);
+  EXPECT_NE(out.find("predicted_path type nav_msgs::msg::dds_::Path_"), std::string::npos);
+  EXPECT_NE(out.find("reference_path type nav_msgs::msg::dds_::Path_"), std::string::npos);
+  // Counts (best effort on loopback: nearly all of the 200 steps) and values: inside the
+  // arena, a unit quaternion, λ in (0, 1), paths of N + 1 = 51 nodes (mi_helix: N = 50).
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(
+      R"(pose (\d+) samples, last position (\S+) (\S+) (\S+), quaternion (\S+) (\S+) (\S+) (\S+))")))
+      << out;
+  EXPECT_GE(std::stoi(m[1]), 190);
+  const double z = std::stod(m[4]);
+  EXPECT_GT(z, 0.0);
+  EXPECT_LT(z, 3.0);
+  double qn = 0;
+  for (int i = 5; i <= 8; ++i) qn += std::stod(m[i]) * std::stod(m[i]);
+  EXPECT_NEAR(qn, 1.0, 1e-3);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(lambda (\d+) samples, last (\S+))"))) << out;
+  EXPECT_GE(std::stoi(m[1]), 190);
+  EXPECT_GT(std::stod(m[2]), 0.0);
+  EXPECT_LT(std::stod(m[2]), 1.0);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(predicted_path (\d+) samples, last (\d+) poses)")))
+      << out;
+  EXPECT_GE(std::stoi(m[1]), 190);
+  EXPECT_EQ(std::stoi(m[2]), 51);
+}
+
 }  // namespace
 }  // namespace mixpilot::net

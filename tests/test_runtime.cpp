@@ -116,20 +116,50 @@ TEST(RealtimeRunner, PauseStopsStepsAndResumeGoesOn) {
   EXPECT_FALSE(mode->finished());  // stopped early: the run was cut at the next step
 }
 
+// A mode whose step costs nothing but what its sink makes it wait: the runner's timing rules
+// tested apart from the solver's speed (which a sanitizer build on a loaded machine can make
+// longer than a period by itself).
+class IdleMode final : public Mode {
+ public:
+  explicit IdleMode(std::int64_t steps) : steps_(steps) {}
+  ModeKind kind() const override { return ModeKind::mixed_initiative; }
+  const std::string& scenario_name() const override { return name_; }
+  double dt() const override { return 0.015; }
+  std::int64_t steps_total() const override { return steps_; }
+  std::int64_t steps_done() const override { return done_; }
+  bool step() override {
+    if (done_ >= steps_) return false;
+    telemetry_.step = done_;
+    telemetry_.t = double(done_) * dt();
+    ++done_;
+    return true;
+  }
+  bool finished() const override { return done_ >= steps_; }
+  bool lost() const override { return false; }
+  double lost_at() const override { return -1.0; }
+  const Telemetry& telemetry() const override { return telemetry_; }
+  Metrics metrics() const override { return {}; }
+  std::string summary() const override { return ""; }
+  void set_deadline_us(double) override {}
+
+ private:
+  std::int64_t steps_, done_ = 0;
+  std::string name_ = "idle";
+  Telemetry telemetry_;
+};
+
 // A step that ends after its period is a deadline miss, counted once: the schedule restarts
 // from its end, so the steps after it are on time again (were it kept, the six steps due during
 // the 100 ms overrun would all end late). Steps that take part of the period are not misses, and
-// the p99 step time reflects them, not the one outlier. The ordinary steps are kept light so a
-// sanitizer build on a loaded machine stays far inside the period; a few stray misses are allowed.
+// the p99 step time reflects them, not the one outlier.
 TEST(RealtimeRunner, ADeadlineMissIsAStepThatEndsAfterItsPeriod) {
-  auto mode = short_flight(3.0);  // 200 steps of 15 ms
-  ASSERT_TRUE(mode);
+  IdleMode mode(200);  // 3 s of 15 ms steps
   struct Slow : TelemetrySink {
     void on_sample(const Telemetry& s) override {
-      std::this_thread::sleep_for(std::chrono::milliseconds(s.step == 50 ? 100 : 1));
+      std::this_thread::sleep_for(std::chrono::milliseconds(s.step == 50 ? 100 : 4));
     }
   } slow;
-  Session session(*mode);
+  Session session(mode);
   session.add_sink(&slow);
   RealtimeRunner runner(session, 1024);
   runner.start();
@@ -138,9 +168,9 @@ TEST(RealtimeRunner, ADeadlineMissIsAStepThatEndsAfterItsPeriod) {
   const RealtimeStats st = runner.stats();
   EXPECT_EQ(st.steps, 200);
   EXPECT_GE(st.deadline_misses, 1);
-  EXPECT_LE(st.deadline_misses, 3);
+  EXPECT_LE(st.deadline_misses, 3);  // the outlier (and at most two strays of a loaded machine)
   EXPECT_GE(st.worst_step_us, 100000.0);
-  EXPECT_GE(st.p99_step_us, 1000.0);
+  EXPECT_GE(st.p99_step_us, 4000.0);
   EXPECT_LT(st.p99_step_us, 15000.0);
 }
 

@@ -70,6 +70,11 @@ std::string loopback_config_uri() {
   return "file://<mixpilot>/assets/dds-loopback.xml";
 }
 
+void use_loopback_unless_configured() {
+  if (const char* uri = std::getenv("CYCLONEDDS_URI"); !uri || !*uri)
+    setenv("CYCLONEDDS_URI", loopback_config_uri().c_str(), 1);
+}
+
 Participant::~Participant() { close(); }
 
 bool Participant::open(std::uint32_t domain, std::string& error) {

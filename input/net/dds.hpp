@@ -12,8 +12,12 @@ namespace mixpilot::net {
 // multicast off, the peer 127.0.0.1. `why` says what is missing otherwise.
 [[nodiscard]] bool loopback_only(std::string& why);
 
-// The project's loopback configuration, as a CYCLONEDDS_URI value ("" when not found).
+// The project's loopback configuration, as a CYCLONEDDS_URI value.
 std::string loopback_config_uri();
+
+// Nothing leaves this machine unless the user configures DDS: without CYCLONEDDS_URI, sets it
+// to the loopback configuration (before the first participant is created).
+void use_loopback_unless_configured();
 
 // A domain participant; deleting it deletes every reader, writer and topic it made.
 class Participant {
