@@ -1,15 +1,11 @@
 #include "input/mapping_wizard.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
-#include <sstream>
 
-#include "core/recording/output_file.hpp"
 #include "input/mapping.hpp"
+#include "input/settings.hpp"
 
 namespace mixpilot::input {
 
@@ -200,21 +196,7 @@ bool save_mapping(const std::string& path, const std::string& line, std::string&
     while (std::getline(in, l))
       if (!l.starts_with(guid + ",")) kept += l + "\n";
   }
-  std::error_code ec;
-  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
-  if (ec) {
-    error = path + ": cannot create its folder (" + ec.message() + ")";
-    return false;
-  }
-  OutputFile f;
-  if (!f.open(path, /*overwrite=*/true, error)) return false;
-  const std::string text = kept + line + "\n";
-  if (std::fwrite(text.data(), 1, text.size(), f.stream()) != text.size()) {
-    error = path + ": cannot write (" + std::strerror(errno) + ")";
-    f.discard();
-    return false;
-  }
-  return f.commit(error);
+  return save_user_file(path, kept + line + "\n", error);
 }
 
 }  // namespace mixpilot::input

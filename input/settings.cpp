@@ -133,7 +133,7 @@ std::string to_toml(const InputSettings& s) {
   return out;
 }
 
-bool save_settings(const std::string& path, const InputSettings& s, std::string& error) {
+bool save_user_file(const std::string& path, const std::string& text, std::string& error) {
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (ec) {
@@ -142,13 +142,16 @@ bool save_settings(const std::string& path, const InputSettings& s, std::string&
   }
   OutputFile f;
   if (!f.open(path, /*overwrite=*/true, error)) return false;
-  const std::string text = to_toml(s);
   if (std::fwrite(text.data(), 1, text.size(), f.stream()) != text.size()) {
     error = path + ": cannot write (" + std::strerror(errno) + ")";
     f.discard();
     return false;
   }
   return f.commit(error);
+}
+
+bool save_settings(const std::string& path, const InputSettings& s, std::string& error) {
+  return save_user_file(path, to_toml(s), error);
 }
 
 std::string config_dir() {

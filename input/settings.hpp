@@ -48,6 +48,10 @@ struct InputSettings {
 // TOML text that parse_settings() reads back to `s`.
 std::string to_toml(const InputSettings& s);
 // Writes `s` to `path` (a temporary file renamed over it, so a crash never leaves half a file).
+// Replaces the user's file at `path` with `text`, atomically (a temporary beside it, then a
+// rename), creating its folder when missing. The user's own config files only.
+[[nodiscard]] bool save_user_file(const std::string& path, const std::string& text,
+                                  std::string& error);
 [[nodiscard]] bool save_settings(const std::string& path, const InputSettings& s,
                                  std::string& error);
 

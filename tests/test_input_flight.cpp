@@ -26,6 +26,7 @@
 #include "input/gamepad.hpp"
 #include "input/virtual_gamepad.hpp"
 #include "models/mikrokopter.hpp"
+#include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot {
@@ -35,30 +36,11 @@ namespace fs = std::filesystem;
 const std::string kSrc = MIXPILOT_SOURCE_DIR;
 const std::string kMixpilot = MIXPILOT_BINARY;
 
-// Runs a mixpilot command line with the user's folders in `home` (no user settings leak in).
 int run(const std::string& args, const fs::path& home) {
-  const std::string cmd = "env XDG_CONFIG_HOME='" + (home / "config").string() +
-                          "' XDG_DATA_HOME='" + (home / "data").string() + "' '" + kMixpilot +
-                          "' " + args + " >'" + (home / "out.txt").string() + "' 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+  return test::run_mixpilot(kMixpilot, args, home);
 }
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// The numbers of a flat JSON object ("key": number).
-std::map<std::string, double> numbers(const std::string& json) {
-  std::map<std::string, double> out;
-  const std::regex re("\"([a-z_0-9]+)\": (-?[0-9.eE+-]+)");
-  for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
-    out[(*it)[1]] = std::stod((*it)[2]);
-  return out;
-}
+using test::numbers;
+using test::read_file;
 
 double channel(const ModeChannelsMsg& m, const std::string& name) {
   for (std::size_t i = 0; i < m.names.size(); ++i)

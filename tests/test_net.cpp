@@ -25,6 +25,7 @@
 #include "input/net/joy_peer.hpp"
 #include "models/mikrokopter.hpp"
 #include "ros2_msgs.h"
+#include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot::net {
@@ -192,26 +193,10 @@ const std::string kSrc = MIXPILOT_SOURCE_DIR;
 const std::string kMixpilot = MIXPILOT_BINARY;
 
 int run(const std::string& args, const fs::path& dir, const std::string& out = "out.txt") {
-  const std::string cmd = "env XDG_CONFIG_HOME='" + (dir / "config").string() + "' '" +
-                          kMixpilot + "' " + args + " >'" + (dir / out).string() + "' 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+  return test::run_mixpilot(kMixpilot, args, dir, out);
 }
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::map<std::string, double> numbers(const std::string& json) {
-  std::map<std::string, double> out;
-  const std::regex re("\"([a-z_0-9]+)\": (-?[0-9.eE+-]+)");
-  for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
-    out[(*it)[1]] = std::stod((*it)[2]);
-  return out;
-}
+using test::numbers;
+using test::read_file;
 
 // joy-publish sends the novice's sticks from its recording; fly --pilot dds flies them in real
 // time in another process. The score is the local replay's within what the timing explains
