@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include "models/attitude.hpp"
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
 
@@ -45,17 +46,7 @@ void line(ImDrawList* dl, const View& v, const Eigen::Vector3d& a, const Eigen::
   if (v.project(a, pa) && v.project(b, pb)) dl->AddLine(pa, pb, c, w);
 }
 
-// Rotation body → world of the quadrotor states: Euler ZYX (16 states, MikroKopter) or a unit
-// quaternion (qw, qx, qy, qz) (13 states, Crazyflie); SPEC §2, §3.
-Eigen::Matrix3d attitude(const Eigen::VectorXd& x) {
-  if (x.size() >= 16)
-    return (Eigen::AngleAxisd(x(5), Eigen::Vector3d::UnitZ()) *
-            Eigen::AngleAxisd(x(4), Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(x(3), Eigen::Vector3d::UnitX()))
-        .toRotationMatrix();
-  if (x.size() >= 7) return Eigen::Quaterniond(x(3), x(4), x(5), x(6)).normalized().toRotationMatrix();
-  return Eigen::Matrix3d::Identity();
-}
+Eigen::Matrix3d attitude(const Eigen::VectorXd& x) { return models::attitude(x).toRotationMatrix(); }
 
 View make_view(const Scene& sc, const Telemetry& s, UiState& ui, ImVec2 min, ImVec2 max) {
   const Eigen::Vector3d centre = 0.5 * (sc.arena_min + sc.arena_max);
