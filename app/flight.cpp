@@ -57,19 +57,10 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
   auto d = std::make_shared<Devices>();
   if (o.input_values) {
     d->settings = *o.input_values;
-  } else if (!o.input_settings.empty()) {
-    bool exists = false;
-    const auto s = input::load_settings(o.input_settings, exists, error);
-    if (!s) return nullptr;
-    if (!exists) {
-      error = o.input_settings + ": no such file (--input-settings)";
-      return nullptr;
-    }
-    d->settings = *s;
   } else {
-    d->settings = load_input_settings("", d->settings_note);
-    if (!d->settings_note.empty())
-      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, d->settings_note.c_str());
+    const auto s = command_input_settings(o.command, o.input_settings, error);
+    if (!s) return nullptr;
+    d->settings = *s;
   }
   const std::optional<Scenario> sc = parse_scenario(scenario_text, scenario_source, error);
   if (!sc) return nullptr;
@@ -248,6 +239,38 @@ void print_peer(const net::JoyPeer& peer) {
   if (s.publishers > 1)
     std::printf("  WARNING: %u publishers on %s; only the first one heard flew\n", s.publishers,
                 peer.options().topic.c_str());
+}
+
+std::optional<input::InputSettings> command_input_settings(const char* command,
+                                                           const std::string& path,
+                                                           std::string& error) {
+  if (path.empty()) {
+    std::string note;
+    const input::InputSettings s = load_input_settings("", note);
+    if (!note.empty()) std::fprintf(stderr, "mixpilot %s: %s\n", command, note.c_str());
+    return s;
+  }
+  bool exists = false;
+  const auto s = input::load_settings(path, exists, error);
+  if (s && !exists) {
+    error = path + ": no such file (--input-settings)";
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<PilotRecording> read_pilot_recording(const std::string& path, std::string& error) {
+  auto rec = read_recording(path, error);
+  if (!rec) return std::nullopt;
+  if (rec->pilot.empty()) {
+    error = path + " holds no pilot commands (a mixed_initiative recording has them)";
+    return std::nullopt;
+  }
+  const std::string* text = embedded_scenario(*rec, path, error);
+  auto scenario =
+      text ? parse_scenario(*text, embedded_scenario_source(*rec, path), error) : std::nullopt;
+  if (!scenario) return std::nullopt;
+  return PilotRecording{std::move(*rec), std::move(*scenario)};
 }
 
 std::array<double, 4> sdl_axes_for(const PilotCommandMsg& m, const input::InputSettings& settings) {

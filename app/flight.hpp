@@ -20,6 +20,7 @@
 #include "core/modes/report.hpp"
 #include "core/recording/recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
+#include "core/scenario/scenario.hpp"
 
 namespace mixpilot::cli {
 
@@ -50,7 +51,6 @@ struct FlyOptions {
 // that plays the script from the start of the flight.
 struct Devices {
   input::InputSettings settings;
-  std::string settings_note;  // a broken settings file: what was wrong (defaults are used)
   std::unique_ptr<input::VirtualGamepad> virtual_pad;
   std::vector<input::ScriptRow> script;
   std::shared_ptr<input::Gamepad> gamepad;  // one per process: the app's, across flights
@@ -115,6 +115,21 @@ Labels report_labels(const Flight& f, bool was_interrupted);
 void print_realtime(const RealtimeStats& st, double dt);
 // The network pilot's line: samples taken, rejected by reason, publishers, latency.
 void print_peer(const net::JoyPeer& peer);
+// The input settings a command flies with: --input-settings FILE (`path`), which must exist and
+// be valid (nullopt with `error`), else the user's file, whose errors give the defaults and a
+// note on stderr ("mixpilot <command>: ...").
+std::optional<input::InputSettings> command_input_settings(const char* command,
+                                                           const std::string& path,
+                                                           std::string& error);
+
+// A mixed-initiative recording and its embedded scenario (gamepad-script, joy-publish);
+// nullopt with the reason.
+struct PilotRecording {
+  RecordingContents recording;
+  Scenario scenario;
+};
+std::optional<PilotRecording> read_pilot_recording(const std::string& path, std::string& error);
+
 // The stick positions (SDL's axes: left x, left y down, right x, right y down) that give a
 // recorded pilot command through `settings` (the inverse of the shaping; clamped at full
 // deflection): how gamepad-script and joy-publish fly a recording through a device path.

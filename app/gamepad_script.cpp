@@ -65,38 +65,14 @@ int gamepad_script_command(int argc, char** argv) {
   if (in.empty()) usage_error("gamepad-script", "which recording? (mixpilot gamepad-script REC.mcap -o OUT.csv)");
   if (out.empty()) usage_error("gamepad-script", "-o OUT.csv is required");
   std::string error;
-  input::InputSettings settings;
-  if (!settings_path.empty()) {
-    bool exists = false;
-    const auto s = input::load_settings(settings_path, exists, error);
-    if (!s || !exists) {
-      std::fprintf(stderr, "mixpilot gamepad-script: %s\n",
-                   s ? (settings_path + ": no such file").c_str() : error.c_str());
-      return kExitError;
-    }
-    settings = *s;
-  } else {
-    std::string note;
-    settings = load_input_settings("", note);
-    if (!note.empty()) std::fprintf(stderr, "mixpilot gamepad-script: %s\n", note.c_str());
-  }
-  const auto rec = read_recording(in, error);
-  if (!rec) {
+  const auto settings = command_input_settings("gamepad-script", settings_path, error);
+  const auto pr = settings ? read_pilot_recording(in, error) : std::nullopt;
+  if (!pr) {
     std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
     return kExitError;
   }
-  if (rec->pilot.empty()) {
-    std::fprintf(stderr, "mixpilot gamepad-script: %s holds no pilot commands (a mixed_initiative "
-                 "recording has them)\n", in.c_str());
-    return kExitError;
-  }
-  const std::string* text = embedded_scenario(*rec, in, error);
-  const auto scenario =
-      text ? parse_scenario(*text, embedded_scenario_source(*rec, in), error) : std::nullopt;
-  if (!scenario) {
-    std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
-    return kExitError;
-  }
+  const RecordingContents* rec = &pr->recording;
+  const Scenario* scenario = &pr->scenario;
   const double dt = scenario->controller.dt;
   OutputFile f;
   if (!f.open(out, force, error)) {
@@ -104,11 +80,11 @@ int gamepad_script_command(int argc, char** argv) {
     return kExitError;
   }
   std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n", in.c_str(),
-               settings.mode);
+               settings->mode);
   std::fprintf(f.stream(), "t,left_x,left_y,right_x,right_y\n");
   for (std::size_t k = 0; k < rec->pilot.size(); ++k) {
     const PilotCommandMsg& m = rec->pilot[k];
-    const std::array<double, 4> a = sdl_axes_for(m, settings);
+    const std::array<double, 4> a = sdl_axes_for(m, *settings);
     std::fprintf(f.stream(), "%.6f,%.6f,%.6f,%.6f,%.6f\n", double(m.step) * dt, a[0], a[1], a[2],
                  a[3]);
   }

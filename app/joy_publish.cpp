@@ -76,26 +76,14 @@ int joy_publish_command(int argc, char** argv) {
   }
   if (from.empty()) usage_error("joy-publish", "--from REC.mcap is required");
   std::string error;
-  const auto rec = read_recording(from, error);
-  if (!rec) {
+  const auto settings = command_input_settings("joy-publish", settings_path, error);
+  const auto pr = settings ? read_pilot_recording(from, error) : std::nullopt;
+  if (!pr) {
     std::fprintf(stderr, "mixpilot joy-publish: %s\n", error.c_str());
     return kExitError;
   }
-  if (rec->pilot.empty()) {
-    std::fprintf(stderr, "mixpilot joy-publish: %s holds no pilot commands (a mixed_initiative "
-                 "recording has them)\n", from.c_str());
-    return kExitError;
-  }
-  const std::string* text = embedded_scenario(*rec, from, error);
-  const auto scenario =
-      text ? parse_scenario(*text, embedded_scenario_source(*rec, from), error) : std::nullopt;
-  if (!scenario) {
-    std::fprintf(stderr, "mixpilot joy-publish: %s\n", error.c_str());
-    return kExitError;
-  }
-  std::string note;
-  const input::InputSettings settings = load_input_settings(settings_path, note);
-  if (!note.empty()) std::fprintf(stderr, "mixpilot joy-publish: %s\n", note.c_str());
+  const RecordingContents* rec = &pr->recording;
+  const Scenario* scenario = &pr->scenario;
   // The messages, all made before the first is sent.
   const bool recorded = rec->joy.size() == rec->pilot.size() && !rec->joy.empty() &&
                         rec->joy.front().axes.size() >= 4;
@@ -106,7 +94,7 @@ int joy_publish_command(int argc, char** argv) {
       axes[k] = rec->joy[k].axes;
       buttons[k] = rec->joy[k].buttons;
     } else {
-      const auto a = sdl_axes_for(rec->pilot[k], settings);
+      const auto a = sdl_axes_for(rec->pilot[k], *settings);
       axes[k] = {float(a[0]), float(a[1]), float(a[2]), float(a[3]), -1.0f, -1.0f};
       buttons[k].assign(11, 0);
     }

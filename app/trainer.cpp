@@ -328,9 +328,12 @@ void Trainer::update_input() {
     input_.device = "keyboard";
   }
   // The settings panel lists SDL's joysticks, whatever flies.
-  if (!gamepad_ && ui_.show_settings) {
+  if (!gamepad_ && ui_.show_settings && !gamepad_failed_) {
     std::string error;
-    if (!gamepad(error)) input_.message = error;
+    if (!gamepad(error)) {  // said once; SDL is not asked again every frame
+      input_.message = error;
+      gamepad_failed_ = true;
+    }
   }
   if (gamepad_) {
     if (!d || !d->keyboard) {

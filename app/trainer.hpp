@@ -98,6 +98,7 @@ class Trainer {
   ui::RunInfo run_;
   int status_ = 0;
   std::shared_ptr<input::Gamepad> gamepad_;  // started when a flight first needs it
+  bool gamepad_failed_ = false;              // SDL could not start its gamepad support
   input::InputSettings input_settings_;      // what the next device flight uses
   std::string input_settings_path_;
   ui::InputInfo input_;
