@@ -11,5 +11,6 @@ int recover_command(int argc, char** argv);
 int models_command();
 int gamepad_script_command(int argc, char** argv);
 int joy_publish_command(int argc, char** argv);
+int vehicle_command(int argc, char** argv);
 
 }  // namespace mixpilot::cli

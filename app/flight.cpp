@@ -13,6 +13,7 @@
 #include "core/recording/output_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/mapping.hpp"
+#include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 
 namespace mixpilot::cli {
@@ -153,6 +154,42 @@ void Devices::cue(double lambda) const {
   if (gamepad) gamepad->set_rumble(input::rumble_intensity(lambda, settings.haptic));
 }
 
+// --vehicle dds: the link to `mixpilot vehicle`, once the vehicle has been heard.
+bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
+  net::RemoteVehicle::Options vo;
+  vo.domain = o.domain;
+  const ModeKind kind = f.mode->kind();
+  if (kind == ModeKind::crazyflie_tracking) {
+    vo.nx = models::Crazyflie::nx;
+  } else if (kind == ModeKind::mixed_initiative) {
+    vo.nx = models::MikroKopter::nx;
+  } else {
+    error = std::string("--vehicle dds: mode ") + to_string(kind) +
+            " has no remote vehicle (crazyflie_tracking and mixed_initiative have)";
+    return false;
+  }
+  net::use_loopback_unless_configured();
+  f.vehicle = std::make_unique<net::RemoteVehicle>();
+  if (!f.vehicle->start(vo, error)) {
+    error = "--vehicle dds: " + error;
+    return false;
+  }
+  std::printf("mixpilot %s: waiting up to %.0f s for the vehicle in DDS domain %u (mixpilot "
+              "vehicle --scenario ...)\n", o.command, o.vehicle_wait_s, unsigned(o.domain));
+  std::fflush(stdout);
+  if (!f.vehicle->wait_for_vehicle(o.vehicle_wait_s)) {
+    error = "--vehicle dds: no vehicle heard on rt/mixpilot/vehicle/state in DDS domain " +
+            std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
+            " s (start `mixpilot vehicle --scenario ...` first)";
+    return false;
+  }
+  if (!f.mode->set_vehicle(f.vehicle.get())) {
+    error = "--vehicle dds: this mode cannot fly a remote vehicle";
+    return false;
+  }
+  return true;
+}
+
 std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status,
                                      std::shared_ptr<input::Gamepad> gamepad) {
   status = kExitError;  // unless said otherwise below
@@ -183,6 +220,7 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
   }
   if (!f->mode) return std::nullopt;
   if (const auto* mi = dynamic_cast<const MiMode*>(f->mode.get())) f->pilot = mi->pilot().name();
+  if (o.vehicle == "dds" && !open_vehicle(o, *f, error)) return std::nullopt;
   status = kExitOk;
   return f;
 }
@@ -194,6 +232,7 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
   info.scenario = f.scenario_text;
   info.scenario_path = f.scenario_file;
   info.pilot = f.pilot;
+  if (f.vehicle) info.vehicle = "dds";
   if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
     info.seed = mi->scenario().plant.seed;
   return info;
@@ -239,6 +278,20 @@ void print_peer(const net::JoyPeer& peer) {
   if (s.publishers > 1)
     std::printf("  WARNING: %u publishers on %s; only the first one heard flew\n", s.publishers,
                 peer.options().topic.c_str());
+}
+
+void print_vehicle(const net::RemoteVehicle& vehicle) {
+  const net::RemoteVehicleStats s = vehicle.stats();
+  std::printf("  vehicle over DDS: %llu commands sent, %llu states taken; rejected %llu bad "
+              "values, %llu bad sizes, %llu unknown commands, %llu stale, %llu of another "
+              "publisher (%u publishers heard)\n",
+              (unsigned long long)s.commands_sent, (unsigned long long)s.accepted,
+              (unsigned long long)s.bad_value, (unsigned long long)s.bad_size,
+              (unsigned long long)s.unknown_command, (unsigned long long)s.stale,
+              (unsigned long long)s.other_publisher, s.publishers);
+  if (s.publishers > 1)
+    std::printf("  WARNING: %u vehicles publish states; only the first one heard flew\n",
+                s.publishers);
 }
 
 std::optional<input::InputSettings> command_input_settings(const char* command,

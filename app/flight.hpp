@@ -13,6 +13,7 @@
 #include "input/gamepad.hpp"
 #include "input/keyboard.hpp"
 #include "input/net/joy_peer.hpp"
+#include "input/net/remote_vehicle.hpp"
 #include "input/settings.hpp"
 #include "input/virtual_gamepad.hpp"
 #include "core/modes/mode.hpp"
@@ -43,6 +44,8 @@ struct FlyOptions {
   std::optional<input::InputSettings> input_values;  // the app's settings, instead of a file
   std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
   bool publish = false;            // --publish: telemetry out over DDS
+  std::string vehicle;             // --vehicle: "" (simulated) or "dds" (mixpilot vehicle)
+  double vehicle_wait_s = 30.0;    // --vehicle-wait: how long to wait for the vehicle
   const char* command = "fly";     // for messages
 };
 
@@ -74,6 +77,7 @@ struct Flight {
   std::unique_ptr<Mode> mode;
   std::string pilot;  // mixed initiative: the pilot source's name
   std::shared_ptr<Devices> devices;  // --pilot gamepad | keyboard
+  std::unique_ptr<net::RemoteVehicle> vehicle;  // --vehicle dds
 };
 
 // The haptic cue from the control thread: each step's λ to the gamepad (an atomic store).
@@ -113,6 +117,8 @@ Labels report_labels(const Flight& f, bool was_interrupted);
 // The summary's real-time line: deadline misses, worst start lateness, p99 and longest step,
 // and the control thread's scheduling.
 void print_realtime(const RealtimeStats& st, double dt);
+// The remote vehicle's line: states taken, rejected by reason, commands sent.
+void print_vehicle(const net::RemoteVehicle& vehicle);
 // The network pilot's line: samples taken, rejected by reason, publishers, latency.
 void print_peer(const net::JoyPeer& peer);
 // The input settings a command flies with: --input-settings FILE (`path`), which must exist and

@@ -58,9 +58,14 @@ constexpr const char* kFlyUsage =
     "                     user's $XDG_CONFIG_HOME/mixpilot/input.toml, docs/input-settings.md)\n"
     "  --publish          publish the telemetry over DDS at the control rate (ROS 2 types:\n"
     "                     rt/mixpilot/pose, lambda, predicted_path, reference_path)\n"
-    "  --domain N         DDS domain of --pilot dds and --publish (0-232, default 0). DDS\n"
-    "                     stays on this machine unless CYCLONEDDS_URI names another\n"
-    "                     configuration (docs/network.md)\n"
+    "  --vehicle sim|dds  sim (default): the plant is simulated in this process; dds: the\n"
+    "                     vehicle of `mixpilot vehicle` flies over DDS, with the round-trip\n"
+    "                     time estimated online (crazyflie_tracking, mixed_initiative;\n"
+    "                     headless only with --realtime)\n"
+    "  --vehicle-wait S   how long to wait for that vehicle before the flight (default 30)\n"
+    "  --domain N         DDS domain of --pilot dds, --publish and --vehicle dds (0-232,\n"
+    "                     default 0). DDS stays on this machine unless CYCLONEDDS_URI names\n"
+    "                     another configuration (docs/network.md)\n"
     "  --headless         run without a window, as fast as possible (default: a window,\n"
     "                     in real time, where a display exists)\n"
     "  --realtime         with --headless: paced by the wall clock, deadline misses counted\n"
@@ -255,6 +260,10 @@ int run_fly(const FlyOptions& o) {
               flown / std::max(wall, 1e-9));
   if (realtime) print_realtime(*realtime, mode.dt());
   if (flight->devices && flight->devices->peer) print_peer(*flight->devices->peer);
+  if (flight->vehicle) {
+    flight->vehicle->finish();
+    print_vehicle(*flight->vehicle);
+  }
   if (publisher) {
     publisher->stop();
     std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
@@ -358,6 +367,16 @@ int fly_command(int argc, char** argv) {
       o.input_settings = value();
     } else if (a == "--publish") {
       o.publish = true;
+    } else if (a == "--vehicle") {
+      o.vehicle = value();
+      if (o.vehicle == "sim") o.vehicle.clear();
+      else if (o.vehicle != "dds")
+        usage_error(o.command, "--vehicle expects sim or dds, got '" + o.vehicle + "'");
+    } else if (a == "--vehicle-wait") {
+      const std::string v = value();
+      const auto s = parse_seconds(v, 3600.0);
+      if (!s) usage_error(o.command, "--vehicle-wait expects seconds up to 3600, got '" + v + "'");
+      o.vehicle_wait_s = *s;
     } else if (a == "--domain") {
       o.domain = parse_domain(o.command, value());
     } else if (a == "--allow-mismatch") {
@@ -372,6 +391,12 @@ int fly_command(int argc, char** argv) {
   if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
   if (!o.gamepad_script.empty() && o.pilot != "gamepad")
     usage_error(o.command, "--gamepad-script plays a virtual gamepad: it goes with --pilot gamepad");
+  if (!o.vehicle.empty() && o.headless && !o.realtime)
+    usage_error(o.command, "--vehicle dds flies a vehicle on the wall clock: a headless flight "
+                           "with it needs --realtime");
+  if (!o.vehicle.empty() && o.pilot.ends_with(".mcap"))
+    usage_error(o.command, "--vehicle dds cannot replay a recording (its pilot commands were "
+                           "checked against a simulated plant); fly another pilot");
   if (o.pilot == "keyboard" && o.headless)
     usage_error(o.command, "--pilot keyboard takes its keys from the window: fly without --headless");
   if (is_device_pilot(o.pilot) && o.headless && !o.realtime)

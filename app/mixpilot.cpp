@@ -26,6 +26,7 @@ constexpr const char* kUsage =
     "  recover rebuild a recording cut short by a crash or kill -9\n"
     "  gamepad-script  a recording's pilot commands as a virtual gamepad's script\n"
     "  joy-publish     a recording's sticks as sensor_msgs/msg/Joy over DDS\n"
+    "  vehicle         a scenario's vehicle in its own process, for fly --vehicle dds\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -104,6 +105,7 @@ int main(int argc, char** argv) {
   if (cmd == "recover") return recover_command(argc, argv);
   if (cmd == "gamepad-script") return gamepad_script_command(argc, argv);
   if (cmd == "joy-publish") return joy_publish_command(argc, argv);
+  if (cmd == "vehicle") return vehicle_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

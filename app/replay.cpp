@@ -82,6 +82,11 @@ std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::st
 std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
+  if (const auto v = rec.metadata.find("vehicle"); v != rec.metadata.end() && !v->second.empty()) {
+    error = path + " was flown with a remote vehicle (--vehicle " + v->second +
+            "): its plant ran in another process, so the flight cannot be flown again here";
+    return nullptr;
+  }
   auto mode = replay_mode_of(rec, path, text, source, duration, error);
   // What depended on the wall clock is replayed as recorded: the overruns' fallbacks.
   if (mode) mode->force_overruns(recorded_overruns(rec));

@@ -79,7 +79,9 @@ void expect_bit_exact_round_trip(const Msg& m,
     ASSERT_NE(err.find("at byte "), std::string::npos) << err;
   }
   EXPECT_LE(old, 8);
-  if (old_format) EXPECT_GE(old, 1);
+  if (old_format) {
+    EXPECT_GE(old, 1);
+  }
 }
 
 TEST(RecordingMessages, EveryTypeRoundTripsBitExactly) {

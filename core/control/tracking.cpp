@@ -33,38 +33,6 @@ OcpTrajectory helix_reference(const TrackingHelix& hx, double dt, const models::
 }
 
 // ---------------------------------------------------------------------------------------------
-// Predictor
-
-void DelayPredictor::setup(const models::Crazyflie& model, int substeps_per_period, double h,
-                           int rtt_substeps) {
-  erk4_ = IntegratorErk4<models::Crazyflie>(model);
-  s_ = std::max(1, substeps_per_period);
-  h_ = h;
-  n_r_ = std::max(0, rtt_substeps);
-  sent_.assign(std::size_t((n_r_ + s_ - 1) / s_ + 1), Input::Zero());
-  k_ = 0;
-}
-
-void DelayPredictor::reset() { k_ = 0; }
-
-void DelayPredictor::record_sent(const Input& u) {
-  sent_[std::size_t(k_ % long(sent_.size()))] = u;
-  ++k_;
-}
-
-void DelayPredictor::predict(const State& measured, State& predicted) const {
-  // Substeps σ_j = j·h for j in [k·s − n_r, k·s); before j = 0 the vehicle rests.
-  const long end = k_ * s_;
-  State x = measured, xn;
-  for (long j = std::max(0L, end - n_r_); j < end; ++j) {
-    const long m = floor_div(j, s_);  // the command in effect on this substep (m < k)
-    erk4_.step<double>(x, sent_[std::size_t(m % long(sent_.size()))], h_, xn);
-    x = xn;
-  }
-  predicted = x;
-}
-
-// ---------------------------------------------------------------------------------------------
 // LQR
 
 Eigen::Matrix<double, 12, 1> TrackingLqr::q_diagonal() {

@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include "core/control/delay_predictor.hpp"
 #include "core/nlp/ocp.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/setup_result.hpp"
@@ -70,31 +71,8 @@ OcpTrajectory helix_reference(const TrackingHelix& helix, double dt, const model
 // ⌊a / b⌋ for b > 0: the control period of substep a when b substeps make one period.
 inline long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-// The ERK4 state predictor of SPEC §5.2 over τ_r = n_r substeps of h (control period = s
-// substeps), with the inputs already sent. setup() allocates; the rest does not.
-class DelayPredictor {
- public:
-  using State = models::Crazyflie::State;
-  using Input = models::Crazyflie::Input;
-
-  void setup(const models::Crazyflie& model, int substeps_per_period, double h, int rtt_substeps);
-  // Forgets the sent commands (next command is k = 0).
-  void reset();
-  // Command u_k was sent (call once per period, after predict()).
-  void record_sent(const Input& u);
-  // x(σ = t_k) from the measurement x(σ = t_k − τ_r), integrating from max(t_k − τ_r, 0) (the
-  // vehicle rests before its first command) with the command in effect on each substep.
-  void predict(const State& measured, State& predicted) const;
-  int rtt_substeps() const { return n_r_; }
-
- private:
-  IntegratorErk4<models::Crazyflie> erk4_{};
-  int s_ = 1;      // substeps per control period
-  double h_ = 0;   // substep [s]
-  int n_r_ = 0;    // τ_r in substeps
-  std::vector<Input> sent_;  // ring of the last commands, indexed k mod size
-  long k_ = 0;               // commands sent so far
-};
+// The ERK4 state predictor of SPEC §5.2 on the Crazyflie (core/control/delay_predictor.hpp).
+using CrazyflieDelayPredictor = DelayPredictor<models::Crazyflie>;
 
 // Discrete LQR on the 12-state model (SPEC §5.2): the ERK4 map at hover over dt, with qw
 // eliminated (∂qw/∂q_v = 0 at hover). State order (p, q_x q_y q_z, v_b, ω), matching

@@ -21,7 +21,12 @@ enum MiChannel {
   kRotorSpeedMax,
   kRotorSpeedBound,
   kRtiTime,
+  kRttEstimate,
+  kRttSample,
 };
+
+// The longest round-trip time a remote vehicle's prediction covers [s].
+constexpr double kMaxRemoteRtt = 0.5;
 
 }  // namespace
 
@@ -52,6 +57,12 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   scorer_.setup(scenario_);
   step_ = 0;
   steps_total_ = std::int64_t(std::lround(scenario_.duration / dt_));
+  const double h = dt_ / substeps_;
+  const int max_substeps = int(std::lround(kMaxRemoteRtt / h));
+  predictor_.setup(model_, substeps_, h, 0, max_substeps);
+  feed_.setup(models::MikroKopter::nx, dt_, h, max_substeps, 2 * std::size_t(steps_total_) + 2);
+  link_ = nullptr;
+  lost_reason_ = "";
   finished_ = steps_total_ <= 0;
   lost_ = false;
   lost_at_ = -1.0;
@@ -112,6 +123,31 @@ void MiMode::measure(double t) {
   }
 }
 
+// A remote vehicle's newest state, predicted over the estimated round-trip time; lost when it
+// left the world or went silent.
+void MiMode::measure_remote(double t) {
+  Telemetry& s = telemetry_;
+  s.step = step_;
+  s.t = t;
+  now_ns_ = vehicle_clock_ns();
+  const VehicleFeed::Reading r = feed_.read(*link_, step_, now_ns_, substeps_);
+  if (r.heard) {
+    const VehicleSample& v = link_->latest();
+    for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
+  }
+  if (left_the_world()) {
+    x_ = s.x;  // the last state inside it
+    lost_reason_ = "it left the arena";
+  } else if (r.silent_s > link_->timeout_s()) {
+    lost_reason_ = "it went silent";
+  }
+  s.x = x_;
+  const models::MikroKopter::State y = x_;
+  models::MikroKopter::State predicted;
+  predictor_.predict(y, predicted, r.horizon_substeps);
+  s.x_measured = predicted;
+}
+
 void MiMode::set_channels() {
   Telemetry& s = telemetry_;
   const double deviation = (s.x.head<3>() - s.reference.head<3>()).norm();
@@ -125,13 +161,29 @@ void MiMode::set_channels() {
   s.set_channel(kRotorSpeedMax, "rotor speed max", "kHz", s.x.tail<4>().maxCoeff());
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "kHz", model_.p.omega_max);
   s.set_channel(kRtiTime, "RTI time", "us", s.stats.total_us);
+  if (link_) {
+    s.set_channel(kRttEstimate, "RTT estimate", "s", feed_.rtt().estimate());
+    s.set_channel(kRttSample, "RTT sample", "s", feed_.rtt().last_sample());
+  }
 }
 
 bool MiMode::step() {
   if (finished_) return false;
   const double t = double(step_) * dt_;
   Telemetry& s = telemetry_;
-  measure(t);
+  if (link_) {
+    measure_remote(t);
+    if (*lost_reason_ != '\0') {
+      lost_ = finished_ = true;
+      lost_at_ = t;
+      s.events = kEventLost;
+      link_->finish();
+      ++step_;
+      return true;
+    }
+  } else {
+    measure(t);
+  }
   const InputState was = s.pilot.input;
   s.pilot.authority = 1.0;  // sources without a device leave these as they are
   s.pilot.input = InputState::ok;
@@ -152,16 +204,32 @@ bool MiMode::step() {
   s.predicted = controller_.predicted_positions();
   s.predicted_reference = controller_.reference_positions();
 
-  // The command enters the delay line; the rotors get the one sent input_delay ago.
-  const std::size_t n = u_delay_.size();
-  u_delay_[std::size_t(step_) % n] = controller_.control();
-  s.u = u_delay_[std::size_t(step_ + 1) % n];
+  if (link_) {
+    // The command leaves at once: the link is the delay line.
+    s.u = controller_.control();
+    const models::MikroKopter::Input u = s.u;
+    predictor_.record_sent(u);
+    link_->send(step_, now_ns_, u.data(), models::MikroKopter::nu);
+  } else {
+    // The command enters the delay line; the rotors get the one sent input_delay ago.
+    const std::size_t n = u_delay_.size();
+    u_delay_[std::size_t(step_) % n] = controller_.control();
+    s.u = u_delay_[std::size_t(step_ + 1) % n];
+  }
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (s.stats.overrun) s.events |= kEventOverrun;
   if (s.pilot.input == InputState::lost && was != InputState::lost) s.events |= kEventInputLost;
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();
 
+  if (link_) {
+    ++step_;
+    if (step_ >= steps_total_) {
+      finished_ = true;
+      link_->finish();
+    }
+    return true;
+  }
   plant_step(s.u);
   ++step_;
   if (left_the_world()) {
@@ -172,6 +240,15 @@ bool MiMode::step() {
   }
   if (step_ >= steps_total_) finished_ = true;
   return true;
+}
+
+Metrics MiMode::metrics() const {
+  Metrics m = to_metrics(score());
+  if (link_) {
+    m.emplace_back("rtt_s", feed_.measured_median());
+    m.emplace_back("rtt_estimated_s", feed_.rtt().estimate());
+  }
+  return m;
 }
 
 std::string MiMode::summary() const {
@@ -190,11 +267,20 @@ std::string MiMode::summary() const {
                 s.max_deviation_m, s.rms_deviation_m, 100.0 * s.time_in_ball, 100.0 * s.progress,
                 s.collisions, s.min_clearance_m, s.override_rms, s.skill);
   std::string out = buf;
-  if (lost_) {
+  if (lost_ && link_) {
+    std::snprintf(buf, sizeof buf, "  the remote vehicle was lost at t = %.3f s: %s\n", lost_at_,
+                  lost_reason_);
+    out += buf;
+  } else if (lost_) {
     std::snprintf(buf, sizeof buf,
                   "  the vehicle was lost at t = %.3f s: it left the arena by more than %.1f m or "
                   "its state stopped being finite\n",
                   lost_at_, mi_defaults::kLostMargin);
+    out += buf;
+  }
+  if (link_) {
+    std::snprintf(buf, sizeof buf, "  remote vehicle: RTT %.1f ms measured, %.1f ms estimated\n",
+                  1e3 * feed_.measured_median(), 1e3 * feed_.rtt().estimate());
     out += buf;
   }
   return out;

@@ -3,6 +3,11 @@
 // over the control period, optional input delay and position noise), the mixed-initiative
 // controller at Δt, and one pilot-input source (emulated pilot, recording, device). Its metrics
 // are the score (core/modes/score.hpp), kept up to date step by step.
+//
+// With a remote vehicle (set_vehicle(), core/modes/vehicle_link.hpp) the plant runs elsewhere:
+// each step starts from the vehicle's newest state predicted over the estimated round-trip
+// time (SPEC §5.2 with the MikroKopter model, core/modes/vehicle_feed.hpp), the command goes
+// out at once (the link is the delay line), and the score is taken on the states received.
 #include <cstdint>
 #include <memory>
 #include <random>
@@ -11,10 +16,12 @@
 
 #include <Eigen/Core>
 
+#include "core/control/delay_predictor.hpp"
 #include "core/control/mi_controller.hpp"
 #include "core/control/pilot.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/score.hpp"
+#include "core/modes/vehicle_feed.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/scenario.hpp"
@@ -43,8 +50,16 @@ class MiMode final : public Mode {
   double lost_at() const override { return lost_at_; }
   const Telemetry& telemetry() const override { return telemetry_; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
-  Metrics metrics() const override { return to_metrics(score()); }
+  // The score; with a remote vehicle also rtt_s (the median round-trip sample) and
+  // rtt_estimated_s (the final estimate).
+  Metrics metrics() const override;
   std::string summary() const override;
+
+  [[nodiscard]] bool set_vehicle(VehicleLink* link) override {
+    link_ = link;
+    return true;
+  }
+  const VehicleFeed& vehicle_feed() const { return feed_; }
 
   Score score() const { return scorer_.finish(); }
   const Scenario& scenario() const { return scenario_; }
@@ -56,6 +71,7 @@ class MiMode final : public Mode {
  private:
   bool left_the_world() const;
   void measure(double t);
+  void measure_remote(double t);
   void set_reference(double t);
   void set_channels();
   void plant_step(const Eigen::VectorXd& u);
@@ -78,6 +94,13 @@ class MiMode final : public Mode {
   bool finished_ = false;
   bool lost_ = false;
   double lost_at_ = -1.0;
+  const char* lost_reason_ = "";
+
+  // Remote vehicle.
+  VehicleLink* link_ = nullptr;
+  VehicleFeed feed_;
+  DelayPredictor<models::MikroKopter> predictor_;
+  std::int64_t now_ns_ = 0;  // the step's stamp
 };
 
 // The scenario's emulated pilot of that name: a profile of the scenario's [pilots], or

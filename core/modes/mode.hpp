@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "core/control/pilot.hpp"
+#include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
 
 namespace mixpilot {
@@ -114,6 +115,13 @@ class Mode {
   // of wall time is discarded as a fallback and raises kEventOverrun. 0 (the default): no
   // deadline, so runs not paced by a clock stay deterministic.
   virtual void set_deadline_us(double deadline_us) = 0;
+  // Flies the vehicle behind `link` (core/modes/vehicle_link.hpp) instead of the simulated
+  // plant: after setup, before the first step. false: this mode has no remote vehicle.
+  [[nodiscard]] virtual bool set_vehicle(VehicleLink* link) {
+    (void)link;
+    return false;
+  }
+
   // A replay: the RTI solves of steps `steps` (ascending step indices) are overruns, as they
   // were in the recorded flight, so it is reproduced bit for bit.
   void force_overruns(std::vector<std::int64_t> steps) {

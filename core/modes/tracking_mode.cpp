@@ -21,7 +21,12 @@ enum TrackingChannel {
   kRotorSpeed1,  // .. kRotorSpeed1 + 3
   kRotorSpeedBound = kRotorSpeed1 + 4,
   kCompensation,
+  kRttSample,
+  kHorizon,
 };
+
+// The longest round-trip time a remote vehicle's prediction covers [s].
+constexpr double kMaxRemoteRtt = 0.5;
 
 constexpr const char* kRotorSpeedNames[4] = {"rotor speed 1", "rotor speed 2", "rotor speed 3",
                                              "rotor speed 4"};
@@ -74,7 +79,11 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   } else if (SetupResult r = lqr_.setup(model_, c.dt); !r) {
     return r;
   }
-  predictor_.setup(model_, int(s_), h_, int(n_r_));
+  predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(kMaxRemoteRtt / h_)));
+  link_ = nullptr;
+  feed_.setup(models::Crazyflie::nx, c.dt, h_, predictor_.max_substeps(),
+              2 * std::size_t(steps_total_) + 2);
+  lost_reason_ = "";
 
   // Ring sizes. States: step k reads boundary k·s − n_m and then integrates at most to
   // (k+1)·s + n_c while boundaries from k·s on are still needed: n_r + s + 1 boundaries.
@@ -94,7 +103,8 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   step_dir_ = step_len_ > 0 ? Eigen::Vector3d(step / step_len_) : Eigen::Vector3d::Zero();
   max_error_ = final_error_ = max_progress_ = max_input_violation_ = 0.0;
   err2_.clear();
-  err2_.reserve(std::size_t(steps_total_) + 1);
+  // Remote: a sample per state received, at most about two per step.
+  err2_.reserve(2 * std::size_t(steps_total_) + 2);
   last_outside_ = -1;
   solve_us_.clear();
   solve_us_.reserve(std::size_t(steps_total_));
@@ -217,8 +227,22 @@ bool TrackingMode::process_to(long end) {
 // Error sample m: x = x(σ = t_m) against p_ref(t_m) (the last node held).
 void TrackingMode::sample(long m, const State& x) {
   const OcpTrajectory& ref = scenario_.reference_trajectory;
-  const Eigen::Vector3d p = x.head<3>();
-  const Eigen::Vector3d pr = ref.x[std::size_t(std::min(m, last_x_))].head<3>();
+  add_sample(m, x.head<3>(), ref.x[std::size_t(std::min(m, last_x_))].head<3>());
+}
+
+// An error sample of a remote vehicle: x = x(σ) against p_ref(σ), linear between the nodes.
+void TrackingMode::sample_at(double sigma, const State& x) {
+  const OcpTrajectory& ref = scenario_.reference_trajectory;
+  const double nodes = std::max(0.0, sigma / scenario_.controller.dt);
+  const long i = std::min(long(nodes), last_x_), i1 = std::min(i + 1, last_x_);
+  const double w = std::min(1.0, nodes - double(i));
+  const Eigen::Vector3d pr =
+      (1.0 - w) * ref.x[std::size_t(i)].head<3>() + w * ref.x[std::size_t(i1)].head<3>();
+  add_sample(std::lround(nodes), x.head<3>(), pr);
+}
+
+void TrackingMode::add_sample(long m, const Eigen::Vector3d& p, const Eigen::Vector3d& pr) {
+  if (err2_.size() == err2_.capacity()) return;  // never grow in the loop
   const double e = position_error(p, pr);
   err2_.push_back(e * e);
   max_error_ = std::max(max_error_, e);
@@ -229,8 +253,20 @@ void TrackingMode::sample(long m, const State& x) {
   }
 }
 
+bool TrackingMode::set_vehicle(VehicleLink* link) {
+  link_ = link;
+  return true;
+}
+
+void TrackingMode::lose(double at, const char* reason) {
+  lost_ = true;
+  lost_at_ = at;
+  lost_reason_ = reason;
+}
+
 bool TrackingMode::step() {
   if (finished_) return false;
+  if (link_) return step_remote();
   const long k = long(step_);
   measure();
   control();
@@ -239,14 +275,57 @@ bool TrackingMode::step() {
   const long end = (k + 1) * s_ + (k + 1 == steps_total_ ? n_c_ : 0);
   integrate_to(std::max(end, k * s_ + n_c_));
   const bool alive = process_to(end);
-  if (!alive) {
-    lost_ = true;
-    lost_at_ = double(j_lost_ - n_c_) * h_;
-  }
+  if (!alive) lose(double(j_lost_ - n_c_) * h_, "it left the world");
   set_telemetry();
   set_channels(predict_us_.back(), solve_us_.back());
   ++step_;
   finished_ = lost_ || step_ >= steps_total_;
+  return true;
+}
+
+// Step k with a remote vehicle: the newest state (a round-trip and an error sample when it is
+// new), the prediction over the estimated round-trip time, the controller, the command out.
+bool TrackingMode::step_remote() {
+  const long k = long(step_);
+  const std::int64_t now = vehicle_clock_ns();
+  const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
+  const VehicleSample& v = link_->latest();
+  if (r.fresh) sample_at(r.sigma, State(v.x));
+  const double t = double(k) * scenario_.controller.dt;
+  y_ = r.heard ? State(v.x) : x_init_;
+  if (r.heard && (!y_.allFinite() ||
+                  (y_.head<3>() - scenario_.plant.start).norm() > tracking_defaults::kLostRadius)) {
+    lose(t, "it left the world");
+    y_ = x_init_;
+  } else if (r.silent_s > link_->timeout_s()) {
+    lose(t, "it went silent");
+  }
+  if (lost_) {
+    finished_ = true;
+    link_->finish();
+    set_telemetry();
+    telemetry_.x = y_;
+    ++step_;
+    return true;
+  }
+
+  const auto t0 = std::chrono::steady_clock::now();
+  if (scenario_.controller.compensation) {
+    predictor_.predict(y_, x0_, r.horizon_substeps);
+  } else {
+    x0_ = y_;
+  }
+  predict_us_.push_back(microseconds_since(t0));
+  control();
+  send();
+  link_->send(k, now, u_.data(), int(u_.size()));
+
+  set_telemetry();
+  telemetry_.x = y_;
+  set_channels(predict_us_.back(), solve_us_.back());
+  ++step_;
+  finished_ = step_ >= steps_total_;
+  if (finished_) link_->finish();
   return true;
 }
 
@@ -274,12 +353,17 @@ void TrackingMode::set_channels(double predictor_us, double controller_us) {
   Telemetry& s = telemetry_;
   const Eigen::Vector3d p = s.x.head<3>(), pr = s.reference.head<3>();
   s.set_channel(kTrackingError, "tracking error", "m", position_error(p, pr));
-  s.set_channel(kRtt, "RTT", "s", scenario_.plant.rtt);
+  s.set_channel(kRtt, link_ ? "RTT estimate" : "RTT", "s",
+                link_ ? feed_.rtt().estimate() : scenario_.plant.rtt);
   s.set_channel(kPredictorTime, "predictor time", "us", predictor_us);
   s.set_channel(kControllerTime, nmpc() ? "RTI time" : "LQR time", "us", controller_us);
   for (int i = 0; i < 4; ++i) s.set_channel(kRotorSpeed1 + i, kRotorSpeedNames[i], "krpm", s.u(i));
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "krpm", model_.p.omega_max);
   s.set_channel(kCompensation, "compensation", "", scenario_.controller.compensation ? 1.0 : 0.0);
+  if (link_) {
+    s.set_channel(kRttSample, "RTT sample", "s", feed_.rtt().last_sample());
+    s.set_channel(kHorizon, "prediction horizon", "s", feed_.horizon_s());
+  }
 }
 
 TrackingResult TrackingMode::result() const {
@@ -306,6 +390,10 @@ TrackingResult TrackingMode::result() const {
   r.rtt_substeps = int(n_r_);
   r.measurement_substeps = int(n_m_);
   r.command_substeps = int(n_c_);
+  r.remote = link_ != nullptr;
+  r.rtt_measured_s = feed_.measured_median();
+  r.rtt_estimated_s = feed_.rtt().estimate();
+  r.rtt_samples = long(feed_.sample_count());
   return r;
 }
 
@@ -325,7 +413,9 @@ Metrics TrackingMode::metrics() const {
   if (rti) m.emplace_back("fallbacks", double(r.fallbacks));
   m.emplace_back("predictor_median_us", r.predictor_median_us);
   m.emplace_back("max_input_violation", r.max_input_violation);
-  m.emplace_back("rtt_s", scenario_.plant.rtt);
+  // A remote vehicle's RTT is measured (the median of its samples) and estimated online.
+  m.emplace_back("rtt_s", r.remote ? r.rtt_measured_s : scenario_.plant.rtt);
+  if (r.remote) m.emplace_back("rtt_estimated_s", r.rtt_estimated_s);
   m.emplace_back("compensation", scenario_.controller.compensation ? 1.0 : 0.0);
   m.emplace_back("steps", double(r.steps));
   m.emplace_back("lost", r.lost ? 1.0 : 0.0);
@@ -337,11 +427,18 @@ std::string TrackingMode::summary() const {
   const bool rti = nmpc();
   const bool step = scenario_.reference.kind == TrackingReferenceKind::smooth_step;
   char buf[512];
+  if (r.remote) {
+    std::snprintf(buf, sizeof buf, "remote vehicle, RTT %.1f ms measured, %.1f ms estimated",
+                  1e3 * r.rtt_measured_s, 1e3 * r.rtt_estimated_s);
+  } else {
+    std::snprintf(buf, sizeof buf, "RTT %.0f ms", 1e3 * scenario_.plant.rtt);
+  }
+  const std::string rtt_text = buf;
   std::snprintf(buf, sizeof buf,
-                "mixpilot fly: %s (crazyflie_tracking, %s, %s, RTT %.0f ms, compensation %s)\n"
+                "mixpilot fly: %s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
                 "  %d steps; tracking RMS %.4f m, max %.4f m, final %.4f m",
                 scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
-                1e3 * scenario_.plant.rtt, scenario_.controller.compensation ? "on" : "off",
+                rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off",
                 r.steps, r.tracking_rms_m, r.max_error_m, r.final_error_m);
   std::string out = buf;
   if (step) {
@@ -352,8 +449,13 @@ std::string TrackingMode::summary() const {
   const std::string fallbacks = rti ? ", " + std::to_string(r.fallbacks) + " fallbacks" : "";
   std::snprintf(buf, sizeof buf, "\n  %s median %.0f us, p99 %.0f us%s; predictor median %.1f us%s\n",
                 rti ? "RTI" : "LQR", r.solve_median_us, r.solve_p99_us, fallbacks.c_str(),
-                r.predictor_median_us, r.lost ? "\n  the vehicle was lost" : "");
+                r.predictor_median_us, r.lost ? "\n  the vehicle was lost: " : "");
   out += buf;
+  if (r.lost) {
+    out.pop_back();
+    out += lost_reason_;
+    out += "\n";
+  }
   return out;
 }
 

@@ -18,6 +18,14 @@
 // far as the commands already sent determine it (to k·s + n_c at least), so that x(σ = t_k) is
 // known when step k ends; integrating ahead changes no state.
 //
+// A remote vehicle (set_vehicle(), core/modes/vehicle_link.hpp): the plant runs elsewhere and
+// nothing is simulated here. Step k starts from the vehicle's newest state, which echoes the
+// command j in effect when it was measured and how long that command had acted (a); each new
+// state is one round-trip sample for the estimator (core/control/rtt_estimator.hpp) and one
+// error sample at σ = t_j + a. With compensation the state is predicted over the estimated
+// round-trip time plus the time it waited here since it arrived. The vehicle is lost when its
+// state leaves the world or it stays silent past the link's timeout.
+//
 // setup() sizes everything; step() allocates nothing.
 #include <cstdint>
 #include <memory>
@@ -29,6 +37,8 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/control/tracking.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/vehicle_feed.hpp"
+#include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/setup_result.hpp"
@@ -59,6 +69,11 @@ struct TrackingResult {
   int rtt_substeps = 0;
   int measurement_substeps = 0;
   int command_substeps = 0;
+  // Remote vehicle: the median of the round-trip samples and the estimator's final estimate.
+  bool remote = false;
+  double rtt_measured_s = 0;
+  double rtt_estimated_s = 0;
+  long rtt_samples = 0;
 };
 
 class TrackingMode final : public Mode {
@@ -93,6 +108,14 @@ class TrackingMode final : public Mode {
   Metrics metrics() const override;
   std::string summary() const override;
 
+  // Flies the vehicle behind `link` instead of the simulated plant (after setup(), before the
+  // first step; nullptr: the simulated plant). The link outlives the flight.
+  [[nodiscard]] bool set_vehicle(VehicleLink* link) override;
+  bool remote() const { return link_ != nullptr; }
+  const RttEstimator& rtt_estimator() const { return feed_.rtt(); }
+  // Why the vehicle was lost ("" while it is not): left the world, or silent.
+  const char* lost_reason() const { return lost_reason_; }
+
   TrackingResult result() const;
   const TrackingScenario& scenario() const { return scenario_; }
   bool nmpc() const { return problem_ != nullptr; }
@@ -105,6 +128,10 @@ class TrackingMode final : public Mode {
   void integrate_to(long end);
   bool process_to(long end);
   void sample(long m, const State& x);
+  void sample_at(double sigma, const State& x);
+  void add_sample(long m, const Eigen::Vector3d& p, const Eigen::Vector3d& pr);
+  bool step_remote();
+  void lose(double at, const char* reason);
   void init_telemetry();
   void set_telemetry();
   void set_channels(double predictor_us, double controller_us);
@@ -115,7 +142,7 @@ class TrackingMode final : public Mode {
   std::unique_ptr<CrazyflieTracking> problem_;  // NMPC only
   std::unique_ptr<RtiSolver> rti_;              // NMPC only
   TrackingLqr lqr_;
-  DelayPredictor predictor_;
+  CrazyflieDelayPredictor predictor_;
 
   // Delay model in plant substeps (core/control/tracking.hpp).
   long s_ = 1;    // substeps per control period
@@ -149,6 +176,11 @@ class TrackingMode final : public Mode {
   double max_input_violation_ = 0;
   std::vector<double> solve_us_;    // per step, reserved for steps_total
   std::vector<double> predict_us_;  // per step, reserved for steps_total
+
+  // Remote vehicle.
+  VehicleLink* link_ = nullptr;
+  VehicleFeed feed_;
+  const char* lost_reason_ = "";
 
   Telemetry telemetry_;
   std::int64_t step_ = 0;

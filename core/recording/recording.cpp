@@ -343,6 +343,7 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                                       {"seed", std::to_string(info.seed)},
                                       {"pilot", info.pilot},
                                       {"trainee", info.trainee},
+                                      {"vehicle", info.vehicle},
                                       {"control_period_ns", std::to_string(period_ns_)}});
   if (!writer_.error().empty()) {
     error = writer_.error();

@@ -153,6 +153,7 @@ struct SessionInfo {
   uint64_t seed = 0;
   std::string pilot;          // pilot source, as in PilotCommandMsg::source (mixed initiative)
   std::string trainee = {};   // the person flying, as typed in the app ("" unknown)
+  std::string vehicle = {};   // "dds": a remote vehicle flew (fly --vehicle dds); "": simulated
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by
