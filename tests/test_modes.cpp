@@ -13,9 +13,13 @@
 #include <vector>
 
 #include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "delayed_plant_link.hpp"
+#include "models/crazyflie.hpp"
+#include "models/mikrokopter.hpp"
 #include "no_malloc.hpp"
 #include "temp_files.hpp"
 
@@ -239,6 +243,76 @@ TEST(MakeMode, ASessionLengthThatTakesTheReferenceOutOfTheArenaIsRefused) {
       EXPECT_NE(error.find("flies the reference out of the arena at t = 113.997 s"), std::string::npos)
           << error;
     }
+  }
+}
+
+
+// --- A remote vehicle (core/modes/vehicle_link.hpp) -------------------------------------
+
+// The modes that fly a remote vehicle step it without allocating, and the mixed-initiative
+// mode over a vehicle without delay starts every step from the state its own plant would have
+// (the newest state, one period old, predicted over that period): the same states, the same
+// commands, the same score.
+TEST(RemoteVehicle, TheMixedInitiativeModeFliesItAsItsOwnPlant) {
+  const ModeCase c{"mi", "mi_helix.toml", "novice", ModeKind::mixed_initiative, nullptr};
+  auto local = make(c), remote = make(c);
+  ASSERT_TRUE(local && remote);
+  const models::MikroKopter model;
+  const auto& mi = dynamic_cast<const MiMode&>(*remote);
+  test::DelayedPlantLink<models::MikroKopter> link(model, mi.state(), remote->dt(), 15, 0.0, 0.0,
+                                                   std::size_t(remote->steps_total()));
+  ASSERT_TRUE(remote->set_vehicle(&link));
+  double worst_x = 0, worst_u = 0;
+  long steps = 0;
+  const GuardedSteps run = step_to_end_without_malloc(*remote, [&] {
+    if (!local->step()) return;
+    const Telemetry &a = local->telemetry(), &b = remote->telemetry();
+    worst_x = std::max(worst_x, (a.x_measured - b.x_measured).lpNorm<Eigen::Infinity>());
+    worst_u = std::max(worst_u, (a.u - b.u).lpNorm<Eigen::Infinity>());
+    ++steps;
+  });
+  EXPECT_EQ(run.allocations, 0);
+  EXPECT_EQ(run.steps, remote->steps_total());
+  EXPECT_EQ(steps, run.steps);
+  EXPECT_LE(worst_x, 1e-12);
+  EXPECT_LE(worst_u, 1e-12);
+  EXPECT_TRUE(link.finished());
+  const MetricMap m = metric_map(remote->metrics());
+  EXPECT_NEAR(m.at("rtt_s"), 0.0, 1e-12);
+  EXPECT_NEAR(m.at("rtt_estimated_s"), 0.0, 1e-12);
+  const MetricMap l = metric_map(local->metrics());
+  for (const char* key : {"skill", "time_in_ball", "max_deviation_m", "mean_lambda", "collisions"})
+    EXPECT_NEAR(m.at(key), l.at(key), 1e-9) << key;
+}
+
+TEST(RemoteVehicle, TheTrackingModeStepsItWithoutAllocating) {
+  const ModeCase c{"tracking", "tracking_helix.toml", nullptr, ModeKind::crazyflie_tracking,
+                   nullptr};
+  auto mode = make(c);
+  ASSERT_TRUE(mode);
+  const models::Crazyflie model;
+  test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state({0.0, 0.0, 0.38}),
+                                                 mode->dt(), 15, 0.03, 0.03,
+                                                 std::size_t(mode->steps_total()));
+  ASSERT_TRUE(mode->set_vehicle(&link));
+  const GuardedSteps run = step_to_end_without_malloc(*mode, [] {});
+  EXPECT_EQ(run.allocations, 0);
+  EXPECT_EQ(run.steps, mode->steps_total());
+  EXPECT_FALSE(mode->lost());
+  const MetricMap m = metric_map(mode->metrics());
+  EXPECT_NEAR(m.at("rtt_estimated_s"), 0.06, 1e-12);
+  EXPECT_LT(m.at("tracking_rms_m"), 0.05);
+}
+
+// Modes without a remote vehicle say so.
+TEST(RemoteVehicle, OtherModesRefuseIt) {
+  for (const char* scenario : {"pendubot_swingup.toml", "obstacles_cluttered.toml"}) {
+    auto mode = make({"other", scenario, nullptr, ModeKind::pendubot_swingup, nullptr});
+    ASSERT_TRUE(mode);
+    test::DelayedPlantLink<models::Crazyflie> link(models::Crazyflie{},
+                                                   models::Crazyflie{}.hover_state({0, 0, 1}),
+                                                   0.015, 15, 0, 0, 1);
+    EXPECT_FALSE(mode->set_vehicle(&link)) << scenario;
   }
 }
 

@@ -12,7 +12,9 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/modes/mode.hpp"
+#include "core/control/rtt_estimator.hpp"
 #include "core/modes/tracking_mode.hpp"
+#include "delayed_plant_link.hpp"
 #include "fly_scenario.hpp"
 
 namespace mixpilot {
@@ -527,6 +529,98 @@ TEST(TrackingScenarioFile, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error, "t.toml:3:9: model: expected one of \"crazyflie\", got the string \"mikrokopter\"");
   EXPECT_FALSE(load_tracking_scenario("/no/such/file.toml", error));
   EXPECT_EQ(error.rfind("/no/such/file.toml: cannot open file", 0), 0u) << error;
+}
+
+
+// --- A remote vehicle (core/modes/vehicle_link.hpp) -------------------------------------
+
+// The estimator: the median of the last kWindow samples; it ignores a lone outlier, follows a
+// change of delay within half a window, and refuses what is not a delay.
+TEST(RttEstimator, MedianOfTheWindow) {
+  RttEstimator e;
+  EXPECT_FALSE(e.valid());
+  EXPECT_FALSE(e.add(std::nan("")));
+  EXPECT_FALSE(e.add(-1e-3));
+  EXPECT_FALSE(e.add(INFINITY));
+  EXPECT_FALSE(e.valid());
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(e.add(0.060 + 1e-4 * (i % 5)));
+  EXPECT_NEAR(e.estimate(), 0.0602, 1e-12);
+  e.add(0.5);  // one late sample
+  EXPECT_NEAR(e.estimate(), 0.0602, 1e-12);
+  int n = 0;
+  while (std::abs(e.estimate() - 0.030) > 1e-12) {
+    e.add(0.030);
+    ++n;
+  }
+  EXPECT_LE(n, RttEstimator::kWindow / 2 + 1);
+  EXPECT_GE(n, RttEstimator::kWindow / 2 - 1);
+  EXPECT_EQ(e.samples(), RttEstimator::kWindow);
+}
+
+// Over a vehicle whose measurement arrives τ_r after the command it echoes started acting, the
+// remote path starts every step from the same state as the simulated plant with that RTT: the
+// round-trip samples are τ_r, the horizon is τ_r, and state, prediction and command agree to
+// the last bits. Without compensation both start from the τ_r-old state.
+TEST(TrackingRemote, ADelayedVehicleIsFlownAsTheSimulatedPlant) {
+  for (const bool compensation : {true, false}) {
+    TrackingScenario sc = load(kStep);
+    sc.duration = 2.0;
+    sc.plant.rtt = 0.06;
+    sc.controller.compensation = compensation;
+    TrackingMode local, remote;
+    ASSERT_TRUE(local.setup(sc).ok());
+    ASSERT_TRUE(remote.setup(sc).ok());
+    const models::Crazyflie model;
+    test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state(sc.plant.start),
+                                                   sc.controller.dt, 15, 0.03, 0.03, 1000);
+    ASSERT_TRUE(remote.set_vehicle(&link));
+    double worst_x0 = 0, worst_u = 0;
+    int steps = 0;
+    while (local.step()) {
+      ASSERT_TRUE(remote.step());
+      const Telemetry &a = local.telemetry(), &b = remote.telemetry();
+      worst_x0 = std::max(worst_x0, (a.x_measured - b.x_measured).lpNorm<Eigen::Infinity>());
+      worst_u = std::max(worst_u, (a.u - b.u).lpNorm<Eigen::Infinity>());
+      ++steps;
+    }
+    EXPECT_FALSE(remote.step());
+    EXPECT_TRUE(link.finished());
+    EXPECT_EQ(steps, 133);
+    EXPECT_LE(worst_x0, 1e-12) << "compensation " << compensation;
+    EXPECT_LE(worst_u, 1e-9) << "compensation " << compensation;
+    const TrackingResult r = remote.result();
+    EXPECT_TRUE(r.remote);
+    EXPECT_NEAR(r.rtt_measured_s, 0.06, 1e-12);
+    EXPECT_NEAR(r.rtt_estimated_s, 0.06, 1e-12);
+    // The last four commands' states arrive after the flight: 133 − 4 error samples, against
+    // the simulated plant's 134; the errors at the common instants are the same.
+    EXPECT_EQ(r.rtt_samples, 129);
+    // the errors at the common instants are the same. (Without compensation the loop diverges:
+    // the last samples dominate.)
+    if (compensation)
+      EXPECT_NEAR(r.tracking_rms_m, local.result().tracking_rms_m,
+                  0.05 * local.result().tracking_rms_m);
+  }
+}
+
+// A vehicle that falls silent is lost after the link's timeout, and the flight ends.
+TEST(TrackingRemote, ASilentVehicleIsLost) {
+  TrackingScenario sc = load(kStep);
+  sc.duration = 3.0;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  const models::Crazyflie model;
+  // Its states arrive 2 s late: silent for the 1 s timeout.
+  test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state(sc.plant.start),
+                                                 sc.controller.dt, 15, 1.0, 1.0, 1000);
+  ASSERT_TRUE(mode.set_vehicle(&link));
+  while (mode.step()) {
+  }
+  EXPECT_TRUE(mode.lost());
+  EXPECT_STREQ(mode.lost_reason(), "it went silent");
+  EXPECT_NEAR(mode.lost_at(), 1.0, 0.0151);
+  EXPECT_TRUE(mode.telemetry().events & kEventLost);
+  EXPECT_TRUE(link.finished());
 }
 
 }  // namespace

@@ -129,23 +129,26 @@ void MiMode::measure_remote(double t) {
   Telemetry& s = telemetry_;
   s.step = step_;
   s.t = t;
-  now_ns_ = vehicle_clock_ns();
+  now_ns_ = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, step_, now_ns_, substeps_);
   if (r.heard) {
     const VehicleSample& v = link_->latest();
     for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
   }
   if (left_the_world()) {
-    x_ = s.x;  // the last state inside it
+    x_ = s.x;  // the last state known inside it
     lost_reason_ = "it left the arena";
   } else if (r.silent_s > link_->timeout_s()) {
     lost_reason_ = "it went silent";
   }
-  s.x = x_;
+  // What is known of the vehicle now: the state predicted to t_k, which the pilot sees, the
+  // controller starts from and the score takes.
   const models::MikroKopter::State y = x_;
   models::MikroKopter::State predicted;
   predictor_.predict(y, predicted, r.horizon_substeps);
-  s.x_measured = predicted;
+  for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = predicted(i);
+  s.x = x_;
+  s.x_measured = x_;
 }
 
 void MiMode::set_channels() {

@@ -7,7 +7,8 @@
 // With a remote vehicle (set_vehicle(), core/modes/vehicle_link.hpp) the plant runs elsewhere:
 // each step starts from the vehicle's newest state predicted over the estimated round-trip
 // time (SPEC §5.2 with the MikroKopter model, core/modes/vehicle_feed.hpp), the command goes
-// out at once (the link is the delay line), and the score is taken on the states received.
+// out at once (the link is the delay line). The prediction is what is known of the vehicle at
+// t_k: the pilot sees it and the score takes it.
 #include <cstdint>
 #include <memory>
 #include <random>

@@ -287,7 +287,7 @@ bool TrackingMode::step() {
 // new), the prediction over the estimated round-trip time, the controller, the command out.
 bool TrackingMode::step_remote() {
   const long k = long(step_);
-  const std::int64_t now = vehicle_clock_ns();
+  const std::int64_t now = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
   const VehicleSample& v = link_->latest();
   if (r.fresh) sample_at(r.sigma, State(v.x));

@@ -40,7 +40,7 @@ class VehicleFeed {
     t0_ns_ = 0;
   }
 
-  // Step k at `now` (vehicle_clock_ns()); substeps_per_period: of the predictor.
+  // Step k at `now` (link.now_ns()); substeps_per_period: of the predictor.
   Reading read(VehicleLink& link, std::int64_t k, std::int64_t now, int substeps_per_period) {
     if (k == 0) t0_ns_ = now;
     const VehicleSample& v = link.latest();

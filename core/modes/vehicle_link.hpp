@@ -14,6 +14,13 @@
 
 namespace mixpilot {
 
+// The controller's steady clock [ns] (the stamps of VehicleLink).
+inline std::int64_t vehicle_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 struct VehicleSample {
   static constexpr int kMaxState = 16;
   using StateVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxState, 1>;
@@ -23,7 +30,7 @@ struct VehicleSample {
   std::int64_t command = -1;    // the newest command in effect then (its step k), −1: none yet
   std::int64_t command_stamp_ns = 0;  // that command's send stamp, echoed (controller's clock)
   double command_age_s = 0.0;   // how long that command had acted when the state was measured
-  std::int64_t received_ns = 0; // when the sample arrived (controller's steady clock)
+  std::int64_t received_ns = 0; // when the sample arrived (VehicleLink::now_ns())
 };
 
 class VehicleLink {
@@ -31,19 +38,15 @@ class VehicleLink {
   virtual ~VehicleLink() = default;
   // The newest sane state (serial 0 before the first).
   virtual const VehicleSample& latest() = 0;
-  // Command k leaves now, stamped `stamp_ns` (the controller's steady clock), u of size nu.
+  // Command k leaves now, stamped `stamp_ns` (now_ns()), u of size nu.
   virtual void send(std::int64_t k, std::int64_t stamp_ns, const double* u, int nu) = 0;
   // The flight is over: the vehicle may stop.
   virtual void finish() = 0;
   // How long the vehicle may stay silent before it counts as lost [s].
   virtual double timeout_s() const = 0;
+  // The controller's clock, on which commands are stamped and states received [ns]: the steady
+  // clock (a simulated one in tests).
+  virtual std::int64_t now_ns() const { return vehicle_clock_ns(); }
 };
-
-// The controller's steady clock [ns] (the stamps of VehicleLink).
-inline std::int64_t vehicle_clock_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 }  // namespace mixpilot
