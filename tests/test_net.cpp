@@ -25,6 +25,7 @@
 #include "input/net/joy_peer.hpp"
 #include "models/mikrokopter.hpp"
 #include "ros2_msgs.h"
+#include "net_test.hpp"
 #include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
@@ -32,28 +33,8 @@ namespace mixpilot::net {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A domain of this process's own (DDS ids 0-232; 0 is the default, left to users).
-std::uint32_t my_domain() { return 1 + std::uint32_t(getpid()) % 232; }
-
-class Net : public testing::Test {
- protected:
-  void SetUp() override {
-    std::string why;
-    if (!loopback_only(why)) FAIL() << "refusing to run a DDS test: " << why;
-    domain_ = my_domain();
-  }
-  template <class F>
-  static bool eventually(F done, double seconds = 5) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (!done()) {
-      if (std::chrono::steady_clock::now() > until) return false;
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    return true;
-  }
-  std::uint32_t domain_ = 0;
-};
+using test::numbers;
+using test::read_file;
 
 TEST(NetConfig, TheLoopbackCheckRefusesWhatWouldLeaveTheMachine) {
   const char* before = std::getenv("CYCLONEDDS_URI");
@@ -188,15 +169,6 @@ TEST_F(Net, ASilentPeerIsAnInputLoss) {
 }
 
 // --- Two processes ----------------------------------------------------------------------
-
-const std::string kSrc = MIXPILOT_SOURCE_DIR;
-const std::string kMixpilot = MIXPILOT_BINARY;
-
-int run(const std::string& args, const fs::path& dir, const std::string& out = "out.txt") {
-  return test::run_mixpilot(kMixpilot, args, dir, out);
-}
-using test::numbers;
-using test::read_file;
 
 // joy-publish sends the novice's sticks from its recording; fly --pilot dds flies them in real
 // time in another process. The score is the local replay's within what the timing explains

@@ -135,7 +135,7 @@ void MiMode::measure_remote(double t) {
     const VehicleSample& v = link_->latest();
     for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
   }
-  if (left_the_world()) {
+  if (left_the_world() || (r.heard && link_->latest().left_world)) {
     x_ = s.x;  // the last state known inside it
     lost_reason_ = "it left the arena";
   } else if (r.silent_s > link_->timeout_s()) {

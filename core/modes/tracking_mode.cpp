@@ -293,7 +293,7 @@ bool TrackingMode::step_remote() {
   if (r.fresh) sample_at(r.sigma, State(v.x));
   const double t = double(k) * scenario_.controller.dt;
   y_ = r.heard ? State(v.x) : x_init_;
-  if (r.heard && (!y_.allFinite() ||
+  if (r.heard && (v.left_world || !y_.allFinite() ||
                   (y_.head<3>() - scenario_.plant.start).norm() > tracking_defaults::kLostRadius)) {
     lose(t, "it left the world");
     y_ = x_init_;

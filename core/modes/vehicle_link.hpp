@@ -31,6 +31,7 @@ struct VehicleSample {
   std::int64_t command_stamp_ns = 0;  // that command's send stamp, echoed (controller's clock)
   double command_age_s = 0.0;   // how long that command had acted when the state was measured
   std::int64_t received_ns = 0; // when the sample arrived (VehicleLink::now_ns())
+  bool left_world = false;      // the vehicle says it left its world (its state is the last inside)
 };
 
 class VehicleLink {

@@ -148,6 +148,7 @@ void RemoteVehicle::run() {
       sample_.command = m.command_step;
       sample_.command_stamp_ns = m.command_step >= 0 ? m.command_stamp_ns : 0;
       sample_.command_age_s = m.command_age_s;
+      sample_.left_world = m.status == 1;
       sample_.received_ns = vehicle_clock_ns();
       ++sample_.serial;
       accepted_.fetch_add(1, std::memory_order_relaxed);
