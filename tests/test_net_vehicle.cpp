@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -318,6 +319,76 @@ TEST_F(Net, FlyRefusesWhatARemoteVehicleCannotDo) {
   EXPECT_EQ(run("vehicle --scenario " + kStep + " --latency -3", dir), 2);
   EXPECT_EQ(run("vehicle --scenario " + kStep + " --wait 0.3 --domain " + d, dir), 1);
   EXPECT_NE(read_file(dir / "out.txt").find("no controller within"), std::string::npos);
+}
+
+
+// Two hosts: vehicle and controller in two network namespaces this test creates, joined by a
+// veth pair and nothing else (no route out of either), each with a Cyclone configuration bound
+// to its end of the pair, multicast off, the other end as its peer. Needs root (CAP_SYS_ADMIN);
+// skipped with the reason otherwise.
+TEST_F(Net, VehicleAndControllerInTwoNetworkNamespacesJoinedByAVethPair) {
+  if (geteuid() != 0) GTEST_SKIP() << "creating network namespaces needs root";
+  const fs::path dir = test::fresh_path("net", "netns");
+  fs::create_directories(dir);
+  const std::string id = std::to_string(getpid() % 100000);
+  const std::string a = "mpveh" + id, b = "mpctl" + id;  // namespaces
+  const std::string va = "mpv" + id, vb = "mpc" + id;    // veth ends (≤ 15 characters)
+  const std::string net = "10.213." + std::to_string(getpid() % 250) + ".";
+  const auto sh = [](const std::string& cmd) { return std::system((cmd + " 2>&1").c_str()); };
+  if (sh("ip netns add " + a) != 0) GTEST_SKIP() << "ip netns add failed: no namespaces here";
+  struct Cleanup {
+    std::string a, b;
+    ~Cleanup() {
+      std::system(("ip netns del " + a + " 2>/dev/null").c_str());
+      std::system(("ip netns del " + b + " 2>/dev/null").c_str());
+    }
+  } cleanup{a, b};
+  ASSERT_EQ(sh("ip netns add " + b), 0);
+  ASSERT_EQ(sh("ip link add " + va + " type veth peer name " + vb), 0);
+  ASSERT_EQ(sh("ip link set " + va + " netns " + a + " && ip link set " + vb + " netns " + b), 0);
+  ASSERT_EQ(sh("ip -n " + a + " addr add " + net + "1/24 dev " + va + " && ip -n " + a +
+               " link set " + va + " up && ip -n " + a + " link set lo up"), 0);
+  ASSERT_EQ(sh("ip -n " + b + " addr add " + net + "2/24 dev " + vb + " && ip -n " + b +
+               " link set " + vb + " up && ip -n " + b + " link set lo up"), 0);
+  const auto config = [&](const std::string& name, const std::string& itf,
+                          const std::string& peer) {
+    const fs::path p = dir / name;
+    std::ofstream(p) << "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain Id=\"any\"><General>"
+                        "<Interfaces><NetworkInterface name=\"" << itf << "\"/></Interfaces>"
+                        "<AllowMulticast>false</AllowMulticast></General><Discovery>"
+                        "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\""
+                     << peer << "\"/></Peers></Discovery></Domain></CycloneDDS>\n";
+    return "ip netns exec " + name.substr(0, name.size() - 4) + " env CYCLONEDDS_URI=file://" +
+           p.string();
+  };
+  const std::string in_a = config(a + ".xml", va, net + "2");
+  const std::string in_b = config(b + ".xml", vb, net + "1");
+  const std::string d = std::to_string(domain_);
+  start("vehicle --scenario " + kStep + " --latency 30 --domain " + d, dir, "vehicle.txt", in_a);
+  const std::string fly = in_b + " env XDG_CONFIG_HOME='" + (dir / "config").string() + "' '" +
+                          kMixpilot + "' fly --scenario " + kStep + " --vehicle dds --domain " + d +
+                          " --headless --realtime --duration 3 --report '" +
+                          (dir / "netns.json").string() + "' >'" + (dir / "fly.txt").string() +
+                          "' 2>&1";
+  EXPECT_EQ(std::system(fly.c_str()), 0) << read_file(dir / "fly.txt");
+  EXPECT_EQ(finished(dir, "vehicle.txt", 10), 0) << read_file(dir / "vehicle.txt");
+  std::printf("%s%s", read_file(dir / "fly.txt").c_str(), read_file(dir / "vehicle.txt").c_str());
+  const auto r = numbers(read_file(dir / "netns.json"));
+  EXPECT_EQ(r.at("lost"), 0.0);
+  EXPECT_GE(r.at("rtt_s"), 0.060);
+  EXPECT_LE(r.at("rtt_s"), 0.066);
+  EXPECT_NEAR(r.at("rtt_estimated_s"), r.at("rtt_s"), 0.003);
+  EXPECT_LT(r.at("tracking_rms_m"), 0.01);
+  // It all went through the pair: both ends carried every command and state.
+  const std::string counts = dir / "veth.txt";
+  ASSERT_EQ(sh("ip netns exec " + a + " cat /sys/class/net/" + va + "/statistics/rx_packets "
+               "/sys/class/net/" + va + "/statistics/tx_packets > '" + counts + "'"), 0);
+  std::istringstream in(read_file(counts));
+  long rx = 0, tx = 0;
+  in >> rx >> tx;
+  std::printf("veth %s: %ld packets in, %ld out\n", va.c_str(), rx, tx);
+  EXPECT_GE(rx, 200);
+  EXPECT_GE(tx, 200);
 }
 
 }  // namespace
