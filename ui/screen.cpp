@@ -144,7 +144,8 @@ void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui,
   ImGui::End();
 }
 
-// The HUD under the authority bar: deviation, time in B, RTI time, fallbacks, misses.
+// The HUD under the authority bar: deviation, time in B, RTI time, fallbacks, misses, and a
+// remote vehicle's round-trip time.
 // Returns the screen y of its bottom edge.
 float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVec2 size) {
   ImGui::SetNextWindowPos(pos);
@@ -185,6 +186,11 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImV
   if (run.deadline_misses > 0) ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
   ImGui::Text("  deadline misses %lld", static_cast<long long>(run.deadline_misses));
   if (run.deadline_misses > 0) ImGui::PopStyleColor();
+  // A remote vehicle (SPEC §9): the round-trip time the predictor uses, and the newest sample.
+  if (const double rtt = s ? channel_value(*s, "RTT estimate", -1.0) : -1.0; rtt >= 0.0) {
+    ImGui::Text("remote vehicle: RTT %5.1f ms estimated, last sample %5.1f ms", 1e3 * rtt,
+                1e3 * channel_value(*s, "RTT sample", 0.0));
+  }
   ImGui::PopFont();
   const float bottom = ImGui::GetCursorScreenPos().y;
   ImGui::End();
@@ -212,6 +218,8 @@ const char* meaning(const std::string& key) {
       {"skill", "the score: progress x quality / (1 + collisions), 0-100"},
       {"lost", "1: the vehicle was lost"},
       {"lost_at_s", "when it was lost [s]"},
+      {"rtt_s", "round-trip time to the vehicle (remote: the median sample) [s]"},
+      {"rtt_estimated_s", "the online round-trip estimate at the end [s]"},
   };
   for (const auto& [k, v] : kMeanings)
     if (key == k) return v;
