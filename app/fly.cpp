@@ -24,11 +24,9 @@
 #include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
+#include "core/scenario/data_files.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
-#ifndef MIXPILOT_SOURCE_DIR
-#define MIXPILOT_SOURCE_DIR "."
-#endif
 
 namespace mixpilot::cli {
 
@@ -44,8 +42,9 @@ constexpr const char* kFlyUsage =
     "the flight at the next step: the recording and report then hold what was flown.\n"
     "\n"
     "  --scenario FILE    scenario file (TOML, docs/scenario-format.md); optional when PILOT is\n"
-    "                     a recording, whose embedded scenario is then used. Its `mode` picks\n"
-    "                     what flies: mixed_initiative (with a pilot) or a thesis controller\n"
+    "                     a recording, whose embedded scenario is then used, and in the window\n"
+    "                     (default: the shipped mi_helix). Its `mode` picks what flies:\n"
+    "                     mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
     "                     gamepad (headless only with --realtime) | keyboard (window) |\n"
     "                     dds[:TOPIC] (sensor_msgs/msg/Joy from the network, default\n"
@@ -387,6 +386,9 @@ int fly_command(int argc, char** argv) {
       usage_error(o.command, "unknown option '" + std::string(a) + "'");
     }
   }
+  // The window without a scenario (the desktop entry): the shipped mi_helix, changeable there.
+  if (o.scenario_path.empty() && !o.headless && !o.pilot.ends_with(".mcap"))
+    o.scenario_path = data_file("scenarios/mi_helix.toml");
   if (o.realtime && !o.headless) usage_error(o.command, "--realtime is for --headless runs (a window is always real time)");
   if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
   if (!o.gamepad_script.empty() && o.pilot != "gamepad")
@@ -457,7 +459,13 @@ int replay_command(int argc, char** argv) {
 
 int demo_command() {
   FlyOptions o;
-  o.scenario_path = MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml";
+  std::string why;
+  const std::string dir = data_dir(&why);
+  if (dir.empty()) {
+    std::fprintf(stderr, "mixpilot demo: %s\n", why.c_str());
+    return kExitError;
+  }
+  o.scenario_path = dir + "/scenarios/mi_helix.toml";
   o.pilot = "novice";
   o.headless = true;
   return run_fly(o);

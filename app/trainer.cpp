@@ -13,10 +13,8 @@
 #include "app/cli.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
+#include "core/scenario/data_files.hpp"
 
-#ifndef MIXPILOT_SOURCE_DIR
-#define MIXPILOT_SOURCE_DIR "."
-#endif
 
 namespace mixpilot::cli {
 
@@ -34,7 +32,9 @@ std::string absolute_path(const std::string& p) {
 std::vector<std::string> shipped_scenarios() {
   std::vector<std::string> out;
   std::error_code ec;
-  for (fs::directory_iterator it(MIXPILOT_SOURCE_DIR "/scenarios", ec), end; !ec && it != end;
+  const std::string dir = data_file("scenarios");
+  if (dir.empty()) return out;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end;
        it.increment(ec))
     if (it->path().extension() == ".toml") out.push_back(absolute_path(it->path().string()));
   std::sort(out.begin(), out.end());

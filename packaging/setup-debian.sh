@@ -24,6 +24,8 @@ packages=(
   clang libclang-rt-dev
   # tooling: independent MCAP reader in the recording tests
   nodejs
+  # the Debian package: man pages, dpkg-shlibdeps, its checks (packaging/build-deb.sh)
+  help2man dpkg-dev lintian desktop-file-utils appstream
 )
 # Debian's npm conflicts with a nodejs that already bundles npm; ask for it only when missing.
 command -v npm >/dev/null 2>&1 || packages+=(npm)

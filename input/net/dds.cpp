@@ -2,6 +2,8 @@
 
 #include <dds/dds.h>
 
+#include "core/scenario/data_files.hpp"
+
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -63,11 +65,14 @@ bool loopback_only(std::string& why) {
 }
 
 std::string loopback_config_uri() {
-#ifdef MIXPILOT_SOURCE_DIR
-  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/assets/dds-loopback.xml";
-  if (std::filesystem::exists(path)) return "file://" + path;
-#endif
-  return "file://<mixpilot>/assets/dds-loopback.xml";
+  const std::string path = data_file("assets/dds-loopback.xml");
+  if (!path.empty() && std::filesystem::exists(path)) return "file://" + path;
+  // Without the file, the same configuration inline.
+  return "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
+         "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+         "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>40"
+         "</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>"
+         "</Domain></CycloneDDS>";
 }
 
 void use_loopback_unless_configured() {

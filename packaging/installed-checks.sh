@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# What a user does with the installed package, from a folder that holds no source: the demo, a
+# flight of an installed scenario with a report, a recording scored, a headless screenshot, the
+# man pages and the help. Runs wherever mixpilot is installed (this machine, or the throwaway
+# root of packaging/debootstrap-test.sh). Usage: installed-checks.sh WORK_DIR
+set -euo pipefail
+work=$1
+mkdir -p "$work/home"
+export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_DATA_HOME=$work/home/.local/share
+unset MIXPILOT_DATA_DIR CYCLONEDDS_URI
+cd /
+share=/usr/share/mixpilot
+say() { echo "installed-checks: $*"; }
+
+[ "$(command -v mixpilot)" = /usr/bin/mixpilot ] || { say "mixpilot is not /usr/bin/mixpilot"; exit 1; }
+mixpilot --version
+mixpilot --help >/dev/null
+say "demo"
+mixpilot demo | tee "$work/demo.txt"
+grep -q "skill" "$work/demo.txt"
+say "fly an installed scenario"
+mixpilot fly --scenario $share/scenarios/tracking_smooth_step.toml --headless \
+  --report "$work/tracking.json"
+grep -q '"lost": 0' "$work/tracking.json"
+say "record and score"
+mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless --duration 5 \
+  --record "$work/novice.mcap" --report "$work/novice.json"
+mixpilot score "$work/novice.mcap" --json "$work/score.json"
+grep -q skill "$work/score.json"
+say "headless screenshot"
+mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless --duration 3 \
+  --screenshot "2:$work/shot.png"
+[ "$(head -c 8 "$work/shot.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || {
+  say "the screenshot is not a PNG"; exit 1; }
+say "man pages"
+for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-reference; do
+  [ -f /usr/share/man/man1/$page.1.gz ] || { say "no man page $page(1)"; exit 1; }
+  zcat /usr/share/man/man1/$page.1.gz | grep -q '^\.TH' || { say "$page(1) is not a man page"; exit 1; }
+done
+say "no path of the build machine in the binaries"
+if [ -n "${MIXPILOT_SOURCE:-}" ] && grep -q -a -F "$MIXPILOT_SOURCE" /usr/bin/mixpilot /usr/bin/mixpilot-reference; then
+  say "a binary names $MIXPILOT_SOURCE"; exit 1
+fi
+say "all passed"
