@@ -37,7 +37,7 @@ dpkg-deb --info "$deb" | sed -n '/Package:/,$p'
 # lintian: errors fail the build; warnings are printed (packaging/README.md explains them).
 # Run as root it warns that it should not be; that is not about the package.
 echo "build-deb: lintian"
-lintian --no-tag-display-limit --allow-root "$deb" | tee "$build/lintian.txt" || true
+lintian --tag-display-limit 0 --allow-root "$deb" | tee "$build/lintian.txt" || true
 if grep -q '^E:' "$build/lintian.txt"; then
   echo "build-deb: lintian reports errors" >&2
   exit 1
