@@ -1,5 +1,7 @@
 #include "app/offscreen.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <utility>
@@ -20,7 +22,8 @@ namespace mixpilot::cli {
 namespace {
 
 const char* const kInstall =
-    " (headless rendering needs Mesa's EGL: apt-get install libegl-mesa0 libgl1-mesa-dri)";
+    " (headless rendering needs Mesa's EGL: apt-get install libegl1 libegl-mesa0 "
+    "libgl1-mesa-dri)";
 
 std::string egl_error(const char* what) {
   char buf[96];
@@ -35,6 +38,13 @@ Offscreen::~Offscreen() { close(); }
 bool Offscreen::open(int width, int height, std::string& error) {
   width_ = width;
   height_ = height;
+  // libepoxy loads libEGL itself and aborts the process when it cannot: ask first.
+  if (void* egl = dlopen("libEGL.so.1", RTLD_LAZY | RTLD_LOCAL)) {
+    dlclose(egl);
+  } else {
+    error = std::string("cannot load libEGL.so.1 (") + dlerror() + ")" + kInstall;
+    return false;
+  }
   auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
       eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (!get_display) {

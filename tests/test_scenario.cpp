@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <regex>
@@ -11,6 +12,8 @@
 #include <string>
 
 #include "core/nlp/trajectory_io.hpp"
+#include "core/scenario/data_files.hpp"
+#include "temp_files.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 #include "core/scenario/pendubot_scenario.hpp"
 #include "core/scenario/scenario_toml.hpp"
@@ -536,6 +539,35 @@ TEST(ScenarioRanges, ReferenceCsvIsBounded) {
   for (int i = 0; i < 65; ++i) wide += ",x" + std::to_string(i);
   EXPECT_EQ(csv_error(wide + ",u0\n"),
             ":1: expected at most 64 x and 64 u columns, found 65 and 1");
+}
+
+
+// The shipped data is found beside the executable (<exe>/../share/mixpilot: the install prefix,
+// and the build tree's links), or where MIXPILOT_DATA_DIR says; a wrong override is reported,
+// never silently replaced.
+TEST(DataFiles, FoundBesideTheExecutableOrWhereTheOverrideSays) {
+  namespace fs = std::filesystem;
+  unsetenv("MIXPILOT_DATA_DIR");
+  const std::string dir = data_dir();
+  ASSERT_FALSE(dir.empty());
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "scenarios" / "mi_helix.toml")) << dir;
+  EXPECT_TRUE(fs::exists(data_file("assets/dds-loopback.xml")));
+  EXPECT_EQ(fs::path(dir).filename(), "mixpilot");
+  EXPECT_EQ(fs::path(dir).parent_path().filename(), "share");
+
+  const fs::path mine = test::fresh_path("data_files", "override");
+  fs::create_directories(mine / "scenarios");
+  setenv("MIXPILOT_DATA_DIR", mine.c_str(), 1);
+  EXPECT_EQ(data_dir(), mine.lexically_normal().string());
+  EXPECT_EQ(data_file("scenarios/x.toml"), (mine / "scenarios" / "x.toml").string());
+
+  setenv("MIXPILOT_DATA_DIR", "/nonexistent/mixpilot", 1);
+  std::string why;
+  EXPECT_EQ(data_dir(&why), "");
+  EXPECT_NE(why.find("MIXPILOT_DATA_DIR=/nonexistent/mixpilot holds no scenarios/"),
+            std::string::npos) << why;
+  EXPECT_EQ(data_file("scenarios/mi_helix.toml"), "");
+  unsetenv("MIXPILOT_DATA_DIR");
 }
 
 }  // namespace
