@@ -19,7 +19,7 @@ command -v debootstrap >/dev/null || apt-get install -y -qq debootstrap
 root=$(mktemp -d /var/tmp/mixpilot-root.XXXXXX)
 cleanup() {
   umount "$root/proc" 2>/dev/null || true
-  rm -rf --one-file-system "$root"
+  rm -rf --one-file-system "$root" "$root.log"
 }
 trap cleanup EXIT
 echo "debootstrap-test: Debian 12 minbase in $root"
