@@ -93,6 +93,9 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   using Input = typename Model::Input;
   std::string error;
   net::use_loopback_unless_configured();
+  // A vehicle's firmware is real time: this loop and the DDS threads it starts run under
+  // SCHED_FIFO where the system allows (the scope lasts the flight).
+  const net::RealtimeThreadsScope realtime;
   net::VehicleEndpoint link;
   if (!link.open(o.domain, Model::nu, error)) {
     std::fprintf(stderr, "mixpilot vehicle: %s\n", error.c_str());
@@ -143,9 +146,10 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
                                 cmd_step >= 0 ? 1e-9 * double(at - applied_ns) : 0.0, status, x});
   };
 
-  std::printf("mixpilot vehicle: %s (%s) in DDS domain %u, latency %.0f ms each way; waiting "
-              "for a controller (fly --vehicle dds)\n",
-              spec.name.c_str(), spec.model.c_str(), unsigned(o.domain), 1e3 * o.latency_s);
+  std::printf("mixpilot vehicle: %s (%s) in DDS domain %u, latency %.0f ms each way, %s; "
+              "waiting for a controller (fly --vehicle dds)\n",
+              spec.name.c_str(), spec.model.c_str(), unsigned(o.domain), 1e3 * o.latency_s,
+              realtime.granted() ? "SCHED_FIFO" : "normal priority");
   std::fflush(stdout);
   catch_interrupts();
   const std::int64_t started = vehicle_clock_ns();

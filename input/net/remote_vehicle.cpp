@@ -24,6 +24,9 @@ bool RemoteVehicle::start(const Options& options, std::string& error) {
     error = "a vehicle state of " + std::to_string(options.nx) + " values is not supported";
     return false;
   }
+  // A state that waits for a thread is predicted over the wrong horizon: the link's threads
+  // (Cyclone's and the reader) run at the control thread's priority where allowed.
+  const RealtimeThreadsScope realtime;
   if (!participant_.open(options.domain, error)) return false;
   const dds_entity_t p = participant_.handle();
   const dds_entity_t command = dds_create_topic(p, &mixpilot_msgs_msg_dds__RotorCommand__desc,

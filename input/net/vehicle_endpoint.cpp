@@ -14,6 +14,7 @@ constexpr int kTake = 32;
 
 bool VehicleEndpoint::open(std::uint32_t domain, int nu, std::string& error) {
   nu_ = nu;
+  // Cyclone's threads inherit the vehicle loop's real-time priority (app/vehicle.cpp).
   if (!participant_.open(domain, error)) return false;
   const dds_entity_t p = participant_.handle();
   const dds_entity_t command = dds_create_topic(p, &mixpilot_msgs_msg_dds__RotorCommand__desc,
