@@ -6,7 +6,7 @@
 // over the estimated round-trip time; its own plant does not run. The network variant is
 // input/net/remote_vehicle.hpp; core never sees how the bytes travel.
 //
-// Both calls are made on the control thread, never wait and allocate nothing.
+// Its calls are made on the control thread, never wait and allocate nothing.
 #include <chrono>
 #include <cstdint>
 

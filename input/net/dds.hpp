@@ -3,8 +3,10 @@
 // that the configuration in force keeps traffic on this machine. Cyclone reads its
 // configuration from CYCLONEDDS_URI; without one it discovers peers by multicast on every
 // interface, which tests, demos and CI must never do (assets/dds-loopback.xml).
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace mixpilot::net {
 
@@ -52,6 +54,21 @@ class RealtimeThreadsScope {
   int policy_ = 0;
   int priority_ = 0;
   bool granted_ = false;
+};
+
+// The writers heard on a topic (their publication handles), each counted once: how a reader
+// tells a second publisher from its own.
+class WritersHeard {
+ public:
+  // Notes `writer`; returns how many distinct writers have been heard.
+  std::uint32_t note(std::uint64_t writer) {
+    if (std::find(writers_.begin(), writers_.end(), writer) == writers_.end())
+      writers_.push_back(writer);
+    return std::uint32_t(writers_.size());
+  }
+
+ private:
+  std::vector<std::uint64_t> writers_;
 };
 
 // "rt/joy" from "joy", "/joy" or "rt/joy" (ROS 2's topic prefix rule).

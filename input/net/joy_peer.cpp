@@ -79,10 +79,7 @@ void JoyPeer::run() {
       if (!infos[i].valid_data) continue;
       const auto& m = *static_cast<const sensor_msgs_msg_dds__Joy_*>(samples[i]);
       const std::uint64_t writer = infos[i].publication_handle;
-      if (std::find(writers_.begin(), writers_.end(), writer) == writers_.end()) {
-        writers_.push_back(writer);
-        publishers_.store(std::uint32_t(writers_.size()), std::memory_order_relaxed);
-      }
+      publishers_.store(writers_.note(writer), std::memory_order_relaxed);
       const std::int64_t now_steady = input::steady_ns();
       if (pilot_writer_ != 0 && writer != pilot_writer_) {
         if (now_steady - last_taken_ns_ <= handover) {

@@ -75,7 +75,7 @@ class JoyPeer final : public input::StickSource {
   input::StickReading reading_;
   std::uint64_t pilot_writer_ = 0;
   std::int64_t last_stamp_ns_ = 0, last_taken_ns_ = 0;
-  std::vector<std::uint64_t> writers_;
+  WritersHeard writers_;
 
   std::atomic<std::uint64_t> accepted_{0}, bad_value_{0}, bad_size_{0}, stale_{0}, other_{0};
   std::atomic<std::uint32_t> publishers_{0};

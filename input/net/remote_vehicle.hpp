@@ -81,7 +81,7 @@ class RemoteVehicle final : public VehicleLink {
   VehicleSample sample_;
   std::uint64_t vehicle_writer_ = 0;
   std::int64_t last_stamp_ns_ = 0;  // the vehicle's clock at the last state taken
-  std::vector<std::uint64_t> writers_;
+  WritersHeard writers_;
 
   std::atomic<std::uint64_t> accepted_{0}, bad_value_{0}, bad_size_{0}, unknown_{0}, stale_{0},
       other_{0};

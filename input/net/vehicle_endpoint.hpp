@@ -62,7 +62,7 @@ class VehicleEndpoint {
   int nu_ = 4;
   std::uint64_t controller_ = 0;
   std::int64_t last_step_ = -1;
-  std::vector<std::uint64_t> writers_;
+  WritersHeard writers_;
   VehicleEndpointStats stats_;
 };
 
