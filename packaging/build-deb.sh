@@ -31,7 +31,7 @@ rm -f "$build"/mixpilot_*.deb
 (cd "$build" && cpack -G DEB)
 deb=$(ls -t "$build"/mixpilot_*.deb | head -1)
 echo "build-deb: $deb"
-dpkg-deb --info "$deb" | sed -n '/Package:/,$p'
+dpkg-deb --field "$deb" Package Version Depends Recommends Suggests Installed-Size
 [ "$check" -eq 1 ] || exit 0
 
 # lintian: errors fail the build; warnings are printed (packaging/README.md explains them).
