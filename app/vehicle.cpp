@@ -29,6 +29,7 @@
 #include "core/scenario/tracking_scenario.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/vehicle_endpoint.hpp"
+#include "input/realtime_priority.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 
@@ -95,7 +96,7 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   net::use_loopback_unless_configured();
   // A vehicle's firmware is real time: this loop and the DDS threads it starts run under
   // SCHED_FIFO where the system allows (the scope lasts the flight).
-  const net::RealtimeThreadsScope realtime;
+  const input::RealtimeThreadsScope realtime;
   net::VehicleEndpoint link;
   if (!link.open(o.domain, Model::nu, error)) {
     std::fprintf(stderr, "mixpilot vehicle: %s\n", error.c_str());

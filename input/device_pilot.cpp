@@ -29,8 +29,13 @@ bool DevicePilot::command(std::int64_t, double, const Eigen::VectorXd&, PilotCom
     state_ = InputState::lost;
     authority_ = 0.0;
   } else if (state_ == InputState::lost || state_ == InputState::recentre) {
-    state_ = centred(c, settings_.recentre_tolerance) ? InputState::returning
-                                                      : InputState::recentre;
+    // Back: the sticks must read centred for kRecentreHoldS on end. A device's first reports
+    // after it is plugged in can read centred before its sticks do, and a pilot still holding
+    // a stick would then get the authority back deflected.
+    if (state_ == InputState::lost) centred_steps_ = 0;
+    centred_steps_ = centred(c, settings_.recentre_tolerance) ? centred_steps_ + 1 : 0;
+    state_ = double(centred_steps_) * dt_ >= kRecentreHoldS - 1e-9 * dt_ ? InputState::returning
+                                                                         : InputState::recentre;
     returning_steps_ = 0;
   }
   if (state_ == InputState::returning) {

@@ -3,8 +3,8 @@
 // settings, and the input-loss rule. The device is lost when it is disconnected or shows no
 // sign of life for longer than the timeout; from that step the command grants no authority
 // (the controller uses min(λ, 0): the planner flies). When the device is back, the authority
-// stays 0 until the sticks are re-centred, then ramps linearly to 1 over return_time_s, so the
-// commanded attitude never jumps. The state and the authority are part of every command, so
+// stays 0 until the sticks have read centred for kRecentreHoldS, then ramps linearly to 1 over
+// return_time_s, so the commanded attitude never jumps. The state and the authority are part of every command, so
 // recordings replay them exactly.
 #include <cstdint>
 #include <string>
@@ -14,6 +14,10 @@
 #include "input/source.hpp"
 
 namespace mixpilot::input {
+
+// How long the sticks must read centred, without a break, before a device that is back gets
+// the authority again [s].
+inline constexpr double kRecentreHoldS = 0.1;
 
 class DevicePilot final : public PilotSource {
  public:
@@ -40,6 +44,7 @@ class DevicePilot final : public PilotSource {
   InputState state_ = InputState::ok;
   double authority_ = 1.0;
   std::int64_t returning_steps_ = 0;  // steps since the sticks were re-centred
+  std::int64_t centred_steps_ = 0;    // consecutive steps the sticks have read centred
   std::int64_t read_ns_ = 0;
 };
 

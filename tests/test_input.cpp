@@ -288,14 +288,29 @@ TEST(DevicePilot, LossGivesThePlannerTheAuthorityAtOnceAndItReturnsGradually) {
     EXPECT_EQ(c.authority, 0.0);
   }
   src.r.sticks.right_x = 0.04;  // inside the deadzone: centred
+  // Held centred for kRecentreHoldS (7 steps of 15 ms) before the return starts; one read of
+  // a deflected stick in between starts the count again.
+  for (int k = 5; k < 8; ++k) {
+    ASSERT_TRUE(pilot.command(k, 0, x, c));
+    EXPECT_EQ(c.input, InputState::recentre) << k;
+  }
+  src.r.sticks.right_x = 0.5;
+  ASSERT_TRUE(pilot.command(8, 0, x, c));
+  EXPECT_EQ(c.input, InputState::recentre);
+  src.r.sticks.right_x = 0.04;
+  for (int k = 9; k < 15; ++k) {
+    ASSERT_TRUE(pilot.command(k, 0, x, c));
+    EXPECT_EQ(c.input, InputState::recentre) << k;
+    EXPECT_EQ(c.authority, 0.0);
+  }
   double previous = 0.0;
-  for (int k = 5; k < 14; ++k) {
+  for (int k = 15; k < 24; ++k) {
     ASSERT_TRUE(pilot.command(k, 0, x, c));
     EXPECT_EQ(c.input, InputState::returning) << k;
     EXPECT_NEAR(c.authority - previous, 0.1, 1e-12) << k;
     previous = c.authority;
   }
-  ASSERT_TRUE(pilot.command(14, 0, x, c));
+  ASSERT_TRUE(pilot.command(24, 0, x, c));
   EXPECT_EQ(c.input, InputState::ok);
   EXPECT_EQ(c.authority, 1.0);
 }

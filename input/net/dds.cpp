@@ -4,9 +4,6 @@
 
 #include "core/scenario/data_files.hpp"
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -82,22 +79,6 @@ std::string loopback_config_uri() {
 void use_loopback_unless_configured() {
   if (const char* uri = std::getenv("CYCLONEDDS_URI"); !uri || !*uri)
     setenv("CYCLONEDDS_URI", loopback_config_uri().c_str(), 1);
-}
-
-RealtimeThreadsScope::RealtimeThreadsScope() {
-  sched_param old{};
-  if (pthread_getschedparam(pthread_self(), &policy_, &old) != 0) return;
-  priority_ = old.sched_priority;
-  sched_param p{};
-  p.sched_priority = std::min(10, sched_get_priority_max(SCHED_FIFO));
-  granted_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
-}
-
-RealtimeThreadsScope::~RealtimeThreadsScope() {
-  if (!granted_) return;
-  sched_param old{};
-  old.sched_priority = priority_;
-  pthread_setschedparam(pthread_self(), policy_, &old);
 }
 
 Participant::~Participant() { close(); }

@@ -39,23 +39,6 @@ class Participant {
   std::uint32_t domain_ = 0;
 };
 
-// While alive, the calling thread runs under SCHED_FIFO (where the system allows), so the
-// threads it starts inherit it: a control link's threads (Cyclone's receive threads, a reader)
-// then wake as promptly as the control thread. The thread's own scheduling comes back after.
-class RealtimeThreadsScope {
- public:
-  RealtimeThreadsScope();
-  ~RealtimeThreadsScope();
-  RealtimeThreadsScope(const RealtimeThreadsScope&) = delete;
-  RealtimeThreadsScope& operator=(const RealtimeThreadsScope&) = delete;
-  bool granted() const { return granted_; }
-
- private:
-  int policy_ = 0;
-  int priority_ = 0;
-  bool granted_ = false;
-};
-
 // The writers heard on a topic (their publication handles), each counted once: how a reader
 // tells a second publisher from its own.
 class WritersHeard {
