@@ -25,8 +25,6 @@ enum MiChannel {
   kRttSample,
 };
 
-// The longest round-trip time a remote vehicle's prediction covers [s].
-constexpr double kMaxRemoteRtt = 0.5;
 
 }  // namespace
 
@@ -58,7 +56,7 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   step_ = 0;
   steps_total_ = std::int64_t(std::lround(scenario_.duration / dt_));
   const double h = dt_ / substeps_;
-  const int max_substeps = int(std::lround(kMaxRemoteRtt / h));
+  const int max_substeps = int(std::lround(VehicleFeed::kMaxRtt / h));
   predictor_.setup(model_, substeps_, h, 0, max_substeps);
   feed_.setup(models::MikroKopter::nx, dt_, h, max_substeps, 2 * std::size_t(steps_total_) + 2);
   link_ = nullptr;
@@ -132,10 +130,10 @@ void MiMode::measure_remote(double t) {
   now_ns_ = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, step_, now_ns_, substeps_);
   if (r.heard) {
-    const VehicleSample& v = link_->latest();
+    const VehicleSample& v = *r.sample;
     for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
   }
-  if (left_the_world() || (r.heard && link_->latest().left_world)) {
+  if (left_the_world() || (r.heard && r.sample->left_world)) {
     x_ = s.x;  // the last state known inside it
     lost_reason_ = "it left the arena";
   } else if (r.silent_s > link_->timeout_s()) {

@@ -25,8 +25,6 @@ enum TrackingChannel {
   kHorizon,
 };
 
-// The longest round-trip time a remote vehicle's prediction covers [s].
-constexpr double kMaxRemoteRtt = 0.5;
 
 constexpr const char* kRotorSpeedNames[4] = {"rotor speed 1", "rotor speed 2", "rotor speed 3",
                                              "rotor speed 4"};
@@ -79,7 +77,7 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   } else if (SetupResult r = lqr_.setup(model_, c.dt); !r) {
     return r;
   }
-  predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(kMaxRemoteRtt / h_)));
+  predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(VehicleFeed::kMaxRtt / h_)));
   link_ = nullptr;
   feed_.setup(models::Crazyflie::nx, c.dt, h_, predictor_.max_substeps(),
               2 * std::size_t(steps_total_) + 2);
@@ -289,7 +287,7 @@ bool TrackingMode::step_remote() {
   const long k = long(step_);
   const std::int64_t now = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
-  const VehicleSample& v = link_->latest();
+  const VehicleSample& v = *r.sample;
   if (r.fresh) sample_at(r.sigma, State(v.x));
   const double t = double(k) * scenario_.controller.dt;
   y_ = r.heard ? State(v.x) : x_init_;

@@ -12,13 +12,18 @@
 
 #include "core/control/rtt_estimator.hpp"
 #include "core/modes/vehicle_link.hpp"
+#include "core/numerics/stats.hpp"
 
 namespace mixpilot {
 
 class VehicleFeed {
  public:
+  // The longest round-trip time a prediction covers [s].
+  static constexpr double kMaxRtt = 0.5;
+
   // What step k learns.
   struct Reading {
+    const VehicleSample* sample = nullptr;  // the state read (the link's, valid for this step)
     bool heard = false;      // a state of the right size has arrived (else: the start state)
     bool fresh = false;      // it is new since the last step, and it echoes a command
     double sigma = 0.0;      // fresh: when it was measured on the controller's clock, t_j + a [s]
@@ -43,8 +48,10 @@ class VehicleFeed {
   // Step k at `now` (link.now_ns()); substeps_per_period: of the predictor.
   Reading read(VehicleLink& link, std::int64_t k, std::int64_t now, int substeps_per_period) {
     if (k == 0) t0_ns_ = now;
+    // Read once: the link may hand over a newer state at any call.
     const VehicleSample& v = link.latest();
     Reading r;
+    r.sample = &v;
     r.heard = v.serial != 0 && v.x.size() == nx_;
     if (r.heard && v.serial != last_serial_) {
       last_serial_ = v.serial;
@@ -72,13 +79,7 @@ class VehicleFeed {
 
   const RttEstimator& rtt() const { return rtt_; }
   // The median of the samples kept [s] (0 without any). Allocates: not for the loop.
-  double measured_median() const {
-    if (samples_.empty()) return 0.0;
-    std::vector<double> v = samples_;
-    const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  }
+  double measured_median() const { return percentile(samples_, 0.5); }
   std::size_t sample_count() const { return samples_.size(); }
   double horizon_s() const { return double(horizon_substeps_) * h_; }
 

@@ -12,6 +12,10 @@ constexpr int kTake = 32;
 }  // namespace
 
 bool VehicleEndpoint::open(std::uint32_t domain, int nu, std::string& error) {
+  if (nu < 1 || nu > VehicleCommand::kMaxInputs) {
+    error = "a vehicle of " + std::to_string(nu) + " inputs is not supported";
+    return false;
+  }
   nu_ = nu;
   // Cyclone's threads inherit the vehicle loop's real-time priority (app/vehicle.cpp).
   if (!participant_.open(domain, error)) return false;
@@ -57,8 +61,9 @@ void VehicleEndpoint::wait(std::int64_t timeout_ns, std::vector<VehicleCommand>&
     controller_ = writer;
     last_step_ = m.step;
     ++stats_.accepted;
-    out.push_back(VehicleCommand{m.step, m.stamp_ns, false,
-                                 std::vector<double>(m.u._buffer, m.u._buffer + nu_)});
+    VehicleCommand c{m.step, m.stamp_ns, false, {}};
+    std::copy_n(m.u._buffer, nu_, c.u.begin());
+    out.push_back(c);
   }
   if (n > 0) dds_return_loan(reader_, samples, n);
 }

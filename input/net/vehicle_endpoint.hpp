@@ -7,6 +7,7 @@
 // A command is taken only when it has nu finite values, a step after the last one taken, and
 // comes from the first controller heard (another writer's commands are rejected and counted).
 // The closing command (end = true) is always taken from that controller.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -16,10 +17,11 @@
 namespace mixpilot::net {
 
 struct VehicleCommand {
+  static constexpr int kMaxInputs = 8;  // the IDL's bound
   std::int64_t step = -1;
   std::int64_t stamp_ns = 0;
   bool end = false;
-  std::vector<double> u;  // nu
+  std::array<double, kMaxInputs> u{};  // the first nu
 };
 
 struct VehicleEndpointStats {
