@@ -307,19 +307,19 @@ bool TrackingMode::step_remote() {
     return true;
   }
 
+  // What is known of the vehicle at t_k is the newest state predicted over its age; the
+  // controller starts from it only with compensation, the telemetry always shows it (the
+  // newest state itself is a round trip old: its error would be the delay's, not the loop's).
   const auto t0 = std::chrono::steady_clock::now();
-  if (scenario_.controller.compensation) {
-    predictor_.predict(y_, x0_, r.horizon_substeps);
-  } else {
-    x0_ = y_;
-  }
-  predict_us_.push_back(microseconds_since(t0));
+  predictor_.predict(y_, predicted_, r.horizon_substeps);
+  x0_ = scenario_.controller.compensation ? predicted_ : y_;
+  predict_us_.push_back(scenario_.controller.compensation ? microseconds_since(t0) : 0.0);
   control();
   send();
   link_->send(k, now, u_.data(), int(u_.size()));
 
   set_telemetry();
-  telemetry_.x = y_;
+  telemetry_.x = predicted_;
   set_channels(predict_us_.back(), solve_us_.back());
   ++step_;
   finished_ = step_ >= steps_total_;

@@ -23,7 +23,8 @@
 // command j in effect when it was measured and how long that command had acted (a); each new
 // state is one round-trip sample for the estimator (core/control/rtt_estimator.hpp) and one
 // error sample at σ = t_j + a. With compensation the state is predicted over the estimated
-// round-trip time plus the time it waited here since it arrived. The vehicle is lost when its
+// round-trip time plus the time it waited here since it arrived; the telemetry shows that
+// prediction (what is known of the vehicle at t_k). The vehicle is lost when its
 // state leaves the world or it stays silent past the link's timeout.
 //
 // setup() sizes everything; step() allocates nothing.
@@ -162,6 +163,7 @@ class TrackingMode final : public Mode {
   // Step k: the measurement, the controller's initial state, the command.
   State y_ = State::Zero();
   State x0_ = State::Zero();
+  State predicted_ = State::Zero();  // remote: the newest state predicted to t_k
   Input u_ = Input::Zero();
 
   // Error samples m = 0..K at boundaries m·s + n_c (σ = t_m).
