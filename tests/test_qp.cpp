@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <memory>
 
 #include <sstream>
 
@@ -1072,6 +1073,45 @@ TEST(QpRiccatiIpmFailure, SemidefiniteStateCostIsFine) {
   OcpQpSolution sol(qp.dims);
   ASSERT_EQ(solver.solve(qp, sol), QpStatus::success);
   EXPECT_LE(std::abs(sol.objective - ref.objective) / std::max(1.0, std::abs(ref.objective)), 1e-7);
+}
+
+// A state without curvature in the cost-to-go (the mixed-initiative cost at λ = 0 leaves φ, θ
+// and Ω unweighted at the terminal stage) and a warm start whose multipliers π do not vanish
+// there: the stationarity residual then has a component along P's null space that the Newton
+// direction must remove (Δπ = P Δx + g needs all of g), or the solve stalls at that residual.
+TEST(QpRiccatiIpmFailure, SemidefiniteStateCostWarmStartedFromOtherMultipliers) {
+  RandomQpSpec s = spec(6, 3, 3, 2, 0, 0.0);
+  s.all_bounds = true;
+  s.absent_side = 0.0;
+  const OcpQp pd = testing_qp::random_qp(s, 51);
+  OcpQp qp = pd;
+  for (int i = 0; i <= qp.dims.N; ++i) {  // state 0 free of cost everywhere
+    qp.stage[i].Q.row(0).setZero();
+    qp.stage[i].Q.col(0).setZero();
+    qp.stage[i].q(0) = 0.0;
+    if (i < qp.dims.N) qp.stage[i].S.col(0).setZero();
+    for (int k = 0; k < qp.stage[i].idxbx.size(); ++k)  // and unbounded: no barrier curvature
+      if (qp.stage[i].idxbx(k) == 0) qp.stage[i].lbx(k) = -1e30, qp.stage[i].ubx(k) = 1e30;
+  }
+  const testing_qp::DenseSolution ref = testing_qp::dense_reference(qp);
+  ASSERT_TRUE(ref.certified);
+  const testing_qp::DenseQp D = testing_qp::densify(qp);
+  for (const bool pairs : {false, true}) {
+    SCOPED_TRACE(pairs ? "pairs" : "plain");
+    std::unique_ptr<QpSolver> solver;
+    if (pairs) solver = std::make_unique<QpRiccatiIpmPairs>(qp.dims, tight());
+    else solver = std::make_unique<QpRiccatiIpm>(qp.dims, tight());
+    OcpQpSolution warm(qp.dims);
+    if (pairs) solver->prepare(pd);
+    ASSERT_EQ(solver->solve(pd, warm), QpStatus::success);
+    for (auto& pi : warm.pi) pi(0) += 1.0;  // multipliers of another problem
+    if (pairs) solver->prepare(qp);
+    ASSERT_EQ(solver->solve(qp, warm, QpWarmStart::primal_dual), QpStatus::success)
+        << "iterations " << warm.iterations << " stationarity " << warm.res_stat;
+    const Eigen::VectorXd z = testing_qp::to_dense(D, qp.dims, warm);
+    EXPECT_LE((z - ref.z).lpNorm<Eigen::Infinity>() / std::max(1.0, ref.z.lpNorm<Eigen::Infinity>()),
+              1e-6);
+  }
 }
 
 TEST(QpRiccatiIpmFailure, NanOrInfInData) {

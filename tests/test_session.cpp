@@ -146,6 +146,51 @@ TEST(MixedInitiative, SafetyConstraintsStopARecklessPilotNearAnObstacle) {
   expect_plant_bounds(safe);
 }
 
+// The novice until t_lost, then its input lost (authority 0, as a device reports it): λ = 0.
+class LosesInput final : public PilotSource {
+ public:
+  LosesInput(std::unique_ptr<PilotSource> pilot, double t_lost)
+      : pilot_(std::move(pilot)), t_lost_(t_lost) {}
+  std::string name() const override { return "loses-input"; }
+  bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override {
+    if (!pilot_->command(step, t, x, out)) return false;
+    if (t >= t_lost_) {
+      out.authority = 0.0;
+      out.input = InputState::lost;
+    }
+    return true;
+  }
+
+ private:
+  std::unique_ptr<PilotSource> pilot_;
+  double t_lost_;
+};
+
+// While the input is lost the planner flies alone (λ = 0: the pilot's ν has no weight, so φ, θ
+// and Ω carry no cost at the last node): every QP of the 10 s is solved, warm-started as the
+// loop does, and the vehicle stays inside B.
+TEST(MixedInitiative, ThePlannerFliesEveryStepWhileTheInputIsLost) {
+  Scenario sc = mi_helix();
+  sc.duration = 15.0;
+  MiMode mode;
+  ASSERT_TRUE(mode.setup(sc, std::make_unique<LosesInput>(make_pilot(sc, "novice"), 5.0)));
+  int lost_steps = 0, fallbacks = 0;
+  double deviation = 0.0;
+  while (mode.step()) {
+    const Telemetry& s = mode.telemetry();
+    if (s.pilot.input != InputState::lost) continue;
+    ++lost_steps;
+    EXPECT_EQ(s.lambda, 0.0);
+    fallbacks += s.stats.status != RtiStatus::success;
+    deviation = std::max(deviation, (s.x.head<3>() - s.reference).norm());
+  }
+  EXPECT_EQ(lost_steps, 666);  // t = 5.01 s (step 334) to the end (step 999)
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_EQ(mode.score().fallbacks, 0);
+  EXPECT_LE(deviation, sc.controller.ph.r);
+  EXPECT_FALSE(mode.lost());
+}
+
 // Every sample of a session, for exact comparisons.
 struct TraceSink final : TelemetrySink {
   std::vector<Eigen::VectorXd> x, u;

@@ -56,6 +56,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   w.Hfull.assign(n1, {});
   w.inv_diag.assign(n1, {});
   w.Dinv.assign(n1, {});
+  w.pivot_floor.assign(n1, 0.0);
   w.tmp.assign(n1, {});
   int ov = 0, op = 0, os = 0, om = 0, oc = 0;
   for (int i = 0; i <= N; ++i) {
@@ -135,6 +136,8 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     w.Hfull[i].topRightCorner(nu, nx) = s.S;
     w.Hfull[i].bottomLeftCorner(nx, nu) = s.S.transpose();
     w.Hfull[i].bottomRightCorner(nx, nx) = s.Q;
+    const double scale = nu + nx > 0 ? w.Hfull[i].diagonal().cwiseAbs().maxCoeff() : 0.0;
+    w.pivot_floor[i] = settings_.psd_tol * (scale > 0.0 ? scale : 1.0);
     for (int k = 0; k < nbu; ++k) w.var_of_box[i][k] = s.idxbu[k];
     for (int k = 0; k < nbx; ++k) w.var_of_box[i][nbu + k] = nu + s.idxbx[k];
     w.soft_of[i].setConstant(-1);
@@ -411,6 +414,7 @@ bool QpRiccatiIpm::factorize(const OcpQp& qp) {
     }
     if (!kernels::syrk_potrf_ln_padded(nf, nx1 + ng, Y.data(), static_cast<int>(Y.rows()),
                                        L.data(), ld, nu, w.inv_diag[i].data(), settings_.psd_tol,
+                                       w.pivot_floor[i],
                                        w.Dinv[i].data(), static_cast<int>(w.Dinv[i].rows())))
       return false;
   }

@@ -45,7 +45,10 @@ struct QpRiccatiIpmWorkspace {
                                             // factor, strict upper triangle zero (stage 0: uu
                                             // block only)
   std::vector<Eigen::MatrixXd> Y;           // np x (nx_{i+1} + ng): [BAt · Lx_{i+1}, ∇gᵀ W̃^½]
-  std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L), 0 for zero pivots
+  std::vector<Eigen::VectorXd> inv_diag;    // nu+nx: 1 / diag(L)
+  std::vector<double> pivot_floor;          // psd_tol · the largest |diagonal| of [R S; Sᵀ Q]
+                                            // (1 if none): the pivot of a direction without
+                                            // curvature
   std::vector<Eigen::MatrixXd> Dinv;        // max(np, 4) x 4: inverses of L's 4 x 4 diagonal
                                             // blocks (rows jb..jb+3 for block jb)
   std::vector<Eigen::VectorXd> tmp;         // max(nx_{i+1}, nc): scratch per stage

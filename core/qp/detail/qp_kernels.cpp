@@ -1,5 +1,6 @@
 #include "core/qp/detail/qp_kernels.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -35,7 +36,8 @@ void syrk_ln(int n, int m, const double* Y, int ldy, double* C, int ldc) {
   }
 }
 
-bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol) {
+bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol,
+             double pivot_floor) {
   for (int j = 0; j < n; ++j) {
     double* cj = C + static_cast<ptrdiff_t>(j) * ldc;
     const double d0 = std::abs(cj[j]);
@@ -44,18 +46,15 @@ bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double p
       const double a = ck[j];
       for (int r = j; r < n; ++r) cj[r] -= a * ck[r];
     }
-    const double p = cj[j];
-    if (p > 0.0) {
-      const double s = std::sqrt(p), is = 1.0 / s;
-      inv_diag[j] = is;
-      cj[j] = s;
-      for (int r = j + 1; r < n; ++r) cj[r] *= is;
-    } else if ((j >= n_strict || d0 > 0.0) && p >= -psd_tol * d0) {
-      inv_diag[j] = 0.0;
-      for (int r = j; r < n; ++r) cj[r] = 0.0;
-    } else {
-      return false;
+    double p = cj[j];
+    if (!(p > pivot_floor)) {
+      if (!((j >= n_strict || d0 > 0.0) && p >= -psd_tol * d0)) return false;
+      p = std::max(pivot_floor, psd_tol * d0);  // no curvature: regularized (see the header)
     }
+    const double s = std::sqrt(p), is = 1.0 / s;
+    inv_diag[j] = is;
+    cj[j] = s;
+    for (int r = j + 1; r < n; ++r) cj[r] *= is;
   }
   return true;
 }
@@ -286,7 +285,8 @@ void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int
 }
 
 bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int ldc, int n_strict,
-                          double* inv_diag, double psd_tol, double* dinv, int lddinv) {
+                          double* inv_diag, double psd_tol, double pivot_floor, double* dinv,
+                          int lddinv) {
 #if defined(__AVX2__) && defined(__FMA__)
   const int np = pad4(n);
   double d0[4];
@@ -307,18 +307,14 @@ bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int
         const double l = C[j + static_cast<ptrdiff_t>(jb + cc) * ldc];
         p -= l * l;
       }
-      double is;
-      if (p > 0.0) {
-        const double sq = std::sqrt(p);
-        is = 1.0 / sq;
-        cj[j] = sq;
-      } else if ((j >= n_strict || d0[c] + row_norm2(m, Y + j, ldy) > 0.0) &&
-                 p >= -psd_tol * std::abs(d0[c] + row_norm2(m, Y + j, ldy))) {
-        is = 0.0;
-        cj[j] = 0.0;
-      } else {
-        return false;
+      if (!(p > pivot_floor)) {
+        const double mag = std::abs(d0[c] + row_norm2(m, Y + j, ldy));
+        if (!((j >= n_strict || mag > 0.0) && p >= -psd_tol * mag)) return false;
+        p = std::max(pivot_floor, psd_tol * mag);  // no curvature: regularized (see the header)
       }
+      const double sq = std::sqrt(p);
+      const double is = 1.0 / sq;
+      cj[j] = sq;
       inv_diag[j] = is;
       for (int r = 0; r < c; ++r) cj[jb + r] = 0.0;  // keep the strict upper triangle zero
       // Rows below the diagonal inside the block (scalar), then the panel in 4-row vectors.
@@ -343,7 +339,7 @@ bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int
   return true;
 #else
   syrk_ln(n, m, Y, ldy, C, ldc);
-  if (!potrf_l(n, n_strict, C, ldc, inv_diag, psd_tol)) return false;
+  if (!potrf_l(n, n_strict, C, ldc, inv_diag, psd_tol, pivot_floor)) return false;
   for (int jb = 0; jb < n; jb += 4)
     diag_block_inverse(jb, n - jb >= 4 ? 4 : n - jb, C, ldc, inv_diag, dinv, lddinv);
   return true;

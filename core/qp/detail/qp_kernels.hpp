@@ -12,14 +12,19 @@ void trmm_rl(int n, int m, const double* A, int lda, const double* L, int ldl, d
 void syrk_ln(int n, int m, const double* Y, int ldy, double* C, int ldc);
 
 // In-place lower Cholesky C = L Lᵀ (IPM blocks are ill-conditioned by design, so pivots are not
-// compared with a relative threshold). A pivot p ≤ 0 with p ≥ −psd_tol·|C_jj| zeroes the column
-// (inv_diag = 0, a pseudo-factor) when the column is a state column (j ≥ n_strict: a positive
-// semidefinite cost-to-go) or C_jj > 0 (an input column whose Schur complement vanished to
-// rounding error under huge barrier weights). Otherwise — negative curvature, or an input with no
-// curvature at all — returns false.
-bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol);
+// compared with a relative threshold). A pivot p ≤ pivot_floor with p ≥ −psd_tol·|C_jj| is a
+// direction without curvature: of a state column (j ≥ n_strict: a positive semidefinite
+// cost-to-go) or of an input column with C_jj > 0 (its Schur complement vanished to rounding error
+// under huge barrier weights). It is regularized to max(pivot_floor, psd_tol·|C_jj|) > 0 (C_jj
+// before the elimination), not dropped: the Riccati
+// recursion forms Δπ = L (Lᵀ Δx + L⁻¹ g), which keeps g's component along that direction only if
+// L is invertible (a zero column would lose it, and a warm start whose multipliers leave a residual
+// there would never converge). Otherwise — negative curvature, or an input with no curvature at
+// all — returns false.
+bool potrf_l(int n, int n_strict, double* C, int ldc, double* inv_diag, double psd_tol,
+             double pivot_floor);
 
-// x ← L⁻¹ x (zero pivots give zero components), with dinv the inverses of L's 4 x 4 diagonal
+// x ← L⁻¹ x (zero pivots, inv_diag 0, give zero components), with dinv the inverses of L's 4 x 4 diagonal
 // blocks as syrk_potrf_ln_padded stores them.
 void trsv_ln(int n, const double* L, int ldl, const double* dinv, int lddinv, double* x);
 // x ← L⁻ᵀ x.
@@ -43,7 +48,8 @@ void trmm_rl_padded(int n, int m, const double* A, int lda, const double* L, int
 // dinv, zero above the diagonal; ld ≥ pad4(n)) for trsv_ln: its substitution chains become
 // matrix-vector products.
 bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int ldc, int n_strict,
-                          double* inv_diag, double psd_tol, double* dinv, int lddinv);
+                          double* inv_diag, double psd_tol, double pivot_floor, double* dinv,
+                          int lddinv);
 // y (m) += A x (A m x n);  y (n) += Aᵀ x (A m x n). Exact row counts, no padding needed.
 void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
 // C += A B with A m x k, B k x n, C m x n (column-major, any leading dimensions): 8 x 4 register
