@@ -43,10 +43,7 @@ std::optional<InputSettings> parse_settings(std::string_view text, const std::st
                                             std::string& error) {
   Diagnostics d(source_name);
   toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    add_syntax_error(d, e, text);
+  if (!parse_toml(text, source_name, d, root)) {
     error = d.str();
     return std::nullopt;
   }

@@ -210,6 +210,21 @@ TEST(Settings, EveryKeyRefusesWhatIsOutsideItsRange) {
   }
 }
 
+// The settings file is TOML too: nesting beyond the bound is refused at its position (a key of
+// 50 000 parts crashed the reader), and a byte-order mark or CR line ends are read as written.
+TEST(InputSettings, DeepNestingIsRefusedAndEditorsLineEndsAreRead) {
+  std::string key = "a";
+  for (int i = 0; i < 50000; ++i) key += ".a";
+  std::string error;
+  EXPECT_FALSE(parse_settings("mode = 2\n" + key + " = 1\n", "in.toml", error));
+  EXPECT_NE(error.find("in.toml:2:"), std::string::npos) << error;
+  EXPECT_NE(error.find("nested more than"), std::string::npos) << error;
+  const auto s = parse_settings("\xEF\xBB\xBFmode = 3\rmax_tilt_deg = 20\r", "in.toml", error);
+  ASSERT_TRUE(s) << error;
+  EXPECT_EQ(s->mode, 3);
+  EXPECT_EQ(s->max_tilt_deg, 20.0);
+}
+
 TEST(Settings, AMissingFileGivesTheDefaultsAndSavedFilesLoad) {
   const std::string dir = test::fresh_path("input", "settings").string();
   bool exists = true;

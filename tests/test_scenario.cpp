@@ -328,6 +328,89 @@ TEST(Scenario, MissingFile) {
   EXPECT_EQ(error, "no/such/scenario.toml: cannot open file (No such file or directory)");
 }
 
+// Deep nesting, the ways TOML has to nest, about n levels each (key parts and arrays): beyond
+// the bound each is refused at its position before the parser sees it (a key of 50 000 parts
+// overflowed toml++'s stack: SIGSEGV), through every TOML reader of the engine.
+std::vector<std::pair<std::string, std::string>> deep_tomls(int n) {
+  std::string dotted = "a", header = "[a", arrays, tables;
+  for (int i = 1; i < n; ++i) dotted += ".a", header += ".a";
+  for (int i = 0; i < n; ++i) arrays += '[';
+  for (int i = 0; i < n; ++i) arrays += ']';
+  for (int i = 0; i < n; ++i) tables += "{a = ";
+  tables += '1';
+  for (int i = 0; i < n; ++i) tables += '}';
+  std::string mixed;  // three levels each: the array and two key parts
+  for (int i = 0; i < n / 3; ++i) mixed += "[{a.b = ";
+  mixed += '1';
+  for (int i = 0; i < n / 3; ++i) mixed += "}]";
+  return {{"dotted key", dotted + " = 1\n"},
+          {"table header", header + "]\nx = 1\n"},
+          {"array of tables header", "[" + header + "]]\nx = 1\n"},
+          {"arrays", "x = " + arrays + "\n"},
+          {"inline tables", "x = " + tables + "\n"},
+          {"arrays of inline tables with dotted keys", "x = " + mixed + "\n"}};
+}
+
+TEST(Scenario, NestingBeyondTheBoundIsRefusedByEveryReader) {
+  const std::string mode = "mode = \"mixed_initiative\"\n";
+  for (const int n : {33, 50000}) {
+    for (const auto& [shape, body] : deep_tomls(n)) {
+      SCOPED_TRACE(shape + " of depth " + std::to_string(n));
+      const std::string text = mode + "# nested\n" + body;
+      std::string e1, e2, e3, e4, e5;
+      EXPECT_FALSE(parse_scenario(text, "d.toml", e1));
+      EXPECT_FALSE(scenario_mode(text, "d.toml", e2));
+      EXPECT_FALSE(parse_tracking_scenario(text, "d.toml", e3));
+      EXPECT_FALSE(parse_pendubot_scenario(text, "d.toml", e4));
+      EXPECT_FALSE(parse_obstacle_scenario(text, "d.toml", e5));
+      for (const std::string* e : {&e1, &e2, &e3, &e4, &e5})
+        EXPECT_TRUE(std::regex_search(*e, std::regex("^d\\.toml:3:[0-9]+: TOML syntax: nested more "
+                                                     "than 32 levels deep")))
+            << *e;
+    }
+  }
+  // Depth 32 is allowed (the parser then judges the content: here an unknown key).
+  for (const auto& [shape, body] : deep_tomls(31)) {
+    SCOPED_TRACE(shape);
+    std::string e;
+    EXPECT_FALSE(parse_scenario(mode + body, "d.toml", e));
+    EXPECT_EQ(e.find("nested more than"), std::string::npos) << e;
+  }
+}
+
+// Nesting is counted in keys and containers, never in strings, comments or values.
+TEST(Scenario, NestingCountsNeitherStringsNorCommentsNorNumbers) {
+  const std::string dots(200, '.');
+  std::string e;
+  EXPECT_TRUE(parse_scenario(std::string(kHead) + "# " + dots + "\n[controller]\ndt = 0.015 # " +
+                                 dots + "\n",
+                             "t.toml", e))
+      << e;
+  // A quoted key with many dots is one part; brackets in strings are not arrays.
+  for (const std::string& body :
+       {"\"" + dots + "\" = 1\n", "x = \"" + std::string(100, '[') + "\"\n",
+        "x = '" + std::string(100, '{') + "'\n",
+        "x = \"\"\"\n" + std::string(100, '{') + "\\\"\"\"\n\"\"\"\n",
+        "x = [" + std::string(50, '1') + ".5, 2.5e3, 1979-05-27T07:32:00Z]\n"}) {
+    const std::string err = error_of(body);
+    EXPECT_FALSE(err.empty());  // unknown keys all, but never for their depth
+    EXPECT_EQ(err.find("nested"), std::string::npos) << err;
+  }
+}
+
+// What editors write: a UTF-8 byte-order mark and CR-only or CR LF line ends read as LF.
+TEST(Scenario, ByteOrderMarkAndLineEndsOfAnyEditor) {
+  std::string error;
+  const std::string text = std::string(kHead) + "[controller]\ndt = 0.02\n";
+  for (const std::string& variant :
+       {"\xEF\xBB\xBF" + text, std::regex_replace(text, std::regex("\n"), "\r"),
+        std::regex_replace(text, std::regex("\n"), "\r\n")}) {
+    const auto sc = parse_scenario(variant, "t.toml", error);
+    ASSERT_TRUE(sc) << error;
+    EXPECT_EQ(sc->controller.dt, 0.02);
+  }
+}
+
 // --- Ranges (docs/scenario-format.md, "Ranges"): each value below was accepted by the loaders
 // before they had ranges, and then crashed, hung or gave nonsense in flight.
 

@@ -1,34 +1,163 @@
 #pragma once
-// Inputs are regular files of bounded size: a FIFO would block a reader, /dev/zero never ends,
-// and a huge file must not be read into memory. One check for every reader of the engine.
+// Reading what a user hands the program, one way for every reader: inputs are regular files of
+// bounded size (a FIFO would block a reader, /dev/zero never ends, a huge file must not be read
+// into memory), text comes in whatever line ends and byte-order mark an editor wrote, and any of
+// it echoed in a message is made printable first (a terminal must never receive its escape
+// sequences from a file).
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <string>
+#include <string_view>
 
 namespace mixpilot {
 
-// True when `path` is a regular file of at most max_bytes; otherwise false with
-// "<path>: cannot open file (<system's reason>)", "<path>: expected a regular file, got ..." or
-// "<path>: N bytes, more than the M ...".
+namespace input_file_detail {
+
+inline std::string kind_of(mode_t m) {
+  if (S_ISDIR(m)) return "a directory";
+  if (S_ISFIFO(m)) return "a named pipe";
+  if (S_ISSOCK(m)) return "a socket";
+  if (S_ISCHR(m) || S_ISBLK(m)) return "a device";
+  return "a special file";
+}
+
+inline std::string too_big(const std::string& path, long long size, long long max_bytes) {
+  return path + ": " + std::to_string(size) + " bytes, more than the " +
+         std::to_string(max_bytes) + " such a file may have";
+}
+
+}  // namespace input_file_detail
+
+// True when `path` names a regular file of at most max_bytes; otherwise false with
+// "<path>: cannot open file (<system's reason>)", "<path>: expected a regular file, got a
+// directory" or "<path>: N bytes, more than the M such a file may have". An empty path is
+// refused as such (it would otherwise read as the current folder or "no such file").
 inline bool check_input_file(const std::string& path, long long max_bytes, std::string& error) {
+  if (path.empty()) {
+    error = "an empty file name was given where a file is expected";
+    return false;
+  }
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     error = path + ": cannot open file (" + std::strerror(errno) + ")";
     return false;
   }
   if (!S_ISREG(st.st_mode)) {
-    error = path + ": expected a regular file, got " +
-            (S_ISDIR(st.st_mode) ? "a directory" : "a special file");
+    error = path + ": expected a regular file, got " + input_file_detail::kind_of(st.st_mode);
     return false;
   }
   if (st.st_size > max_bytes) {
-    error = path + ": " + std::to_string(st.st_size) + " bytes, more than the " +
-            std::to_string(max_bytes) + " such a file may have";
+    error = input_file_detail::too_big(path, st.st_size, max_bytes);
     return false;
   }
   return true;
+}
+
+// The whole content of a regular file of at most max_bytes, with check_input_file()'s errors.
+// The file is opened without blocking and checked on the open descriptor, so a FIFO put in
+// place between a check and the read cannot hang the reader.
+inline bool read_input_file(const std::string& path, long long max_bytes, std::string& text,
+                            std::string& error) {
+  if (!check_input_file(path, max_bytes, error)) return false;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    error = path + ": cannot open file (" + std::strerror(errno) + ")";
+    return false;
+  }
+  struct stat st {};
+  bool ok = ::fstat(fd, &st) == 0;
+  if (!ok) {
+    error = path + ": cannot open file (" + std::strerror(errno) + ")";
+  } else if (!S_ISREG(st.st_mode)) {
+    ok = false;
+    error = path + ": expected a regular file, got " + input_file_detail::kind_of(st.st_mode);
+  }
+  std::string out;
+  char buf[1 << 16];
+  while (ok) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      ok = false;
+      error = path + ": read error (" + std::strerror(errno) + ")";
+    } else if (static_cast<long long>(out.size()) + n > max_bytes) {  // it grew while read
+      ok = false;
+      error = input_file_detail::too_big(path, static_cast<long long>(out.size()) + n, max_bytes);
+    } else {
+      out.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+  ::close(fd);
+  if (ok) text = std::move(out);
+  return ok;
+}
+
+// Text as a reader of lines wants it: a leading UTF-8 byte-order mark dropped, CR LF and lone
+// CR line ends (old Mac editors, some spreadsheet exports) made LF.
+inline std::string normalize_text(std::string_view text) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\r') {
+      out += '\n';
+      if (i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+// `text` safe to print inside quotes: control characters and bytes that are not UTF-8 appear
+// as \xNN (escape sequences never reach the terminal), a quote as \", and anything beyond
+// max_chars is cut with "…".
+inline std::string printable(std::string_view text, std::size_t max_chars = 60) {
+  std::string out;
+  std::size_t chars = 0;
+  const auto hex = [&](unsigned char c) {
+    char b[8];
+    std::snprintf(b, sizeof b, "\\x%02X", c);
+    out += b;
+  };
+  for (std::size_t i = 0; i < text.size();) {
+    if (chars == max_chars) {
+      out += "…";
+      break;
+    }
+    const auto c = static_cast<unsigned char>(text[i]);
+    std::size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool valid = len > 0 && i + len <= text.size();
+    for (std::size_t k = 1; valid && k < len; ++k)
+      valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+    if (valid && len == 2) valid = c >= 0xC2;  // no overlong forms
+    if (!valid) {
+      hex(c);
+      ++i;
+    } else if (len == 1 && (c < 0x20 || c == 0x7F)) {
+      hex(c);
+      ++i;
+    } else if (len == 1 && (c == '"' || c == '\\')) {
+      out += '\\';
+      out += char(c);
+      ++i;
+    } else if (len == 2 && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0) {
+      hex(c);  // C1 controls (U+0080..U+009F), e.g. the 8-bit CSI
+      hex(static_cast<unsigned char>(text[i + 1]));
+      i += 2;
+    } else {
+      out.append(text.substr(i, len));
+      i += len;
+    }
+    ++chars;
+  }
+  return out;
 }
 
 }  // namespace mixpilot

@@ -275,20 +275,7 @@ std::optional<Scenario> load_scenario(const std::string& path, std::string& erro
 }
 
 bool read_text_file(const std::string& path, std::string& text, std::string& error) {
-  if (!check_input_file(path, kMaxTextFileBytes, error)) return false;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = path + ": cannot open file (" + std::strerror(errno) + ")";
-    return false;
-  }
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) {
-    error = path + ": read error (" + std::strerror(errno) + ")";
-    return false;
-  }
-  text = s.str();
-  return true;
+  return read_input_file(path, kMaxTextFileBytes, text, error);
 }
 
 std::optional<double> reference_leaves_arena(const Scenario& sc, double duration) {

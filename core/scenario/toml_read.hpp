@@ -8,6 +8,8 @@
 // catch toml::parse_error themselves.
 #include <toml++/toml.h>
 
+#include "core/numerics/input_file.hpp"
+
 #include <Eigen/Core>
 #include <algorithm>
 #include <charconv>
@@ -410,9 +412,132 @@ inline void add_syntax_error(Diagnostics& d, const toml::parse_error& e, std::st
   d.add(pos_of(e.source()), "TOML syntax", desc);
 }
 
+// Deepest nesting a mixpilot TOML file may use: keys of tables of arrays of inline tables, a
+// handful of levels; anything near this bound is not a settings file.
+inline constexpr int kMaxTomlNesting = 32;
+
+// Where `text` nests deeper than kMaxTomlNesting, before a parser sees it: toml++ recurses per
+// dotted-key part and per table-header part and has no bound of its own there, so a key of
+// 50 000 parts overflows the stack. Depth is that of the document's tree: one level per key
+// part (of dotted keys, keys in inline tables and [table.header]s) and per array. Strings and
+// comments are skipped;
+// dots in values (numbers, dates) are not key parts. A text that is not TOML is left to the
+// parser's own errors: only the depth is judged here.
+inline std::optional<Pos> too_deep(std::string_view text) {
+  enum class Ctx { key, value };
+  struct Open {
+    char c;     // '[' array, '{' inline table
+    int parts;  // parts of the key whose value it opens
+  };
+  std::vector<Open> open;
+  Ctx ctx = Ctx::key;
+  int parts = 1;        // parts of the current key
+  int outer = 0;        // levels of the open arrays and inline tables and of their keys
+  bool header = false;  // inside a [table] or [[array.of.tables]] header
+  std::uint32_t line = 1, col = 1;
+  std::size_t i = 0;
+  const auto advance = [&](std::size_t n) {
+    for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
+      if (text[i] == '\n') ++line, col = 1;
+      else ++col;
+    }
+  };
+  const auto skip_string = [&] {
+    const char q = text[i];
+    const std::string_view delim = text.substr(i, 3) == std::string_view(q == '"' ? "\"\"\"" : "'''")
+                                       ? text.substr(i, 3)
+                                       : text.substr(i, 1);
+    advance(delim.size());
+    while (i < text.size()) {
+      if (q == '"' && text[i] == '\\') {
+        advance(2);  // an escape, \" included
+      } else if (text.substr(i, delim.size()) == delim) {
+        advance(delim.size());
+        return;
+      } else if (delim.size() == 1 && text[i] == '\n') {
+        return;  // unterminated: the parser reports it
+      } else {
+        advance(1);
+      }
+    }
+  };
+  const auto depth = [&] { return outer + parts; };
+  const auto close = [&] {
+    outer -= open.back().parts + (open.back().c == '[' ? 1 : 0);
+    parts = open.back().parts;
+    open.pop_back();
+  };
+  while (i < text.size()) {
+    const char c = text[i];
+    if (c == '#') {
+      while (i < text.size() && text[i] != '\n') advance(1);
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      skip_string();
+      continue;
+    }
+    const Pos here{line, col};
+    if (header) {
+      if (c == '.' && ++parts > kMaxTomlNesting) return here;
+      if (c == ']' || c == '\n') header = false;
+      advance(1);
+      continue;
+    }
+    if (ctx == Ctx::key) {
+      if (c == '[' && open.empty()) {  // a table header starts a line
+        header = true;
+        parts = 1;
+        while (i < text.size() && text[i] == '[') advance(1);
+        continue;
+      }
+      if (c == '.') {
+        ++parts;
+        if (depth() > kMaxTomlNesting) return here;
+      } else if (c == '=') {
+        ctx = Ctx::value;
+      } else if (c == '}' && !open.empty() && open.back().c == '{') {
+        close();  // an empty inline table
+        ctx = Ctx::value;
+      } else if (c == '\n' && open.empty()) {
+        parts = 1;
+      }
+      advance(1);
+      continue;
+    }
+    // Value context.
+    if (c == '[' || c == '{') {
+      open.push_back({c, parts});
+      outer += parts + (c == '[' ? 1 : 0);
+      parts = 0;
+      if (depth() > kMaxTomlNesting) return here;
+      if (c == '{') ctx = Ctx::key, parts = 1;
+    } else if (c == ']' || c == '}') {
+      if (!open.empty()) close();
+    } else if (c == ',' && !open.empty() && open.back().c == '{') {
+      ctx = Ctx::key;
+      parts = 1;
+    } else if (c == '\n' && open.empty()) {
+      ctx = Ctx::key;
+      parts = 1;
+    }
+    advance(1);
+  }
+  return std::nullopt;
+}
+
 // Parses TOML text; a syntax error becomes a diagnostic. No exception escapes.
 inline bool parse_toml(std::string_view text, const std::string& source_name, Diagnostics& d,
                        toml::table& root) {
+  // A byte-order mark and CR-only line ends are an editor's habit, not an error.
+  const std::string normalized = normalize_text(text);
+  text = normalized;
+  if (const std::optional<Pos> at = too_deep(text)) {
+    d.add(*at, "TOML syntax",
+          "nested more than " + std::to_string(kMaxTomlNesting) +
+              " levels deep (keys, tables and arrays); a mixpilot file needs a few");
+    return false;
+  }
   try {
     root = toml::parse(text, std::string_view(source_name));
   } catch (const toml::parse_error& e) {
