@@ -105,6 +105,8 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
       go.preferred = d->settings.gamepad;
       go.mappings_file = input::user_mappings_path();
       if (!d->gamepad->start(go, error)) return nullptr;
+      if (!d->gamepad->mappings_note().empty())
+        std::fprintf(stderr, "mixpilot: %s\n", d->gamepad->mappings_note().c_str());
     }
     if (o.headless) {
       // SDL reports the pads present at start-up within its first polls.

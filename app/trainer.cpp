@@ -101,6 +101,10 @@ std::shared_ptr<input::Gamepad> Trainer::gamepad(std::string& error) {
   go.preferred = input_settings_.gamepad;
   go.mappings_file = input::user_mappings_path();
   if (!g->start(go, error)) return nullptr;
+  if (!g->mappings_note().empty()) {
+    std::fprintf(stderr, "mixpilot: %s\n", g->mappings_note().c_str());
+    say(go.mappings_file + " was left out (see the terminal); SDL's built-in mappings apply", true);
+  }
   return gamepad_ = std::move(g);
 }
 

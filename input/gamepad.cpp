@@ -8,6 +8,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <string_view>
+
+#include "core/numerics/input_file.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot::input {
 
@@ -17,7 +21,38 @@ SDL_GameController* as_controller(void* p) { return static_cast<SDL_GameControll
 
 float axis_value(Sint16 v) { return std::clamp(float(v) / 32767.0f, -1.0f, 1.0f); }
 
+// Community mapping databases are a few hundred kilobytes; the cap is every text input's.
+constexpr long long kMaxMappingsBytes = kMaxTextFileBytes;
+
 }  // namespace
+
+// SDL mapping lines "GUID,name,mapping,...[,platform:NAME,]" by GUID, in one pass: comments and
+// lines for another platform skipped, a later line for a GUID replacing an earlier one (as SDL
+// does), a line without a GUID and a name counted as malformed.
+MappingFile parse_mappings(std::string_view text) {
+  MappingFile m;
+  const std::string_view platform = SDL_GetPlatform();
+  const std::string normalized = normalize_text(text);
+  std::string_view rest = normalized;
+  while (!rest.empty()) {
+    const std::size_t end = rest.find('\n');
+    std::string_view line = rest.substr(0, end);
+    rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
+    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+    if (line.empty() || line.front() == '#') continue;
+    const std::size_t comma = line.find(',');
+    if (comma == 0 || comma == std::string_view::npos || line.find(',', comma + 1) == std::string_view::npos) {
+      ++m.malformed;
+      continue;
+    }
+    if (const std::size_t p = line.find("platform:"); p != std::string_view::npos) {
+      const std::string_view name = line.substr(p + 9, line.find(',', p) - (p + 9));
+      if (name != platform) continue;
+    }
+    m.by_guid[std::string(line.substr(0, comma))] = std::string(line);
+  }
+  return m;
+}
 
 bool Gamepad::start(const Options& options, std::string& error) {
   options_ = options;
@@ -28,13 +63,20 @@ bool Gamepad::start(const Options& options, std::string& error) {
             SDL_GetError() + ")";
     return false;
   }
+  user_mappings_.clear();
+  mappings_note_.clear();
   std::error_code ec;
-  if (!options.mappings_file.empty() && std::filesystem::exists(options.mappings_file, ec)) {
-    if (SDL_GameControllerAddMappingsFromFile(options.mappings_file.c_str()) < 0) {
-      error = options.mappings_file + ": SDL cannot read these gamepad mappings (" +
-              SDL_GetError() + ")";
-      SDL_QuitSubSystem(SDL_INIT_GAMECONTROLLER);
-      return false;
+  const std::string& file = options.mappings_file;
+  if (!file.empty() && (std::filesystem::exists(file, ec) || std::filesystem::is_symlink(file, ec))) {
+    std::string text, why;
+    if (read_input_file(file, kMaxMappingsBytes, text, why)) {
+      MappingFile m = parse_mappings(text);
+      user_mappings_ = std::move(m.by_guid);
+      if (m.malformed > 0)
+        mappings_note_ = file + ": " + std::to_string(m.malformed) +
+                         " line(s) are not SDL mappings (GUID,name,mapping...) and were skipped";
+    } else {
+      mappings_note_ = why + "\n(your gamepad mappings are left out; SDL's built-in ones apply)";
     }
   }
   running_ = true;
@@ -58,9 +100,20 @@ std::string Gamepad::active_name() const {
   return active_;
 }
 
+void Gamepad::apply_user_mapping(int device_index) {
+  if (user_mappings_.empty()) return;
+  char guid[64];
+  SDL_JoystickGetGUIDString(SDL_JoystickGetDeviceGUID(device_index), guid, sizeof guid);
+  const auto it = user_mappings_.find(guid);
+  if (it == user_mappings_.end()) return;
+  (void)SDL_GameControllerAddMapping(it->second.c_str());  // a line SDL refuses: as SDL's loader
+  user_mappings_.erase(it);
+}
+
 void Gamepad::refresh_devices() {
   std::vector<GamepadInfo> list;
   for (int i = 0; i < SDL_NumJoysticks(); ++i) {
+    apply_user_mapping(i);
     GamepadInfo d;
     d.instance = SDL_JoystickGetDeviceInstanceID(i);
     const char* n = SDL_JoystickNameForIndex(i);
@@ -79,6 +132,7 @@ bool Gamepad::open_device(std::int32_t wanted) {
   // The wanted instance, else the preferred name, else the first game controller.
   int pick = -1;
   for (int i = 0; i < SDL_NumJoysticks(); ++i) {
+    apply_user_mapping(i);
     if (!SDL_IsGameController(i)) continue;
     if (SDL_JoystickGetDeviceInstanceID(i) == wanted) {
       pick = i;

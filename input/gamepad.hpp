@@ -11,7 +11,9 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "input/latest.hpp"
@@ -19,6 +21,13 @@
 #include "input/source.hpp"
 
 namespace mixpilot::input {
+
+// The user's SDL mapping lines (gamecontrollerdb.txt) for this platform, by GUID.
+struct MappingFile {
+  std::unordered_map<std::string, std::string> by_guid;
+  int malformed = 0;  // lines that are neither comments nor "GUID,name,..."
+};
+MappingFile parse_mappings(std::string_view text);
 
 struct GamepadInfo {
   std::int32_t instance = -1;  // SDL joystick instance id
@@ -41,8 +50,11 @@ class Gamepad final : public StickSource {
   Gamepad(const Gamepad&) = delete;
   Gamepad& operator=(const Gamepad&) = delete;
 
-  // Initializes SDL's game controller subsystem and starts the device thread.
+  // Initializes SDL's game controller subsystem and starts the device thread. A mappings file
+  // that cannot be used (not a regular file, too large, unreadable) does not stop the pads:
+  // SDL's built-in mappings still apply, and mappings_note() says why the file was left out.
   [[nodiscard]] bool start(const Options& options, std::string& error);
+  const std::string& mappings_note() const { return mappings_note_; }
   void stop();
 
   std::string name() const override { return "gamepad"; }
@@ -86,6 +98,7 @@ class Gamepad final : public StickSource {
   void refresh_devices();
   void update_watch();
   bool apply_pending_mapping();  // true when one was applied
+  void apply_user_mapping(int device_index);  // the user's line for its GUID, once
 
   Options options_;
   std::thread thread_;
@@ -111,6 +124,12 @@ class Gamepad final : public StickSource {
   StickReading reading_;
   float rumble_sent_ = 0.0f;
   std::int64_t rumble_sent_ns_ = 0;
+
+  // The user's mapping lines by GUID, read once by start(); each is handed to SDL only when a
+  // joystick with that GUID appears (SDL's own file loader searches its list for every line:
+  // quadratic in the file's length).
+  std::unordered_map<std::string, std::string> user_mappings_;
+  std::string mappings_note_;
 
   mutable std::mutex devices_mutex_;  // the UI's list; never taken by the control thread
   std::vector<GamepadInfo> devices_;

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <SDL2/SDL.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -498,6 +501,71 @@ TEST(MappingWizard, SaveReplacesThePadsLineOnly) {
   std::stringstream ss;
   ss << in.rdbuf();
   EXPECT_EQ(ss.str(), "0300bbbb,two,a:b1,platform:Linux,\n0300aaaa,one,a:b2,platform:Linux,\n");
+}
+
+// The user's mappings file: read in one pass by GUID (this platform's lines, the last line of a
+// GUID winning, comments and CR line ends as written, malformed lines counted).
+TEST(GamepadMappings, ParsedByGuidInOnePass) {
+  const std::string platform = SDL_GetPlatform();
+  const MappingFile m = parse_mappings(
+      "\xEF\xBB\xBF# comment\r\n"
+      "0300aaaa,one,a:b0,platform:" + platform + ",\r\n"
+      "0300bbbb,two,a:b1,platform:Windows,\r\n"
+      "0300aaaa,one again,a:b2,platform:" + platform + ",\r\n"
+      "0300cccc,no platform,a:b3,\r"
+      "just some words\n,,\n  \n");
+  ASSERT_EQ(m.by_guid.size(), 2u);
+  EXPECT_EQ(m.by_guid.at("0300aaaa"), "0300aaaa,one again,a:b2,platform:" + platform + ",");
+  EXPECT_EQ(m.by_guid.at("0300cccc"), "0300cccc,no platform,a:b3,");
+  EXPECT_EQ(m.malformed, 2);
+}
+
+// The mappings file is an input like any other: a FIFO there no longer blocks the start (a test
+// that hangs is a failure), a directory or an oversized file is said in words and left out while
+// the pads still start; a long file is not handed to SDL line by line (SDL's loader searched its
+// whole list for every line: 100 000 lines did not start within 40 s), only the line of a pad
+// that is present.
+TEST(GamepadMappings, TheFileIsCheckedAndNotHandedToSdlWhole) {
+  const auto dir = test::fresh_path("input", "mapping_files");
+  std::filesystem::create_directories(dir);
+  const std::string fifo = (dir / "fifo.txt").string(), folder = (dir / "folder").string(),
+                    big = (dir / "big.txt").string(), loop = (dir / "loop.txt").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::filesystem::create_directories(folder);
+  std::filesystem::create_symlink(loop, loop);
+  {
+    std::ofstream out(big);
+    char line[160];
+    for (int i = 0; i < 100000; ++i) {
+      std::snprintf(line, sizeof line,
+                    "03000000%08x0000000000000000,pad %d,a:b0,b:b1,leftx:a0,lefty:a1,platform:%s,\n",
+                    i, i, SDL_GetPlatform());
+      out << line;
+    }
+  }
+  ASSERT_EQ(SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER), 0) << SDL_GetError();
+  const int before = SDL_GameControllerNumMappings();
+  for (const auto& [file, why] : std::vector<std::pair<std::string, std::string>>{
+           {fifo, "expected a regular file, got a named pipe"},
+           {folder, "expected a regular file, got a directory"},
+           {loop, "Too many levels of symbolic links"},
+           {big, ""}}) {
+    SCOPED_TRACE(file);
+    Gamepad g;
+    Gamepad::Options o;
+    o.mappings_file = file;
+    std::string error;
+    ASSERT_TRUE(g.start(o, error)) << error;
+    if (why.empty()) {
+      EXPECT_EQ(g.mappings_note(), "");
+    } else {
+      EXPECT_NE(g.mappings_note().find(why), std::string::npos) << g.mappings_note();
+      EXPECT_NE(g.mappings_note().find("SDL's built-in ones apply"), std::string::npos);
+    }
+    ASSERT_TRUE(eventually([&] { return g.polls() > 5; }));
+    EXPECT_LE(SDL_GameControllerNumMappings(), before + 4) << "the file went to SDL whole";
+  }
+  SDL_QuitSubSystem(SDL_INIT_GAMECONTROLLER);
 }
 
 // End to end through SDL: a virtual joystick SDL has no mapping for is watched raw, mapped by
