@@ -32,7 +32,7 @@ Metrics replay_metrics(const Mode& mode, const RecordingContents& rec, Score* sc
   const std::size_t n = std::min(rec.solver.size(), std::size_t(mode.steps_done()));
   std::vector<double> recorded_us(n);
   for (std::size_t k = 0; k < n; ++k) recorded_us[k] = rec.solver[k].total_us;
-  set_timing(s, std::move(recorded_us), mode.dt());
+  set_timing(s, std::move(recorded_us), s.deadline_misses);  // misses: replayed as recorded
   if (score) *score = s;
   return with_lost_fields(to_metrics(s), mode);
 }
@@ -43,11 +43,11 @@ std::string in_embedded_scenario(const std::string& path, const std::string& err
 
 namespace {
 
-// The steps whose RTI solve overran its deadline in the recorded (real-time) flight.
-std::vector<std::int64_t> recorded_overruns(const RecordingContents& rec) {
+// The steps of the recorded (real-time) flight marked with `event`.
+std::vector<std::int64_t> recorded_steps(const RecordingContents& rec, std::uint32_t event) {
   std::vector<std::int64_t> steps;
   for (std::size_t j = 0; j < rec.channels.size(); ++j)
-    if (rec.channels[j].events & kEventOverrun) steps.push_back(std::int64_t(j));
+    if (rec.channels[j].events & event) steps.push_back(std::int64_t(j));
   return steps;
 }
 
@@ -88,8 +88,10 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
     return nullptr;
   }
   auto mode = replay_mode_of(rec, path, text, source, duration, error);
-  // What depended on the wall clock is replayed as recorded: the overruns' fallbacks.
-  if (mode) mode->force_overruns(recorded_overruns(rec));
+  // What depended on the wall clock is replayed as recorded: the overruns' fallbacks and the
+  // deadline misses.
+  if (mode)
+    mode->replay_timing(recorded_steps(rec, kEventOverrun), recorded_steps(rec, kEventDeadlineMiss));
   const auto embedded = rec.metadata.find("scenario");
   if (!mode && embedded != rec.metadata.end() && embedded->second == text)
     error = in_embedded_scenario(path, error);

@@ -227,6 +227,56 @@ const ModeCase kCases[] = {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, EveryMode, testing::ValuesIn(kCases), print_case);
 
+// Sustained overload (SPEC §4's failure policy exhausted): every solve of a long stretch overruns,
+// as on a machine that cannot keep up. After 5 fallbacks in a row the safe controller flies
+// (kEventSafeHold, kEventSwitch where it takes over), nothing is lost, and 5 good solves in a row
+// after the stretch hand the vehicle back to the MPC; without allocating, and a second run
+// switches at the same steps.
+TEST_P(EveryMode, OverrunsInARowHandTheVehicleToTheSafeControllerAndBack) {
+  const ModeCase& c = GetParam();
+  auto mode = make(c);
+  ASSERT_TRUE(mode);
+  // A stretch of overruns a third into the run, as long as a third of it; the Pendubot's during
+  // its swing-up (its LQR, once it flies, solves no QP to overrun), 0.4 s long.
+  const std::int64_t total = mode->steps_total();
+  const bool pendubot = c.kind == ModeKind::pendubot_swingup;
+  const std::int64_t first = pendubot ? 100 : total / 3;
+  const std::int64_t last = first + (pendubot ? 200 : total / 3);
+  std::vector<std::int64_t> overruns;
+  for (std::int64_t k = first; k <= last; ++k) overruns.push_back(k);
+  const std::int64_t safe_from = first + rti_defaults::kSafeAfterFallbacks - 1;
+  const std::int64_t safe_to = last + rti_defaults::kSafeAfterFallbacks - 1;  // last safe step
+  mode->replay_timing(overruns);
+
+  std::vector<std::uint32_t> events;
+  events.reserve(std::size_t(total));
+  const GuardedSteps run =
+      step_to_end_without_malloc(*mode, [&] { events.push_back(mode->telemetry().events); });
+  EXPECT_EQ(run.allocations, 0);
+  EXPECT_FALSE(mode->lost());
+  ASSERT_EQ(std::int64_t(events.size()), total);
+  for (std::int64_t k = 0; k < total; ++k) {
+    const bool safe = (events[std::size_t(k)] & kEventSafeHold) != 0;
+    ASSERT_EQ(safe, k >= safe_from && k <= safe_to) << "step " << k;
+    if (k == safe_from || k == safe_to + 1)
+      EXPECT_NE(events[std::size_t(k)] & kEventSwitch, 0u) << "step " << k;
+  }
+  const MetricMap m = metric_map(mode->metrics());
+  if (c.kind == ModeKind::mixed_initiative) {  // held, then flown back into B: nothing hit
+    EXPECT_EQ(at(m, "collisions"), 0);
+    EXPECT_NEAR(at(m, "safe_hold_s"), double(safe_to - safe_from + 1) * mode->dt(), 1e-9);
+    const Telemetry& end = mode->telemetry();
+    EXPECT_LE((end.x.head<3>() - end.reference).norm(), 0.175);
+  } else if (c.kind == ModeKind::crazyflie_tracking) {  // the LQR kept tracking the reference
+    EXPECT_LT(at(m, "tracking_rms_m"), 0.05);
+  }
+
+  auto again = make(c);
+  again->replay_timing(overruns);
+  std::size_t k = 0;
+  while (again->step()) ASSERT_EQ(again->telemetry().events, events[k++]) << "step " << k;
+}
+
 // A session length given apart from the file (fly --duration) obeys the file's own rule: the
 // helix reference climbs out of mi_helix_slow's 2.5 m arena at 113.998 s (z = 0.6 + 0.016667 t).
 TEST(MakeMode, ASessionLengthThatTakesTheReferenceOutOfTheArenaIsRefused) {

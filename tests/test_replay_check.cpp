@@ -30,7 +30,7 @@ RecordingContents record(const std::string& scenario, double seconds, const char
                         error))
       << error;
   // Overruns as a real-time run would have them where the clock said so (SPEC §4).
-  mode->force_overruns(std::move(overruns));
+  mode->replay_timing(std::move(overruns));
   Session session(*mode);
   session.add_sink(&sink);
   session.run();

@@ -1,5 +1,6 @@
 #include "core/modes/mi_mode.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -46,6 +47,10 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
                                         scenario_.reference);
       !r)
     return SetupResult::failure("the controller settings do not form a valid OCP: " + r.reason());
+  if (SetupResult r = hover_.setup(model_, scenario_.controller.weights, dt_); !r)
+    return SetupResult::failure("the safe controller cannot be set up: " + r.reason());
+  safety_.reset();
+  command_ = model_.hover_input();
   x_ = model_.hover_state(scenario_.reference.position(0.0));
   controller_.reset(x_);
   const int delay_steps = int(std::lround(scenario_.plant.input_delay / dt_));
@@ -170,6 +175,7 @@ void MiMode::set_channels() {
 
 bool MiMode::step() {
   if (finished_) return false;
+  const auto started = std::chrono::steady_clock::now();
   const double t = double(step_) * dt_;
   Telemetry& s = telemetry_;
   if (link_) {
@@ -204,21 +210,37 @@ bool MiMode::step() {
   s.stats = controller_.rti().stats();
   s.predicted = controller_.predicted_positions();
   s.predicted_reference = controller_.reference_positions();
+  // The MPC's plan spent: the safe controller holds the position where it took over, and the
+  // pilot has no authority meanwhile.
+  const bool safe = safety_.update(s.stats.status != RtiStatus::success);
+  if (safe) {
+    if (safety_.switched()) hold_ = s.x_measured.head<3>();
+    hover_.control(s.x_measured, hold_, u_safe_);
+    s.lambda = 0.0;
+    command_ = u_safe_;
+  } else {
+    command_ = controller_.control();
+  }
+  const double compute_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
 
   if (link_) {
     // The command leaves at once: the link is the delay line.
-    s.u = controller_.control();
+    s.u = command_;
     const models::MikroKopter::Input u = s.u;
     predictor_.record_sent(u);
     link_->send(step_, now_ns_, u.data(), models::MikroKopter::nu);
   } else {
     // The command enters the delay line; the rotors get the one sent input_delay ago.
     const std::size_t n = u_delay_.size();
-    u_delay_[std::size_t(step_) % n] = controller_.control();
+    u_delay_[std::size_t(step_) % n] = command_;
     s.u = u_delay_[std::size_t(step_ + 1) % n];
   }
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (s.stats.overrun) s.events |= kEventOverrun;
+  if (safe) s.events |= kEventSafeHold;
+  if (safety_.switched()) s.events |= kEventSwitch;
+  s.events |= deadline_event(step_, compute_us, s.stats.overrun);
   if (s.pilot.input == InputState::lost && was != InputState::lost) s.events |= kEventInputLost;
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();

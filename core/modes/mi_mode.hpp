@@ -18,9 +18,11 @@
 #include <Eigen/Core>
 
 #include "core/control/delay_predictor.hpp"
+#include "core/control/hover_lqr.hpp"
 #include "core/control/mi_controller.hpp"
 #include "core/control/pilot.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/safety_net.hpp"
 #include "core/modes/score.hpp"
 #include "core/modes/vehicle_feed.hpp"
 #include "core/numerics/integrator_erk4.hpp"
@@ -67,6 +69,7 @@ class MiMode final : public Mode {
   const models::MikroKopter& model() const { return model_; }
   const PilotSource& pilot() const { return *pilot_; }
   const MiController& controller() const { return controller_; }
+  const SafetyNet& safety_net() const { return safety_; }
   const Eigen::VectorXd& state() const { return x_; }
 
  private:
@@ -82,6 +85,12 @@ class MiMode final : public Mode {
   models::MikroKopter model_{};
   IntegratorErk4<models::MikroKopter> plant_{};
   MiController controller_;
+  // The safe controller: hover-hold at hold_ while the MPC's plan is spent.
+  HoverLqr hover_;
+  SafetyNet safety_;
+  Eigen::Vector3d hold_ = Eigen::Vector3d::Zero();
+  models::MikroKopter::Input u_safe_ = models::MikroKopter::Input::Zero();  // nu
+  Eigen::VectorXd command_;  // nu: the step's command (the MPC's or the safe controller's)
   ScoreAccumulator scorer_;  // sized in setup() for the whole flight
   Telemetry telemetry_;
   Eigen::VectorXd x_;                      // nx: true state

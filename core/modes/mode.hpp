@@ -32,10 +32,16 @@ enum ModeEvent : std::uint32_t {
   kEventFallback = 1u << 0,   // the QP failed: the previous solution's next input was applied
   kEventCollision = 1u << 1,  // contact started: the vehicle touches an obstacle, wall or floor
   kEventViolation = 1u << 2,  // a constraint of the mode was violated (clearance, velocity bound)
-  kEventSwitch = 1u << 3,     // the active controller changed (Pendubot NMPC ↔ LQR)
+  kEventSwitch = 1u << 3,     // the active controller changed (Pendubot NMPC ↔ LQR, MPC ↔ safe)
   kEventLost = 1u << 4,       // the vehicle was lost (non-finite or far away): the run ends
   kEventOverrun = 1u << 5,    // the RTI solve overran its deadline: handled as a fallback
   kEventInputLost = 1u << 6,  // the pilot's device was lost: the planner took the authority
+  // A paced run's step whose control input was ready after its period had ended (it started
+  // late, or computing took too long), or whose computing took longer than Δt (SPEC §8).
+  kEventDeadlineMiss = 1u << 7,
+  // The safe controller flew this step: the MPC's plan was spent after fallbacks in a row
+  // (core/modes/safety_net.hpp).
+  kEventSafeHold = 1u << 8,
 };
 
 // A named scalar of one step, for plots that do not know the mode. Names and units are string
@@ -122,24 +128,45 @@ class Mode {
     return false;
   }
 
-  // A replay: the RTI solves of steps `steps` (ascending step indices) are overruns, as they
-  // were in the recorded flight, so it is reproduced bit for bit.
-  void force_overruns(std::vector<std::int64_t> steps) {
-    forced_overruns_ = std::move(steps);
-    next_forced_ = 0;
+  // A paced run (core/runtime/realtime_runner.hpp), before each step: how late the step
+  // starts after its schedule and the wall-clock period it has [µs]. The step is then marked
+  // kEventDeadlineMiss when its control input is ready after that period, or computing it took
+  // longer than Δt (an overrun of the solve is always one). 0, 0 (the default): not paced.
+  void set_pacing(double late_us, double period_us) {
+    late_us_ = late_us;
+    period_us_ = period_us;
+  }
+
+  // A replay: what depended on the wall clock in the recorded flight, as it happened there.
+  // The RTI solves of steps `overruns` are overruns (their fallbacks are reproduced bit for
+  // bit) and steps `misses` missed their deadline (ascending step indices each).
+  void replay_timing(std::vector<std::int64_t> overruns, std::vector<std::int64_t> misses = {}) {
+    forced_overruns_ = std::move(overruns);
+    forced_misses_ = std::move(misses);
+    next_forced_ = next_miss_ = 0;
   }
 
  protected:
   // Whether step k's solve is a recorded overrun (asked with increasing k).
-  bool forced_overrun(std::int64_t k) {
-    while (next_forced_ < forced_overruns_.size() && forced_overruns_[next_forced_] < k)
-      ++next_forced_;
-    return next_forced_ < forced_overruns_.size() && forced_overruns_[next_forced_] == k;
+  bool forced_overrun(std::int64_t k) { return take(forced_overruns_, next_forced_, k); }
+  // kEventDeadlineMiss for step k whose control input took `compute_us` from the step's start,
+  // or whose solve overran its deadline (asked once per step, with increasing k), else 0.
+  std::uint32_t deadline_event(std::int64_t k, double compute_us, bool overrun) {
+    const bool recorded = take(forced_misses_, next_miss_, k);
+    const bool late = period_us_ > 0.0 &&
+                      (late_us_ + compute_us > period_us_ || compute_us > 1e6 * dt());
+    return recorded || late || overrun ? kEventDeadlineMiss : 0u;
   }
 
  private:
-  std::vector<std::int64_t> forced_overruns_;
-  std::size_t next_forced_ = 0;
+  static bool take(const std::vector<std::int64_t>& steps, std::size_t& next, std::int64_t k) {
+    while (next < steps.size() && steps[next] < k) ++next;
+    return next < steps.size() && steps[next] == k;
+  }
+
+  std::vector<std::int64_t> forced_overruns_, forced_misses_;
+  std::size_t next_forced_ = 0, next_miss_ = 0;
+  double late_us_ = 0.0, period_us_ = 0.0;
 };
 
 }  // namespace mixpilot

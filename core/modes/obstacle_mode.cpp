@@ -1,6 +1,7 @@
 #include "core/modes/obstacle_mode.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -41,6 +42,9 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   if (SetupResult r = rti_.setup(problem_->ocp()); !r)
     return SetupResult::failure("controller: " + r.reason());
   if (SetupResult r = check_scenario(); !r) return r;
+  if (SetupResult r = safe_lqr_.setup(model_, settings_.dt); !r)
+    return SetupResult::failure("the safe controller: " + r.reason());
+  safety_.reset();
 
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   last_x_ = int(ref.x.size()) - 1;
@@ -122,6 +126,7 @@ void ObstacleMode::reset_telemetry() {
 
 bool ObstacleMode::step() {
   if (finished_) return false;
+  const auto started = std::chrono::steady_clock::now();
   const int k = int(step_);
   const double t = k * settings_.dt;
   const OcpTrajectory& ref = scenario_.reference.trajectory;
@@ -133,7 +138,15 @@ bool ObstacleMode::step() {
   const RtiStats& st = rti_.stats();
   rti_us_.push_back(st.total_us);
   qp_iterations_max_ = std::max(qp_iterations_max_, st.qp_iterations);
-  const models::Crazyflie::Input u = rti_.control();
+  models::Crazyflie::Input u = rti_.control();
+  // The plan spent after fallbacks in a row: hover-hold where the safe controller took over.
+  const bool safe = safety_.update(st.status != RtiStatus::success);
+  if (safe) {
+    if (safety_.switched()) hold_ = model_.hover_state(x_.head<3>());
+    safe_lqr_.control(x_, hold_, model_.hover_input(), u);
+  }
+  const double compute_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
 
   Telemetry& s = telemetry_;
   s.step = step_;
@@ -155,6 +168,9 @@ bool ObstacleMode::step() {
   ++step_;
   s.events = st.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (st.overrun) s.events |= kEventOverrun;
+  if (safe) s.events |= kEventSafeHold;
+  if (safety_.switched()) s.events |= kEventSwitch;
+  s.events |= deadline_event(s.step, compute_us, st.overrun);
   if (violated) s.events |= kEventViolation;
   set_channels(distance, std::sqrt(sq_error));
   if (!x_.allFinite()) {  // never hand a non-finite state to anyone

@@ -13,7 +13,9 @@
 #include <Eigen/Core>
 
 #include "core/control/obstacle_avoidance.hpp"
+#include "core/control/tracking.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/safety_net.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
@@ -110,6 +112,11 @@ class ObstacleMode final : public Mode {
   ObstacleControllerSettings settings_;
   std::optional<ObstacleAvoidanceOcp> problem_;  // rebuilt by setup(); rti_ points into it
   RtiSolver rti_;
+  // The safe controller: hover-hold at hold_ while the NMPC's plan is spent.
+  models::Crazyflie model_{};
+  TrackingLqr safe_lqr_;
+  SafetyNet safety_;
+  models::Crazyflie::State hold_ = models::Crazyflie::State::Zero();  // 13
   Telemetry telemetry_;
   models::Crazyflie::State x_;  // 13: true plant state
   std::vector<double> rti_us_;  // steps_total_: per step, RTI prepare + feedback [us]

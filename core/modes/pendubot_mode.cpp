@@ -1,6 +1,7 @@
 #include "core/modes/pendubot_mode.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -107,6 +108,7 @@ SetupResult PendubotMode::setup(PendubotScenario scenario) {
   x0_ = Eigen::VectorXd::Zero(4);
   u_prev_ = 0.0;
   lqr_active_ = false;
+  safety_.reset();
 
   max_abs_u_ = worst_velocity_violation_ = err2_ = lqr_time_ = 0.0;
   velocity_violations_ = err_n_ = nmpc_steps_ = lqr_entries_ = 0;
@@ -203,6 +205,10 @@ double PendubotMode::control() {
     telemetry_.stats.fallbacks = rti_.stats().fallbacks;
   } else {
     u = nmpc();
+    // The plan spent after fallbacks in a row: the LQR near the top, no torque elsewhere (the
+    // links then swing down and settle instead of being driven by a stale plan).
+    if (safety_.update(telemetry_.stats.status != RtiStatus::success))
+      u = xw_.head<2>().norm() <= scenario_.lqr.exit_angle ? -lqr_.K.dot(xw_) : 0.0;
   }
   if (!std::isfinite(u)) u = 0.0;
   const double u_max = scenario_.controller.u_max;
@@ -275,13 +281,17 @@ void PendubotMode::record_angle_norm() {
 
 bool PendubotMode::step() {
   if (finished_) return false;
+  const auto started = std::chrono::steady_clock::now();
   measure();
   const bool switched = switch_controller();
   const double u = control();
+  const double compute_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
   const State x_k = x_;
   const double worst = integrate(u);
   telemetry_.x = x_k;
   set_telemetry(u, switched, worst);
+  telemetry_.events |= deadline_event(step_, compute_us, telemetry_.solved && telemetry_.stats.overrun);
   ++step_;
   record_angle_norm();
   finished_ = step_ >= steps_total_;
@@ -307,6 +317,8 @@ void PendubotMode::set_telemetry(double u, bool switched, double worst_violation
   if (worst_violation > 0) s.events |= kEventViolation;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
   if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
+  if (!lqr_active_ && safety_.engaged()) s.events |= kEventSafeHold;
+  if (!lqr_active_ && safety_.switched()) s.events |= kEventSwitch;
   set_channels();
 }
 

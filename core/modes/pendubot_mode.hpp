@@ -33,6 +33,7 @@
 
 #include "core/control/pendubot.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/safety_net.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/pendubot_scenario.hpp"
@@ -124,6 +125,7 @@ class PendubotMode final : public Mode {
   // The true plant state now, x(t = steps_done·Δt): after the last step, the final state.
   const State& state() const { return x_; }
   bool lqr_active() const { return lqr_active_; }
+  const SafetyNet& safety_net() const { return safety_; }
 
  private:
   SetupResult check_settings() const;
@@ -140,7 +142,9 @@ class PendubotMode final : public Mode {
   PendubotScenario scenario_;
   std::unique_ptr<PendubotSwingup> problem_;
   RtiSolver rti_;
-  PendubotLqr lqr_;
+  PendubotLqr lqr_;  // zero gain when the scenario's LQR is disabled
+  // The NMPC's safety net: the LQR near the top, no torque elsewhere, once its plan is spent.
+  SafetyNet safety_;
 
   std::int64_t steps_total_ = 0;
   int substeps_ = 1;      // plant RK4 substeps per control step

@@ -26,6 +26,9 @@ bool ScoreAccumulator::add(const Telemetry& s) {
   lambda_.push_back(s.lambda);
   rti_us_.push_back(s.stats.total_us);
   if (s.stats.status == RtiStatus::fallback) ++fallbacks_;
+  if (s.events & kEventDeadlineMiss) ++deadline_misses_;
+  if (s.events & kEventSafeHold) ++safe_hold_steps_;
+  if (s.pilot.input == InputState::lost) ++input_lost_steps_;
 
   const double dr = s.pilot.roll - s.applied.roll, dp = s.pilot.pitch - s.applied.pitch;
   sum_override_sq_ += dr * dr + dp * dp;
@@ -103,8 +106,10 @@ Score ScoreAccumulator::finish() const {
   sc.override_rms = std::sqrt(sum_override_sq_ / double(K));
   sc.stick_smoothness = K > 1 ? std::sqrt(sum_stick_sq_ / double(K - 1)) : 0.0;
 
-  set_timing(sc, rti_us_, dt_);
+  set_timing(sc, rti_us_, deadline_misses_);
   sc.fallbacks = fallbacks_;
+  sc.input_lost_s = double(input_lost_steps_) * dt_;
+  sc.safe_hold_s = double(safe_hold_steps_) * dt_;
 
   const double quality = 0.4 * sc.time_in_ball + 0.4 * sc.mean_lambda +
                          0.2 * std::exp(-sc.override_rms / 0.1);
@@ -112,11 +117,10 @@ Score ScoreAccumulator::finish() const {
   return sc;
 }
 
-void set_timing(Score& sc, std::vector<double> t, double dt) {
+void set_timing(Score& sc, std::vector<double> t, int deadline_misses) {
   sc.rti_median_us = sc.rti_p99_us = 0.0;
-  sc.deadline_misses = 0;
+  sc.deadline_misses = deadline_misses;
   if (t.empty()) return;
-  for (double v : t) sc.deadline_misses += v > dt * 1e6 ? 1 : 0;
   sc.rti_median_us = percentile(t, 0.5);
   sc.rti_p99_us = percentile(t, 0.99);
 }
@@ -139,6 +143,8 @@ Metrics to_metrics(const Score& s) {
       {"deadline_misses", double(s.deadline_misses)},
       {"fallbacks", double(s.fallbacks)},
       {"skill", s.skill},
+      {"input_lost_s", s.input_lost_s},
+      {"safe_hold_s", s.safe_hold_s},
   };
 }
 

@@ -15,11 +15,16 @@
 //   stick_smoothness  √(mean_k ‖(Δφ_h, Δθ_h)/Δt‖²) [rad/s]: RMS rate of the pilot's attitude
 //                     command (lower is smoother)
 //   rti_median_us, rti_p99_us  of the controller's prepare + feedback time per step
-//   deadline_misses   steps whose controller time exceeded Δt;   fallbacks  RTI fallbacks
+//   deadline_misses   steps of a paced run that missed their deadline (kEventDeadlineMiss:
+//                     started late or computed too long; 0 when not paced)
+//   fallbacks         RTI fallbacks (QP failed or overran)
+//   input_lost_s      time the pilot's device was lost (the planner flew)
+//   safe_hold_s       time the safe controller flew (the MPC's plan was spent)
 //   skill             100 · progress · (0.4 time_in_ball + 0.4 mean_lambda
 //                     + 0.2 exp(−override_rms / 0.1 rad)) / (1 + collisions) ∈ [0, 100]
-// The three timing fields measure this run on this machine; every other field is a pure
-// function of the telemetry, so a replay of a recording reproduces it bit for bit.
+// The three timing fields measure this run on this machine (a replay takes them from the
+// recording); every other field is a pure function of the telemetry, so a replay of a
+// recording reproduces it bit for bit.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -48,13 +53,16 @@ struct Score {
   int deadline_misses = 0;
   std::int64_t fallbacks = 0;
   double skill = 0;
+  double input_lost_s = 0;
+  double safe_hold_s = 0;
 };
 
 // The fields above in this order, as metrics.
 Metrics to_metrics(const Score& score);
 
-// Timing fields from per-step controller times [µs] (median, p99, misses of dt).
-void set_timing(Score& score, std::vector<double> total_us, double dt);
+// Timing fields of a flight: the median and p99 of its per-step controller times [µs] and its
+// deadline misses (steps marked kEventDeadlineMiss).
+void set_timing(Score& score, std::vector<double> total_us, int deadline_misses);
 
 // The score of a flight, one step at a time. add() allocates nothing for the steps setup()
 // sized it for.
@@ -82,6 +90,9 @@ class ScoreAccumulator {
   int collisions_ = 0;
   bool in_contact_ = false;
   std::int64_t fallbacks_ = 0;
+  int deadline_misses_ = 0;
+  std::int64_t input_lost_steps_ = 0;
+  std::int64_t safe_hold_steps_ = 0;
 };
 
 }  // namespace mixpilot

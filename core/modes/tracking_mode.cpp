@@ -74,9 +74,10 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
       return SetupResult::failure("the tracking NMPC cannot be set up: " + r.reason());
     problem_->hover_guess(rti_->trajectory(), pl.start);
     problem_->set_reference(rti_->data(), ref, 0);  // for the telemetry before the first step
-  } else if (SetupResult r = lqr_.setup(model_, c.dt); !r) {
-    return r;
   }
+  // The LQR law, or the NMPC's safe controller (core/modes/safety_net.hpp).
+  if (SetupResult r = lqr_.setup(model_, c.dt); !r) return r;
+  safety_.reset();
   predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(VehicleFeed::kMaxRtt / h_)));
   link_ = nullptr;
   feed_.setup(models::Crazyflie::nx, c.dt, h_, predictor_.max_substeps(),
@@ -164,6 +165,11 @@ void TrackingMode::control() {
     u_ = rti.control();
     s.solved = true;
     s.stats = rti.stats();
+    // The plan spent after fallbacks in a row: the LQR tracks the reference meanwhile.
+    if (safety_.update(s.stats.status != RtiStatus::success)) {
+      const Eigen::VectorXd& xr = ref.x[std::size_t(std::min(k, last_x_))];
+      lqr_.control(x0_, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), u_);
+    }
     for (int i = 0; i <= scenario_.controller.N; ++i) {
       s.predicted.col(i) = rti.trajectory().x[std::size_t(i)].head<3>();
       s.predicted_reference.col(i) = rti.data().yref[std::size_t(i)].head<3>();
@@ -266,8 +272,10 @@ bool TrackingMode::step() {
   if (finished_) return false;
   if (link_) return step_remote();
   const long k = long(step_);
+  const auto started = std::chrono::steady_clock::now();
   measure();
   control();
+  compute_us_ = microseconds_since(started);
   send();
   // The plant to the next control boundary; after the last step on to K·s + n_c (sample K).
   const long end = (k + 1) * s_ + (k + 1 == steps_total_ ? n_c_ : 0);
@@ -275,6 +283,7 @@ bool TrackingMode::step() {
   const bool alive = process_to(end);
   if (!alive) lose(double(j_lost_ - n_c_) * h_, "it left the world");
   set_telemetry();
+  telemetry_.events |= deadline_event(step_, compute_us_, telemetry_.solved && telemetry_.stats.overrun);
   set_channels(predict_us_.back(), solve_us_.back());
   ++step_;
   finished_ = lost_ || step_ >= steps_total_;
@@ -315,10 +324,12 @@ bool TrackingMode::step_remote() {
   x0_ = scenario_.controller.compensation ? predicted_ : y_;
   predict_us_.push_back(scenario_.controller.compensation ? microseconds_since(t0) : 0.0);
   control();
+  compute_us_ = microseconds_since(t0);
   send();
   link_->send(k, now, u_.data(), int(u_.size()));
 
   set_telemetry();
+  telemetry_.events |= deadline_event(step_, compute_us_, telemetry_.solved && telemetry_.stats.overrun);
   telemetry_.x = predicted_;
   set_channels(predict_us_.back(), solve_us_.back());
   ++step_;
@@ -344,6 +355,8 @@ void TrackingMode::set_telemetry() {
   s.events = 0;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
   if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
+  if (safety_.engaged()) s.events |= kEventSafeHold;
+  if (safety_.switched()) s.events |= kEventSwitch;
   if (lost_) s.events |= kEventLost;
 }
 

@@ -38,6 +38,7 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/control/tracking.hpp"
 #include "core/modes/mode.hpp"
+#include "core/modes/safety_net.hpp"
 #include "core/modes/vehicle_feed.hpp"
 #include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
@@ -120,6 +121,7 @@ class TrackingMode final : public Mode {
   TrackingResult result() const;
   const TrackingScenario& scenario() const { return scenario_; }
   bool nmpc() const { return problem_ != nullptr; }
+  const SafetyNet& safety_net() const { return safety_; }
 
  private:
   std::size_t ring(long j) const { return std::size_t(j % long(states_.size())); }
@@ -142,7 +144,9 @@ class TrackingMode final : public Mode {
   IntegratorErk4<models::Crazyflie> plant_{};
   std::unique_ptr<CrazyflieTracking> problem_;  // NMPC only
   std::unique_ptr<RtiSolver> rti_;              // NMPC only
-  TrackingLqr lqr_;
+  TrackingLqr lqr_;  // the LQR law, or the NMPC's safe controller
+  SafetyNet safety_;
+  double compute_us_ = 0.0;  // the step's measurement and control time
   CrazyflieDelayPredictor predictor_;
 
   // Delay model in plant substeps (core/control/tracking.hpp).

@@ -98,6 +98,11 @@ inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm_pairs;
 // One level of pairs in RTI: its warm-started QPs take ~2 iterations, too few to repay a second
 // condensing level (BM_Rti/mi 379 µs with two levels, 343 µs with one).
 inline constexpr int kQpPairLevels = 1;
+// SPEC §4's failure policy applies the previous plan's next input; after this many fallbacks in
+// a row (QP failures or overruns: 75 ms of the quadrotor modes' 15 ms steps, half the
+// Pendubot's 10-step plan) the plan is judged spent and the mode's safe controller flies, until
+// the MPC has again solved this many steps in a row in time.
+inline constexpr int kSafeAfterFallbacks = 5;
 }  // namespace rti_defaults
 
 // PH index of SPEC §5.4 (Table 7.1).

@@ -28,8 +28,15 @@ void RealtimeRunner::stop() {
 }
 
 RealtimeStats RealtimeRunner::stats() const {
-  RealtimeStats st{steps_.load(),         misses_.load(),         late_starts_.load(),
-                   worst_lateness_us_.load(), worst_step_us_.load(), 0.0, fifo_.load()};
+  RealtimeStats st;
+  st.steps = steps_.load();
+  st.deadline_misses = misses_.load();
+  st.late_starts = late_starts_.load();
+  st.safe_hold_steps = safe_.load();
+  st.slip_s = slip_s_.load();
+  st.worst_lateness_us = worst_lateness_us_.load();
+  st.worst_step_us = worst_step_us_.load();
+  st.realtime_priority = fifo_.load();
   // The smallest bin edge below which 99 % of the steps fall.
   std::uint64_t total = 0;
   for (const auto& b : step_bins_) total += b.load(std::memory_order_relaxed);
@@ -61,24 +68,34 @@ void RealtimeRunner::loop() {
   fifo_.store(ask_realtime_priority());
   const double dt = session_->mode().dt();
   auto next = clock::now();
+  double overshoot_us = 0.0;
   while (!stop_.load(std::memory_order_relaxed)) {
     if (paused_.load(std::memory_order_relaxed)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       next = clock::now();  // resume without catching up
+      overshoot_us = 0.0;
       continue;
     }
     std::this_thread::sleep_until(next);
+    const double speed = std::max(1e-3, speed_.load(std::memory_order_relaxed));
+    const double period_us = 1e6 * dt / speed;
     const auto started = clock::now();
-    const double late_us = std::chrono::duration<double, std::micro>(started - next).count();
+    // Late against the schedule, plus how far the previous step overshot its end: its restart
+    // of the schedule moved this step's start, not the time its input was due.
+    const double late_us =
+        std::chrono::duration<double, std::micro>(started - next).count() + overshoot_us;
+    overshoot_us = 0.0;
+    Mode& mode = session_->mode();
+    mode.set_pacing(std::max(0.0, late_us), period_us);
     const bool stepped = session_->step();
     const auto ended = clock::now();
     if (!stepped) break;
-    ring_.push(session_->mode().telemetry());
+    ring_.push(mode.telemetry());
+    const std::uint32_t events = mode.telemetry().events;
     const double step_us = std::chrono::duration<double, std::micro>(ended - started).count();
-    const double period_us = 1e6 * dt / std::max(1e-3, speed_.load(std::memory_order_relaxed));
-    const bool missed = late_us + step_us > period_us || step_us > 1e6 * dt;
-    if (missed) misses_.fetch_add(1);
+    if (events & kEventDeadlineMiss) misses_.fetch_add(1);
     else if (late_us > 0.1 * 1e6 * dt) late_starts_.fetch_add(1);
+    if (events & kEventSafeHold) safe_.fetch_add(1);
     if (late_us > worst_lateness_us_.load()) worst_lateness_us_.store(late_us);
     if (step_us > worst_step_us_.load()) worst_step_us_.store(step_us);
     step_bins_[std::size_t(std::min(double(kBins - 1), step_us / kBinUs))].fetch_add(
@@ -86,8 +103,16 @@ void RealtimeRunner::loop() {
     steps_.fetch_add(1);
     const auto period =
         std::chrono::duration_cast<clock::duration>(std::chrono::duration<double, std::micro>(period_us));
-    // A missed deadline restarts the schedule from the step's end: no burst of catch-up steps.
-    next = (missed ? ended : next) + period;
+    // A step that ends after it is due restarts the schedule from its end: no burst of catch-up
+    // steps, and simulated time falls behind the wall clock by the overshoot.
+    const auto due = next + period;
+    if (ended > due) {
+      overshoot_us = std::chrono::duration<double, std::micro>(ended - due).count();
+      slip_s_.store(slip_s_.load() + speed * 1e-6 * overshoot_us);
+      next = ended + period;
+    } else {
+      next = due;
+    }
   }
   running_.store(false);
 }

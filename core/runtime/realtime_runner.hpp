@@ -5,10 +5,13 @@
 // from any thread through atomics; the control thread never waits on them.
 //
 // Deadlines: step k is scheduled at s_k = s_0 + k T (T = Δt / speed of wall time) and is due at
-// the end of its period, s_k + T. A step that ends after it is due (it started too late, or ran
-// too long), or whose step time exceeds Δt, counts one deadline miss, and the schedule then
-// restarts from its end (no burst of catch-up steps). Starts later than 10 % of Δt are counted
-// too (late starts): the step still met its deadline, and the schedule keeps its grid.
+// the end of its period, s_k + T. The runner tells the mode how late each step starts; the mode
+// marks a step whose control input is ready after it is due, or took longer than Δt to compute,
+// as a deadline miss (kEventDeadlineMiss), so the recording, the score, the HUD and this
+// runner's count are one count. A step that ends after it is due restarts the schedule from its
+// end (no burst of catch-up steps): simulated time then falls behind the wall clock, by the
+// amount reported as `slip_s`. Starts later than 10 % of Δt that still met the deadline are
+// counted too (late starts), and the schedule keeps its grid.
 //
 // The control thread asks for real-time scheduling (SCHED_FIFO) so that a busy UI or renderer
 // (Mesa's software rasterizer runs a thread per core) cannot delay its steps; where the system
@@ -26,8 +29,10 @@ namespace mixpilot {
 
 struct RealtimeStats {
   std::int64_t steps = 0;
-  std::int64_t deadline_misses = 0;
+  std::int64_t deadline_misses = 0;  // steps the mode marked kEventDeadlineMiss
   std::int64_t late_starts = 0;    // started more than 10 % of Δt late, yet met the deadline
+  std::int64_t safe_hold_steps = 0;  // flown by the mode's safe controller (kEventSafeHold)
+  double slip_s = 0.0;             // how far simulated time fell behind the wall clock [s]
   double worst_lateness_us = 0.0;  // the latest start after its schedule
   double worst_step_us = 0.0;      // the longest step
   double p99_step_us = 0.0;        // 99th percentile of the step times (to 20 us)
@@ -63,7 +68,8 @@ class RealtimeRunner {
   std::thread thread_;
   std::atomic<bool> stop_{false}, paused_{false}, running_{false}, fifo_{false};
   std::atomic<double> speed_{1.0};
-  std::atomic<std::int64_t> steps_{0}, misses_{0}, late_starts_{0};
+  std::atomic<std::int64_t> steps_{0}, misses_{0}, late_starts_{0}, safe_{0};
+  std::atomic<double> slip_s_{0.0};
   std::atomic<double> worst_lateness_us_{0.0}, worst_step_us_{0.0};
   // Step times in 20 us bins (the last bin holds every longer step): percentiles without
   // keeping the samples.
