@@ -2,8 +2,11 @@
 // and pixels that can fail are checked against the telemetry they draw.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,7 +19,10 @@
 #include "core/modes/session.hpp"
 #include "ui/scene.hpp"
 #include "ui/screen.hpp"
+#include "ui/panels.hpp"
 #include "ui/theme.hpp"
+
+#include "ui_layout.hpp"
 
 namespace mixpilot {
 namespace {
@@ -82,9 +88,13 @@ TEST_F(Ui, AuthorityBarFillMatchesLambda) {
   ui::UiState st;
   const double lambda = f.history.newest().lambda;
   const auto px = render(scene, f.history, st);
-  // The bar's row: the first row from the top with both colours, counted left to right.
+  // The bar's row: the first row from the view's top with both colours, counted left to right.
+  ImVec2 vmin, vmax;
+  ui::RunInfo run;
+  run.state = ui::RunState::flying;
+  ui::view_rect(ImVec2(kW, kH), run, vmin, vmax);
   int best_row = -1, pilot = 0, planner = 0;
-  for (int y = 96; y < 200 && best_row < 0; ++y) {
+  for (int y = int(vmin.y); y < int(vmin.y) + 120 && best_row < 0; ++y) {
     int a = 0, b = 0;
     for (int x = 0; x < kW; ++x) {
       const std::uint8_t* p = &px[(std::size_t(y) * kW + std::size_t(x)) * 4];
@@ -165,6 +175,43 @@ TEST_F(Ui, EveryModeRenders) {
       for (int x = 0; x < kW / 2; ++x)
         drawn += near(&px[(std::size_t(y) * kW + std::size_t(x)) * 4], bg, 2) ? 0 : 1;
     EXPECT_GT(drawn, 2000) << scenario << ": the view is (almost) empty";
+  }
+}
+
+// Every mode's flying screen at 100 %, 150 % and 200 % of 1280x720 and in an 800x450 window:
+// no pane overlaps another, nothing is cut (ui_layout.hpp).
+TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
+  std::vector<std::pair<const char*, Flown>> flights;
+  for (const char* scenario : {"mi_helix.toml", "pendubot_swingup.toml", "tracking_helix.toml",
+                               "obstacles_thrown_balls.toml"})
+    flights.emplace_back(scenario, fly(scenario, 1.5));
+  struct Display {
+    int w, h;
+    float scale;
+  };
+  for (const Display d : {Display{1280, 720, 1.0f}, Display{1280, 720, 1.5f},
+                          Display{1280, 720, 2.0f}, Display{800, 450, 1.0f}}) {
+    cli::Offscreen screen;
+    std::string error;
+    if (!screen.open(d.w, d.h, error, d.scale)) GTEST_SKIP() << "no EGL device: " << error;
+    for (auto& [scenario, f] : flights) {
+      ASSERT_TRUE(f.mode) << scenario;
+      SCOPED_TRACE(std::string(scenario) + " at " + std::to_string(d.w) + "x" + std::to_string(d.h) +
+                   ", scale " + std::to_string(d.scale));
+      const ui::Scene scene = ui::scene_of(*f.mode, "test");
+      ui::UiState st;
+      ui::RunInfo run;
+      run.state = ui::RunState::flying;
+      for (int i = 0; i < 3; ++i) screen.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+      for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+      // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
+      if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
+        std::ofstream(std::string(dir) + "/mode_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +
+                          "_" + std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
+                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
+                      std::ios::binary)
+            << screen.png();
+    }
   }
 }
 

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -43,7 +44,7 @@ struct View {
 void line(ImDrawList* dl, const View& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
           ImU32 c, float w) {
   ImVec2 pa, pb;
-  if (v.project(a, pa) && v.project(b, pb)) dl->AddLine(pa, pb, c, w);
+  if (v.project(a, pa) && v.project(b, pb)) dl->AddLine(pa, pb, c, scaled(w));
 }
 
 Eigen::Matrix3d attitude(const Eigen::VectorXd& x) { return models::attitude(x).toRotationMatrix(); }
@@ -108,9 +109,9 @@ void draw_sphere(ImDrawList* dl, const View& v, const Eigen::Vector3d& c, double
   if (!v.project(c, pc)) return;
   const float pr = float(v.pixels(r, c));
   dl->AddCircleFilled(pc, pr, (col & 0x00FFFFFF) | 0x70000000, 32);
-  dl->AddCircle(pc, pr, col, 32, 1.5f);
+  dl->AddCircle(pc, pr, col, 32, scaled(1.5f));
   ImVec2 pf;  // its shadow on the floor, so its height reads
-  if (v.project({c.x(), c.y(), 0.0}, pf)) dl->AddLine(pc, pf, (col & 0x00FFFFFF) | 0x60000000, 1.0f);
+  if (v.project({c.x(), c.y(), 0.0}, pf)) dl->AddLine(pc, pf, (col & 0x00FFFFFF) | 0x60000000, scaled(1.0f));
 }
 
 void draw_vehicle(ImDrawList* dl, const View& v, const Scene& sc, const Telemetry& s) {
@@ -132,16 +133,16 @@ void draw_vehicle(ImDrawList* dl, const View& v, const Scene& sc, const Telemetr
       const float f = float(std::clamp(omega[i] / omax, 0.0, 1.0));
       const ImU32 c = ImGui::ColorConvertFloat4ToU32(
           ImVec4(0.45f + 0.49f * f, 0.45f + 0.44f * f, 0.45f - 0.19f * f, 0.85f));
-      const float r = std::clamp(float(v.pixels(0.05, tip)), 3.0f, 12.0f);
-      dl->AddCircle(pt, r, c, 16, 2.5f);
+      const float r = std::clamp(float(v.pixels(0.05, tip)), scaled(3.0f), scaled(12.0f));
+      dl->AddCircle(pt, r, c, 16, scaled(2.5f));
     }
   }
   // The nose, so the heading reads.
   line(dl, v, p, p + R * Eigen::Vector3d(1.6 * arm, 0, 0), colour::kCritical, 2.0f);
   ImVec2 pp, pf;
-  if (v.project(p, pp)) dl->AddCircleFilled(pp, 4.0f, colour::kText, 12);
+  if (v.project(p, pp)) dl->AddCircleFilled(pp, scaled(4.0f), colour::kText, 12);
   if (v.project(p, pp) && v.project({p.x(), p.y(), sc.arena_min.z()}, pf))
-    dl->AddLine(pp, pf, colour::rgb(200, 200, 200, 90), 1.0f);
+    dl->AddLine(pp, pf, colour::rgb(200, 200, 200, 90), scaled(1.0f));
 }
 
 }  // namespace
@@ -152,7 +153,8 @@ bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& u
   return make_view(sc, newest, copy, min, max).project(p, px);
 }
 
-void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max) {
+void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max,
+                ImVec2 frame) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
   dl->AddRectFilled(min, max, colour::kBackground);
@@ -161,7 +163,7 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     return;
   }
   const Telemetry& s = h.newest();
-  const View v = make_view(sc, s, ui, min, max);
+  const View v = make_view(sc, s, ui, frame, max);
   draw_world(dl, v, sc);
   for (const SceneSphere& o : sc.spheres) draw_sphere(dl, v, o.center, o.radius, colour::kObstacle);
   if (sc.moving) {
@@ -177,13 +179,14 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
       ImVec2 pc;
       const Eigen::Vector3d c = s.predicted_reference.col(i);
       if (v.project(c, pc))
-        dl->AddCircle(pc, float(v.pixels(sc.ball_radius, c)), colour::rgb(0xEE, 0xEE, 0xEE, 50), 24);
+        dl->AddCircle(pc, float(v.pixels(sc.ball_radius, c)), colour::rgb(0xEE, 0xEE, 0xEE, 50), 24,
+                      scaled(1.0f));
     }
     ImVec2 pb;
     if (s.reference.size() >= 3 && v.project(s.reference.head<3>(), pb)) {
       const float r = float(v.pixels(sc.ball_radius, s.reference.head<3>()));
       dl->AddCircleFilled(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 28), 32);
-      dl->AddCircle(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 150), 32, 1.5f);
+      dl->AddCircle(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 150), 32, scaled(1.5f));
     }
   }
   // The trail of the last seconds, coloured by λ in mixed initiative.
@@ -212,8 +215,13 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
       ui.orbit_distance = std::clamp(base * std::pow(0.9f, io.MouseWheel), 0.5f, 100.0f);
     }
   }
-  dl->AddText(ImVec2(min.x + 8, max.y - 22), colour::rgb(200, 200, 200),
-              (std::string("camera: ") + to_string(ui.camera) + "  (1 chase · 2 orbit · 3 top · 4 side)").c_str());
+  // The camera and its keys at the bottom left; the keys shorter where the view is narrow.
+  const float inset = ImGui::GetStyle().WindowPadding.x;
+  std::string hint = std::string("camera: ") + to_string(ui.camera) + "  (1 chase · 2 orbit · 3 top · 4 side)";
+  if (ImGui::CalcTextSize(hint.c_str()).x > max.x - min.x - 2 * inset)
+    hint = std::string("camera: ") + to_string(ui.camera) + "  (keys 1-4)";
+  dl->AddText(ImVec2(min.x + inset, max.y - inset - ImGui::GetTextLineHeight()),
+              colour::rgb(200, 200, 200), hint.c_str());
   dl->PopClipRect();
 }
 
