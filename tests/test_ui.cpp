@@ -178,6 +178,59 @@ TEST_F(Ui, EveryModeRenders) {
   }
 }
 
+// At launch the chase camera looks at the vehicle across the column on the arena's axis (a
+// sphere between the camera and the vehicle). It is faded: around the vehicle it adds almost no
+// obstacle colour to what the scene shows without it, yet its outline is still drawn.
+TEST_F(Ui, AnObstacleBetweenTheCameraAndTheVehicleIsFaded) {
+  Flown f = fly("mi_helix.toml", 0.1, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  ASSERT_EQ(st.camera, ui::Camera::chase);
+  const auto with = render(scene, f.history, st);
+  ImVec2 vmin, vmax;
+  ui::view_rect(ImVec2(kW, kH), ui::RunInfo{}, vmin, vmax);
+  const Telemetry& s = f.history.newest();
+  ImVec2 vehicle;
+  ASSERT_TRUE(ui::project_in_arena(scene, s, st, vmin, vmax, s.x.head<3>(), vehicle));
+  // The sphere whose disc on screen holds the vehicle (its radius from its top's projection).
+  int blocking = -1;
+  float radius = 0.0f;
+  for (std::size_t k = 0; k < scene.spheres.size(); ++k) {
+    const ui::SceneSphere& o = scene.spheres[k];
+    ImVec2 c, top;
+    if (!ui::project_in_arena(scene, s, st, vmin, vmax, o.center, c) ||
+        !ui::project_in_arena(scene, s, st, vmin, vmax, o.center + o.radius * Eigen::Vector3d::UnitZ(), top))
+      continue;
+    const float r = std::hypot(top.x - c.x, top.y - c.y);
+    if (std::hypot(vehicle.x - c.x, vehicle.y - c.y) < 0.5f * r && r > radius) {
+      blocking = int(k);
+      radius = r;
+    }
+  }
+  ASSERT_GE(blocking, 0) << "no sphere between the chase camera and the vehicle at launch";
+  ui::Scene without = scene;
+  without.spheres.erase(without.spheres.begin() + blocking);
+  const auto bare = render(without, f.history, st);
+  // Strongly obstacle-coloured: reddish purple, well away from the grey scene.
+  const auto purple = [](const std::uint8_t* p) { return p[0] - p[1] > 20 && p[2] - p[1] > 10; };
+  int region = 0, added = 0, changed = 0;
+  const float around = 0.8f * radius;
+  for (int y = int(vmin.y); y < int(vmax.y); ++y) {
+    for (int x = int(vmin.x); x < int(vmax.x); ++x) {
+      const std::size_t i = (std::size_t(y) * kW + std::size_t(x)) * 4;
+      changed += with[i] != bare[i] || with[i + 1] != bare[i + 1] || with[i + 2] != bare[i + 2];
+      if (std::hypot(float(x) - vehicle.x, float(y) - vehicle.y) > around) continue;
+      ++region;
+      added += purple(&with[i]) && !purple(&bare[i]) ? 1 : 0;
+    }
+  }
+  ASSERT_GT(region, 1000);
+  EXPECT_LT(added, region / 50) << added << " of " << region
+                                << " pixels around the vehicle turn obstacle-coloured";
+  EXPECT_GT(changed, 300) << "the sphere in front of the vehicle is not drawn at all";
+}
+
 // Every mode's flying screen at 100 %, 150 % and 200 % of 1280x720 and in an 800x450 window:
 // no pane overlaps another, nothing is cut (ui_layout.hpp).
 TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
