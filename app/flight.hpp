@@ -36,6 +36,7 @@ struct FlyOptions {
   bool force = false;
   std::vector<ScreenshotRequest> screenshots;
   int width = 1280, height = 720;  // of the screenshots and the window
+  float scale = 0.0f;              // --scale: the UI's display scale (0: the window's; headless 1)
   bool realtime = false;           // headless, paced by the wall clock
   bool exit_at_end = false;        // window: start at once, close when the run is over
   bool replay = false;             // `mixpilot replay`: a recording of any mode flown again

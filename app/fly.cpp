@@ -33,6 +33,8 @@ namespace mixpilot::cli {
 namespace {
 
 constexpr double kMaxDuration = 3600.0;  // [s] --duration: memory and time stay proportionate
+// --scale: from half size (a 4K panel at 48 dpi makes no sense below) to 400 %.
+constexpr double kMinScale = 0.5, kMaxScale = 4.0;
 
 constexpr const char* kFlyUsage =
     "usage: mixpilot fly --scenario FILE --pilot PILOT [--headless] [options]\n"
@@ -80,6 +82,10 @@ constexpr const char* kFlyUsage =
     "                     step with t_k <= T < t_k + dt), rendered offscreen with EGL;\n"
     "                     repeatable\n"
     "  --size WxH         screenshot and window size in pixels (default 1280x720)\n"
+    "  --scale S          display scale of the UI, 0.5 to 4 (1.5 = 150 %): the fonts and\n"
+    "                     sizes the window has on such a display. Default: the window follows\n"
+    "                     the desktop (GLFW's content scale, Xft.dpi / 96 on X11); --headless\n"
+    "                     renders at 1 (100 %)\n"
     "  --force            overwrite existing --record, --report and --screenshot files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
@@ -99,7 +105,7 @@ int run_in_window(const FlyOptions& o) {
     return status == kExitOk ? kExitError : status;
   }
   std::vector<std::string> shots;
-  const WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force};
+  const WindowOptions wo{o.width, o.height, o.exit_at_end, o.screenshots, o.force, o.scale};
   const bool shown = run_window(app, wo, shots, error);
   status = app.finish();
   for (const std::string& path : shots) std::printf("  screenshot %s\n", path.c_str());
@@ -123,7 +129,7 @@ int run_replay_headless(const FlyOptions& o) {
   std::optional<Offscreen> screen;
   if (!o.screenshots.empty()) {
     screen.emplace();
-    if (!screen->open(o.width, o.height, error)) {
+    if (!screen->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
@@ -190,7 +196,7 @@ int run_fly(const FlyOptions& o) {
   std::optional<ScreenshotSink> screenshots;
   if (!o.screenshots.empty() && o.headless) {
     screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
-    if (!screenshots->open(o.width, o.height, error)) {
+    if (!screenshots->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
@@ -305,7 +311,7 @@ int run_fly(const FlyOptions& o) {
   return status;
 }
 
-// --screenshot, --size and --exit-at-end, shared by fly and replay: true when `a` is one of them
+// --screenshot, --size, --scale and --exit-at-end, shared by fly and replay: true when `a` is one of them
 // (its value taken through `value`).
 template <class Value>
 bool parse_view_option(std::string_view a, const Value& value, FlyOptions& o) {
@@ -320,6 +326,13 @@ bool parse_view_option(std::string_view a, const Value& value, FlyOptions& o) {
     const std::string v = value();
     if (!parse_size(v, o.width, o.height))
       usage_error(o.command, "--size expects WxH, each from 64 to 8192 pixels, got '" + v + "'");
+  } else if (a == "--scale") {
+    const std::string v = value();
+    const auto scale = parse_seconds(v, kMaxScale);  // a positive number up to the bound
+    if (!scale || *scale < kMinScale)
+      usage_error(o.command, "--scale expects a display scale from 0.5 to 4 (1.5 is 150 %), got '" +
+                                 v + "'");
+    o.scale = float(*scale);
   } else if (a == "--exit-at-end") {
     o.exit_at_end = true;
   } else {
@@ -417,6 +430,7 @@ constexpr const char* kReplayUsage =
     "  --headless         no window (with --screenshot: what the window shows at time T)\n"
     "  --screenshot T:FILE.png  as for fly; repeatable\n"
     "  --size WxH         screenshot or window size (default 1280x720)\n"
+    "  --scale S          display scale of the UI, 0.5 to 4 (as for fly; headless default 1)\n"
     "  --exit-at-end      window: start at once and close the window at the end\n"
     "  --force            overwrite existing screenshot files\n"
     "  -h, --help         show this help\n"

@@ -35,9 +35,10 @@ std::string egl_error(const char* what) {
 
 Offscreen::~Offscreen() { close(); }
 
-bool Offscreen::open(int width, int height, std::string& error) {
+bool Offscreen::open(int width, int height, std::string& error, float scale) {
   width_ = width;
   height_ = height;
+  scale_ = scale;
   // libepoxy loads libEGL itself and aborts the process when it cannot: ask first.
   if (void* egl = dlopen("libEGL.so.1", RTLD_LAZY | RTLD_LOCAL)) {
     dlclose(egl);
@@ -106,8 +107,8 @@ bool Offscreen::open(int width, int height, std::string& error) {
       {ImGuiKey_X, GLFW_KEY_X}, {ImGuiKey_Y, GLFW_KEY_Y}, {ImGuiKey_Z, GLFW_KEY_Z}};
   for (const auto& [k, code] : keys) io.KeyMap[k] = code;
   io.DisplaySize = ImVec2(float(width), float(height));
-  mixpilot::ui::apply_style(1.0f);
-  font_ = mixpilot::ui::load_fonts(1.0f);
+  mixpilot::ui::apply_style(scale);
+  font_ = mixpilot::ui::load_fonts(scale);
   if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
     error = "ImGui's OpenGL3 renderer did not start";
     return false;

@@ -16,9 +16,10 @@ class Offscreen {
   Offscreen& operator=(const Offscreen&) = delete;
   ~Offscreen();
 
-  // Creates the context, the framebuffer and ImGui (style and fonts of ui/theme.hpp). False
-  // with the reason (no EGL device, no OpenGL 3.3) and what to install.
-  [[nodiscard]] bool open(int width, int height, std::string& error);
+  // Creates the context, the framebuffer and ImGui (style and fonts of ui/theme.hpp) at the
+  // display scale `scale` (1: 100 %, 1.5: 150 %): what the window shows on such a display.
+  // False with the reason (no EGL device, no OpenGL 3.3) and what to install.
+  [[nodiscard]] bool open(int width, int height, std::string& error, float scale = 1.0f);
 
   // Renders one ImGui frame: `build` runs between ImGui::NewFrame() and ImGui::Render().
   // `dt` is the frame's time step for ImGui [s].
@@ -35,12 +36,14 @@ class Offscreen {
 
   int width() const { return width_; }
   int height() const { return height_; }
+  float scale() const { return scale_; }
   const std::string& font() const { return font_; }
 
  private:
   void close();
 
   int width_ = 0, height_ = 0;
+  float scale_ = 1.0f;
   void* display_ = nullptr;  // EGLDisplay
   void* context_ = nullptr;  // EGLContext
   unsigned fbo_ = 0, colour_ = 0, depth_ = 0;

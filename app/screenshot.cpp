@@ -44,9 +44,9 @@ ScreenshotSink::ScreenshotSink(ui::Scene scene, std::vector<ScreenshotRequest> r
 
 ScreenshotSink::~ScreenshotSink() = default;
 
-bool ScreenshotSink::open(int width, int height, std::string& error) {
+bool ScreenshotSink::open(int width, int height, std::string& error, float scale) {
   offscreen_ = std::make_unique<Offscreen>();
-  return offscreen_->open(width, height, error);
+  return offscreen_->open(width, height, error, scale);
 }
 
 void ScreenshotSink::on_sample(const Telemetry& s) {

@@ -32,8 +32,8 @@ class ScreenshotSink : public TelemetrySink {
   ScreenshotSink(ui::Scene scene, std::vector<ScreenshotRequest> requests, bool overwrite);
   ~ScreenshotSink() override;
 
-  // Starts the offscreen renderer; false with the reason.
-  [[nodiscard]] bool open(int width, int height, std::string& error);
+  // Starts the offscreen renderer at the display scale `scale`; false with the reason.
+  [[nodiscard]] bool open(int width, int height, std::string& error, float scale = 1.0f);
   void on_sample(const Telemetry& sample) override;
 
   // After the flight: false with the first failure (a write error, a time never reached).

@@ -40,6 +40,21 @@ std::string frame_png(int w, int h) {
   return out;
 }
 
+// The UI's scale on this window's display. ImGui lays out in window coordinates: where the
+// desktop scales the framebuffer itself (Wayland, macOS: a 2x framebuffer behind a 1280x720
+// window) that part of the content scale is already done; where it does not (X11: Xft.dpi),
+// the fonts and sizes carry all of it.
+float ui_scale(GLFWwindow* window) {
+  float sx = 1.0f, sy = 1.0f;
+  glfwGetWindowContentScale(window, &sx, &sy);
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  const float framebuffer = ww > 0 && fw > 0 ? float(fw) / float(ww) : 1.0f;
+  const float s = sx / std::max(framebuffer, 1.0f);
+  return std::isfinite(s) && s > 0.0f ? std::clamp(s, 0.5f, 4.0f) : 1.0f;
+}
+
 }  // namespace
 
 bool window_available(std::string& error) {
@@ -68,13 +83,12 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
   }
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
-  float sx = 1.0f, sy = 1.0f;
-  glfwGetWindowContentScale(window, &sx, &sy);
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
-  ui::apply_style(sx);
-  ui::load_fonts(sx);
+  const float scale = o.scale > 0 ? o.scale : ui_scale(window);
+  ui::apply_style(scale);
+  ui::load_fonts(scale);
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 

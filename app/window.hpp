@@ -15,6 +15,7 @@ struct WindowOptions {
   bool exit_at_end = false;  // start at once and close the window when the run is over
   std::vector<ScreenshotRequest> screenshots;  // the window's frame when the shown time reaches T
   bool overwrite = false;
+  float scale = 0.0f;  // the UI's display scale (0: the window's content scale)
 };
 
 // Whether a window can be opened here (a display and GLFW); false with the reason.

@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
-# one per mode, one of a replay and one of input loss, 800x450; the input settings panel at
-# 1280x720 (an app test renders it). Usage: docs/screenshots.sh [path/to/mixpilot]
+# one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display
+# and the input settings panel at 1280x720 (an app test renders the panel).
+# Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 m=${1:-build/release/app/mixpilot}
 out=docs/screenshots
 "$m" fly --scenario scenarios/mi_helix.toml --pilot novice --headless --duration 8 \
   --screenshot 7.5:$out/mixed_initiative.png --size 800x450 --force >/dev/null
+# What a 150 % display (Xft.dpi 144) shows in a 1280x720 window.
+"$m" fly --scenario scenarios/mi_helix.toml --pilot novice --headless --duration 8 \
+  --screenshot 7.5:$out/scale_150.png --size 1280x720 --scale 1.5 --force >/dev/null
 "$m" fly --scenario scenarios/pendubot_swingup.toml --headless --duration 2 \
   --screenshot 1.2:$out/pendubot.png --size 800x450 --force >/dev/null
 "$m" fly --scenario scenarios/tracking_helix.toml --headless --duration 5 \

@@ -34,6 +34,7 @@
 #include "ui/theme.hpp"
 
 #include "temp_files.hpp"
+#include "ui_layout.hpp"
 
 namespace mixpilot {
 namespace {
@@ -718,6 +719,96 @@ TEST_F(App, TheMappingWizardMakesAnUnknownJoystickAGamepad) {
   SDL_JoystickClose(js);
   SDL_JoystickDetachVirtual(index);
   SDL_QuitSubSystem(SDL_INIT_JOYSTICK);
+}
+
+// The window at 100 %, 150 % and 200 % of 1280x720 and in a small window (800x450 at 100 %):
+// in every state a newcomer meets (ready with the session panel, a long message, flying, the
+// score card, the shortcut sheet, the file browser, the input settings, a replay) no pane
+// overlaps another, no window cuts what it holds and no text is cut (ui_layout.hpp). With
+// MIXPILOT_SHOT_DIR set, each state is saved as layout_<state>_<W>x<H>_<percent>.png.
+TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
+  fresh_user_dirs("layout");
+  const std::string rec = record("mi_helix.toml", 3.0, "reckless", "layout.mcap");
+  struct Display {
+    int w, h;
+    float scale;
+  };
+  for (const Display d : {Display{1280, 720, 1.0f}, Display{1280, 720, 1.5f},
+                          Display{1280, 720, 2.0f}, Display{800, 450, 1.0f}}) {
+    cli::Offscreen screen;
+    std::string error;
+    if (!screen.open(d.w, d.h, error, d.scale)) GTEST_SKIP() << "no EGL device: " << error;
+    const std::string at = std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
+                           std::to_string(int(std::lround(100 * d.scale)));
+    const auto frames = [&](cli::Trainer& app, int n = 3) {
+      for (int i = 0; i < n; ++i) screen.frame([&] { app.build_frame(0.0); }, 1e-4f);
+    };
+    const auto check = [&](const char* state) {
+      SCOPED_TRACE(std::string(state) + " at " + at);
+      for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+      save_shot(screen, std::string("layout_") + state + "_" + at);
+    };
+    const auto press = [&](cli::Trainer& app, int k, bool ctrl = false) {
+      ImGui::GetIO().KeyCtrl = ctrl;
+      ImGui::GetIO().KeysDown[k] = true;
+      frames(app, 1);
+      ImGui::GetIO().KeysDown[k] = false;
+      ImGui::GetIO().KeyCtrl = false;
+      frames(app);
+    };
+    {
+      cli::Trainer app(live_options("mi_helix.toml", 0.6));
+      int status = 0;
+      ASSERT_TRUE(app.open_live(error, status)) << error;
+      frames(app);
+      check("ready");
+      press(app, ui::kKeyF1);
+      check("help");
+      press(app, ImGui::GetIO().KeyMap[ImGuiKey_Escape]);
+      press(app, 'O', true);
+      check("open");
+      app.ui_state().open_dialog.open = false;
+      frames(app);
+      press(app, 'I');
+      check("settings");
+      press(app, 'I');
+      app.start();
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      frames(app);
+      check("flying");
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      while (!app.over() && std::chrono::steady_clock::now() < deadline) {
+        frames(app, 1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      frames(app);
+      check("score_card");
+    }
+    {
+      // A message too long for the top bar (a broken settings file names its path).
+      const std::string dir = std::string(std::getenv("XDG_CONFIG_HOME")) + "/mixpilot";
+      std::filesystem::create_directories(dir);
+      std::ofstream(dir + "/input.toml") << "mode = 7\n";
+      cli::Trainer app(live_options("mi_helix.toml", 1.0, "keyboard"));
+      int status = 0;
+      ASSERT_TRUE(app.open_live(error, status)) << error;
+      frames(app);
+      ASSERT_FALSE(app.run_info().message.empty());
+      check("message");
+      std::filesystem::remove(dir + "/input.toml");
+    }
+    {
+      cli::FlyOptions o;
+      o.replay = true;
+      o.pilot = rec;
+      cli::Trainer app(o);
+      ASSERT_TRUE(app.open_replay(rec, error)) << error;
+      app.load_replay();
+      app.seek(2.0);
+      frames(app);
+      check("replay");
+    }
+  }
 }
 
 }  // namespace

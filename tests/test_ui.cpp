@@ -2,8 +2,11 @@
 // and pixels that can fail are checked against the telemetry they draw.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,7 +19,10 @@
 #include "core/modes/session.hpp"
 #include "ui/scene.hpp"
 #include "ui/screen.hpp"
+#include "ui/panels.hpp"
 #include "ui/theme.hpp"
+
+#include "ui_layout.hpp"
 
 namespace mixpilot {
 namespace {
@@ -82,9 +88,13 @@ TEST_F(Ui, AuthorityBarFillMatchesLambda) {
   ui::UiState st;
   const double lambda = f.history.newest().lambda;
   const auto px = render(scene, f.history, st);
-  // The bar's row: the first row from the top with both colours, counted left to right.
+  // The bar's row: the first row from the view's top with both colours, counted left to right.
+  ImVec2 vmin, vmax;
+  ui::RunInfo run;
+  run.state = ui::RunState::flying;
+  ui::view_rect(ImVec2(kW, kH), run, vmin, vmax);
   int best_row = -1, pilot = 0, planner = 0;
-  for (int y = 96; y < 200 && best_row < 0; ++y) {
+  for (int y = int(vmin.y); y < int(vmin.y) + 120 && best_row < 0; ++y) {
     int a = 0, b = 0;
     for (int x = 0; x < kW; ++x) {
       const std::uint8_t* p = &px[(std::size_t(y) * kW + std::size_t(x)) * 4];
@@ -165,6 +175,96 @@ TEST_F(Ui, EveryModeRenders) {
       for (int x = 0; x < kW / 2; ++x)
         drawn += near(&px[(std::size_t(y) * kW + std::size_t(x)) * 4], bg, 2) ? 0 : 1;
     EXPECT_GT(drawn, 2000) << scenario << ": the view is (almost) empty";
+  }
+}
+
+// At launch the chase camera looks at the vehicle across the column on the arena's axis (a
+// sphere between the camera and the vehicle). It is faded: around the vehicle it adds almost no
+// obstacle colour to what the scene shows without it, yet its outline is still drawn.
+TEST_F(Ui, AnObstacleBetweenTheCameraAndTheVehicleIsFaded) {
+  Flown f = fly("mi_helix.toml", 0.1, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  ASSERT_EQ(st.camera, ui::Camera::chase);
+  const auto with = render(scene, f.history, st);
+  ImVec2 vmin, vmax;
+  ui::view_rect(ImVec2(kW, kH), ui::RunInfo{}, vmin, vmax);
+  const Telemetry& s = f.history.newest();
+  ImVec2 vehicle;
+  ASSERT_TRUE(ui::project_in_arena(scene, s, st, vmin, vmax, s.x.head<3>(), vehicle));
+  // The sphere whose disc on screen holds the vehicle (its radius from its top's projection).
+  int blocking = -1;
+  float radius = 0.0f;
+  for (std::size_t k = 0; k < scene.spheres.size(); ++k) {
+    const ui::SceneSphere& o = scene.spheres[k];
+    ImVec2 c, top;
+    if (!ui::project_in_arena(scene, s, st, vmin, vmax, o.center, c) ||
+        !ui::project_in_arena(scene, s, st, vmin, vmax, o.center + o.radius * Eigen::Vector3d::UnitZ(), top))
+      continue;
+    const float r = std::hypot(top.x - c.x, top.y - c.y);
+    if (std::hypot(vehicle.x - c.x, vehicle.y - c.y) < 0.5f * r && r > radius) {
+      blocking = int(k);
+      radius = r;
+    }
+  }
+  ASSERT_GE(blocking, 0) << "no sphere between the chase camera and the vehicle at launch";
+  ui::Scene without = scene;
+  without.spheres.erase(without.spheres.begin() + blocking);
+  const auto bare = render(without, f.history, st);
+  // Strongly obstacle-coloured: reddish purple, well away from the grey scene.
+  const auto purple = [](const std::uint8_t* p) { return p[0] - p[1] > 20 && p[2] - p[1] > 10; };
+  int region = 0, added = 0, changed = 0;
+  const float around = 0.8f * radius;
+  for (int y = int(vmin.y); y < int(vmax.y); ++y) {
+    for (int x = int(vmin.x); x < int(vmax.x); ++x) {
+      const std::size_t i = (std::size_t(y) * kW + std::size_t(x)) * 4;
+      changed += with[i] != bare[i] || with[i + 1] != bare[i + 1] || with[i + 2] != bare[i + 2];
+      if (std::hypot(float(x) - vehicle.x, float(y) - vehicle.y) > around) continue;
+      ++region;
+      added += purple(&with[i]) && !purple(&bare[i]) ? 1 : 0;
+    }
+  }
+  ASSERT_GT(region, 1000);
+  EXPECT_LT(added, region / 50) << added << " of " << region
+                                << " pixels around the vehicle turn obstacle-coloured";
+  EXPECT_GT(changed, 300) << "the sphere in front of the vehicle is not drawn at all";
+}
+
+// Every mode's flying screen at 100 %, 150 % and 200 % of 1280x720 and in an 800x450 window:
+// no pane overlaps another, nothing is cut (ui_layout.hpp).
+TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
+  std::vector<std::pair<const char*, Flown>> flights;
+  for (const char* scenario : {"mi_helix.toml", "pendubot_swingup.toml", "tracking_helix.toml",
+                               "obstacles_thrown_balls.toml"})
+    flights.emplace_back(scenario, fly(scenario, 1.5));
+  struct Display {
+    int w, h;
+    float scale;
+  };
+  for (const Display d : {Display{1280, 720, 1.0f}, Display{1280, 720, 1.5f},
+                          Display{1280, 720, 2.0f}, Display{800, 450, 1.0f}}) {
+    cli::Offscreen screen;
+    std::string error;
+    if (!screen.open(d.w, d.h, error, d.scale)) GTEST_SKIP() << "no EGL device: " << error;
+    for (auto& [scenario, f] : flights) {
+      ASSERT_TRUE(f.mode) << scenario;
+      SCOPED_TRACE(std::string(scenario) + " at " + std::to_string(d.w) + "x" + std::to_string(d.h) +
+                   ", scale " + std::to_string(d.scale));
+      const ui::Scene scene = ui::scene_of(*f.mode, "test");
+      ui::UiState st;
+      ui::RunInfo run;
+      run.state = ui::RunState::flying;
+      for (int i = 0; i < 3; ++i) screen.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+      for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+      // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
+      if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
+        std::ofstream(std::string(dir) + "/mode_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +
+                          "_" + std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
+                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
+                      std::ios::binary)
+            << screen.png();
+    }
   }
 }
 

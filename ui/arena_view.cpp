@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -43,7 +44,29 @@ struct View {
 void line(ImDrawList* dl, const View& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
           ImU32 c, float w) {
   ImVec2 pa, pb;
-  if (v.project(a, pa) && v.project(b, pb)) dl->AddLine(pa, pb, c, w);
+  if (v.project(a, pa) && v.project(b, pb)) dl->AddLine(pa, pb, c, scaled(w));
+}
+
+ImU32 with_alpha(ImU32 c, float alpha) {
+  return (c & 0x00FFFFFF) | (ImU32(std::clamp(alpha, 0.0f, 1.0f) * 255.0f + 0.5f) << 24);
+}
+
+// `a` moved towards `b` by `f` ∈ [0, 1], with opacity `alpha`.
+ImU32 mix(ImU32 a, ImU32 b, float f, float alpha) {
+  const ImVec4 x = ImGui::ColorConvertU32ToFloat4(a), y = ImGui::ColorConvertU32ToFloat4(b);
+  const auto m = [f](float p, float q) { return p + (q - p) * f; };
+  return ImGui::ColorConvertFloat4ToU32(ImVec4(m(x.x, y.x), m(x.y, y.y), m(x.z, y.z), alpha));
+}
+
+// A horizontal disc of radius r at `c` (a shadow on the floor), as the camera sees it.
+void floor_disc(ImDrawList* dl, const View& v, const Eigen::Vector3d& c, double r, ImU32 col) {
+  constexpr int kPoints = 28;
+  ImVec2 pts[kPoints];
+  for (int i = 0; i < kPoints; ++i) {
+    const double a = 2.0 * M_PI * i / kPoints;
+    if (!v.project(c + r * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0), pts[i])) return;
+  }
+  dl->AddConvexPolyFilled(pts, kPoints, col);
 }
 
 Eigen::Matrix3d attitude(const Eigen::VectorXd& x) { return models::attitude(x).toRotationMatrix(); }
@@ -103,17 +126,33 @@ void draw_world(ImDrawList* dl, const View& v, const Scene& sc) {
   }
 }
 
-void draw_sphere(ImDrawList* dl, const View& v, const Eigen::Vector3d& c, double r, ImU32 col) {
-  ImVec2 pc;
-  if (!v.project(c, pc)) return;
-  const float pr = float(v.pixels(r, c));
-  dl->AddCircleFilled(pc, pr, (col & 0x00FFFFFF) | 0x70000000, 32);
-  dl->AddCircle(pc, pr, col, 32, 1.5f);
-  ImVec2 pf;  // its shadow on the floor, so its height reads
-  if (v.project({c.x(), c.y(), 0.0}, pf)) dl->AddLine(pc, pf, (col & 0x00FFFFFF) | 0x60000000, 1.0f);
+// A sphere lit from the upper left: a fan from the highlight to the rim, lighter to darker, so
+// it reads as a ball rather than a disc; `fog` ∈ [0, 1] dims it with its distance.
+void shaded_sphere(ImDrawList* dl, ImVec2 c, float r, ImU32 base, float fog, float alpha) {
+  constexpr int kRim = 40;
+  const ImU32 body = mix(base, colour::kBackground, 0.45f * fog, 1.0f);
+  const ImU32 light = mix(body, colour::rgb(255, 255, 255), 0.55f, alpha);
+  const ImVec2 hl(c.x - 0.38f * r, c.y - 0.42f * r);
+  const ImVec2 uv = ImGui::GetFontTexUvWhitePixel();
+  const auto first = ImDrawIdx(dl->_VtxCurrentIdx);
+  dl->PrimReserve(kRim * 3, kRim + 1);
+  dl->PrimWriteVtx(hl, uv, light);
+  for (int i = 0; i < kRim; ++i) {
+    const float a = 2.0f * float(M_PI) * float(i) / kRim;
+    // Darker away from the light (towards the lower right), never black.
+    const float away = 0.5f + 0.5f * std::cos(a - 0.25f * float(M_PI));
+    dl->PrimWriteVtx(ImVec2(c.x + r * std::cos(a), c.y + r * std::sin(a)), uv,
+                     mix(body, colour::rgb(0x10, 0x10, 0x14), 0.15f + 0.5f * away, alpha));
+  }
+  for (int i = 0; i < kRim; ++i) {
+    dl->PrimWriteIdx(first);
+    dl->PrimWriteIdx(ImDrawIdx(first + 1 + i));
+    dl->PrimWriteIdx(ImDrawIdx(first + 1 + (i + 1) % kRim));
+  }
+  dl->AddCircle(c, r, mix(body, colour::rgb(255, 255, 255), 0.25f, alpha), kRim, scaled(1.0f));
 }
 
-void draw_vehicle(ImDrawList* dl, const View& v, const Scene& sc, const Telemetry& s) {
+void draw_vehicle(ImDrawList* dl, const View& v, const Telemetry& s) {
   const Eigen::Vector3d p = s.x.head<3>();
   const Eigen::Matrix3d R = attitude(s.x);
   const double arm = 0.23;
@@ -132,16 +171,51 @@ void draw_vehicle(ImDrawList* dl, const View& v, const Scene& sc, const Telemetr
       const float f = float(std::clamp(omega[i] / omax, 0.0, 1.0));
       const ImU32 c = ImGui::ColorConvertFloat4ToU32(
           ImVec4(0.45f + 0.49f * f, 0.45f + 0.44f * f, 0.45f - 0.19f * f, 0.85f));
-      const float r = std::clamp(float(v.pixels(0.05, tip)), 3.0f, 12.0f);
-      dl->AddCircle(pt, r, c, 16, 2.5f);
+      const float r = std::clamp(float(v.pixels(0.05, tip)), scaled(3.0f), scaled(12.0f));
+      dl->AddCircle(pt, r, c, 16, scaled(2.5f));
     }
   }
   // The nose, so the heading reads.
   line(dl, v, p, p + R * Eigen::Vector3d(1.6 * arm, 0, 0), colour::kCritical, 2.0f);
-  ImVec2 pp, pf;
-  if (v.project(p, pp)) dl->AddCircleFilled(pp, 4.0f, colour::kText, 12);
-  if (v.project(p, pp) && v.project({p.x(), p.y(), sc.arena_min.z()}, pf))
-    dl->AddLine(pp, pf, colour::rgb(200, 200, 200, 90), 1.0f);
+  ImVec2 pp;
+  if (v.project(p, pp)) dl->AddCircleFilled(pp, scaled(4.0f), colour::kText, 12);
+}
+
+// The vehicle's height made visible: a line down to the floor and a ring where it lands.
+void draw_drop_line(ImDrawList* dl, const View& v, const Scene& sc, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d foot(p.x(), p.y(), sc.arena_min.z());
+  const ImU32 c = colour::rgb(220, 220, 220, 150);
+  line(dl, v, p, foot, c, 1.5f);
+  constexpr int kPoints = 20;
+  for (int i = 0; i < kPoints; ++i) {
+    const double a0 = 2.0 * M_PI * i / kPoints, a1 = 2.0 * M_PI * (i + 1) / kPoints;
+    line(dl, v, foot + 0.08 * Eigen::Vector3d(std::cos(a0), std::sin(a0), 0),
+         foot + 0.08 * Eigen::Vector3d(std::cos(a1), std::sin(a1), 0), c, 1.5f);
+  }
+}
+
+// An obstacle as the camera sees it.
+struct Ball {
+  Eigen::Vector3d centre;
+  double radius = 0.0;
+  ImU32 colour = 0;
+  double depth = 0.0;   // of its centre along the camera's axis [m]
+  bool blocks = false;  // it stands between the camera and the vehicle
+};
+
+// Whether the sphere (c, r) hides part of the vehicle (a ball of radius `size` around p) from
+// the eye: it holds the eye, or it lies along the line of sight, nearer than the vehicle, and
+// comes within r + size of it.
+bool blocks_view(const View& v, const Eigen::Vector3d& c, double r, const Eigen::Vector3d& p,
+                 double size) {
+  if ((c - v.eye).norm() <= r) return true;
+  const Eigen::Vector3d sight = p - v.eye;
+  const double length = sight.norm();
+  if (length < 1e-9) return false;
+  const double along = (c - v.eye).dot(sight) / length;
+  if (along <= 0.0 || along - r >= length) return false;
+  const double t = std::min(along, length);
+  return (v.eye + t / length * sight - c).norm() < r + size;
 }
 
 }  // namespace
@@ -152,7 +226,8 @@ bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& u
   return make_view(sc, newest, copy, min, max).project(p, px);
 }
 
-void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max) {
+void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max,
+                ImVec2 frame) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
   dl->AddRectFilled(min, max, colour::kBackground);
@@ -161,29 +236,61 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     return;
   }
   const Telemetry& s = h.newest();
-  const View v = make_view(sc, s, ui, min, max);
+  const View v = make_view(sc, s, ui, frame, max);
+  const bool has_vehicle = s.x.size() >= 3;
+  const Eigen::Vector3d p = has_vehicle ? Eigen::Vector3d(s.x.head<3>()) : Eigen::Vector3d::Zero();
+  const double vehicle_size = 0.35;  // [m] arms and rotors, with a margin
   draw_world(dl, v, sc);
-  for (const SceneSphere& o : sc.spheres) draw_sphere(dl, v, o.center, o.radius, colour::kObstacle);
+
+  // The obstacles, far to near: shaded, dimmer with distance, with shadows and drop lines to
+  // the floor so their heights read. Those between the camera and the vehicle come last and
+  // faded (glass), so the vehicle stays in sight.
+  std::vector<Ball> balls;
+  for (const SceneSphere& o : sc.spheres) balls.push_back({o.center, o.radius, colour::kObstacle});
   if (sc.moving) {
     static thread_local std::vector<Eigen::Vector3d> centres;
     sc.moving(s.t, centres);
-    for (const auto& c : centres) draw_sphere(dl, v, c, sc.moving_radius, colour::kCritical);
+    for (const auto& c : centres) balls.push_back({c, sc.moving_radius, colour::kCritical});
   }
+  double far = 1e-9;
+  for (Ball& b : balls) {
+    b.depth = (b.centre - v.eye).dot(v.forward);
+    b.blocks = has_vehicle && blocks_view(v, b.centre, b.radius, p, vehicle_size);
+    far = std::max(far, b.depth);
+  }
+  std::sort(balls.begin(), balls.end(), [](const Ball& a, const Ball& b) { return a.depth > b.depth; });
+  const double floor_z = sc.arena_min.z();
+  for (const Ball& b : balls)
+    if (b.centre.z() - b.radius >= floor_z - 1e-9)
+      floor_disc(dl, v, {b.centre.x(), b.centre.y(), floor_z}, b.radius, colour::rgb(0, 0, 0, 70));
+  if (has_vehicle && p.z() > floor_z)
+    floor_disc(dl, v, {p.x(), p.y(), floor_z}, 0.28, colour::rgb(0, 0, 0, 120));
+  for (const Ball& b : balls) {
+    ImVec2 pc;
+    if (b.blocks || !v.project(b.centre, pc)) continue;
+    line(dl, v, b.centre, {b.centre.x(), b.centre.y(), floor_z}, with_alpha(b.colour, 0.45f), 1.0f);
+    shaded_sphere(dl, pc, float(v.pixels(b.radius, b.centre)), b.colour,
+                  float(std::clamp(b.depth / far, 0.0, 1.0)), 0.92f);
+  }
+  if (has_vehicle) draw_drop_line(dl, v, sc, p);
+
   for (Eigen::Index i = 1; i < sc.reference.cols(); ++i)
     line(dl, v, sc.reference.col(i - 1), sc.reference.col(i), colour::kReference, 1.0f);
   // The safe tube along the horizon and the ball B around the current reference point.
-  if (sc.ball_radius > 0 && s.predicted_reference.cols() > 0) {
-    for (Eigen::Index i = 0; i < s.predicted_reference.cols(); i += 4) {
+  if (sc.ball_radius > 0) {
+    // The horizon's reference exists once the planner has solved.
+    for (Eigen::Index i = 0; s.solved && i < s.predicted_reference.cols(); i += 4) {
       ImVec2 pc;
       const Eigen::Vector3d c = s.predicted_reference.col(i);
       if (v.project(c, pc))
-        dl->AddCircle(pc, float(v.pixels(sc.ball_radius, c)), colour::rgb(0xEE, 0xEE, 0xEE, 50), 24);
+        dl->AddCircle(pc, float(v.pixels(sc.ball_radius, c)), colour::rgb(0xEE, 0xEE, 0xEE, 50), 24,
+                      scaled(1.0f));
     }
     ImVec2 pb;
     if (s.reference.size() >= 3 && v.project(s.reference.head<3>(), pb)) {
       const float r = float(v.pixels(sc.ball_radius, s.reference.head<3>()));
       dl->AddCircleFilled(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 28), 32);
-      dl->AddCircle(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 150), 32, 1.5f);
+      dl->AddCircle(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 150), 32, scaled(1.5f));
     }
   }
   // The trail of the last seconds, coloured by λ in mixed initiative.
@@ -197,7 +304,15 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
   }
   for (Eigen::Index i = 1; i < s.predicted.cols(); ++i)
     line(dl, v, s.predicted.col(i - 1), s.predicted.col(i), colour::kMpc, 2.0f);
-  draw_vehicle(dl, v, sc, s);
+  if (has_vehicle) draw_vehicle(dl, v, s);
+  // What stands between the camera and the vehicle: a tint and its outline, over the rest.
+  for (const Ball& b : balls) {
+    ImVec2 pc;
+    if (!b.blocks || !v.project(b.centre, pc)) continue;
+    const float r = float(v.pixels(b.radius, b.centre));
+    dl->AddCircleFilled(pc, r, with_alpha(b.colour, 0.10f), 48);
+    dl->AddCircle(pc, r, with_alpha(b.colour, 0.6f), 48, scaled(1.5f));
+  }
   // Mouse: drag orbits (switching to the orbit camera), the wheel zooms.
   if (ImGui::IsMouseHoveringRect(min, max) && !ImGui::IsAnyItemActive()) {
     ImGuiIO& io = ImGui::GetIO();
@@ -212,8 +327,13 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
       ui.orbit_distance = std::clamp(base * std::pow(0.9f, io.MouseWheel), 0.5f, 100.0f);
     }
   }
-  dl->AddText(ImVec2(min.x + 8, max.y - 22), colour::rgb(200, 200, 200),
-              (std::string("camera: ") + to_string(ui.camera) + "  (1 chase · 2 orbit · 3 top · 4 side)").c_str());
+  // The camera and its keys at the bottom left; the keys shorter where the view is narrow.
+  const float inset = ImGui::GetStyle().WindowPadding.x;
+  std::string hint = std::string("camera: ") + to_string(ui.camera) + "  (1 chase · 2 orbit · 3 top · 4 side)";
+  if (ImGui::CalcTextSize(hint.c_str()).x > max.x - min.x - 2 * inset)
+    hint = std::string("camera: ") + to_string(ui.camera) + "  (keys 1-4)";
+  dl->AddText(ImVec2(min.x + inset, max.y - inset - ImGui::GetTextLineHeight()),
+              colour::rgb(200, 200, 200), hint.c_str());
   dl->PopClipRect();
 }
 

@@ -1,5 +1,6 @@
 // The input settings panel and the input-loss banner (SPEC §6).
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -23,13 +24,18 @@ void axis_curve(const char* id, const input::AxisSettings& a, double live, ImVec
   const auto px = [&](double x, double y) {
     return ImVec2(float(min.x + (x + 1) * 0.5 * size.x), float(max.y - (y + 1) * 0.5 * size.y));
   };
-  dl->AddLine(px(-1, 0), px(1, 0), colour::kGrid);
-  dl->AddLine(px(0, -1), px(0, 1), colour::kGrid);
+  dl->AddLine(px(-1, 0), px(1, 0), colour::kGrid, scaled(1.0f));
+  dl->AddLine(px(0, -1), px(0, 1), colour::kGrid, scaled(1.0f));
   constexpr int kPoints = 48;
   for (int i = 0; i <= kPoints; ++i) dl->PathLineTo(px(-1 + 2.0 * i / kPoints, input::shape(-1 + 2.0 * i / kPoints, a)));
-  dl->PathStroke(colour::kPilot, 0, 2.0f);
+  dl->PathStroke(colour::kPilot, 0, scaled(2.0f));
   const double x = std::clamp(live, -1.0, 1.0);
-  dl->AddCircleFilled(px(x, input::shape(x, a)), 4.0f, colour::kCaution);
+  dl->AddCircleFilled(px(x, input::shape(x, a)), scaled(4.0f), colour::kCaution);
+}
+
+// A slider or combo `field` wide with its label after it.
+float labelled_width(const char* label, float field) {
+  return field + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(label, nullptr, true).x;
 }
 
 bool slider(const char* label, double& v, double lo, double hi, const char* format) {
@@ -60,9 +66,12 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   }
   input::InputSettings& s = ui.draft;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
+  const float em = ImGui::GetFontSize(), margin = em;
   ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
-  // Its width is fixed, its height always fits what it holds (devices come and go).
-  ImGui::SetNextWindowSize(ImVec2(std::min(760.0f, d.x - 40), 0), ImGuiCond_Always);
+  // Its width is fixed, its height always fits what it holds (devices come and go), within the
+  // display (it scrolls there).
+  ImGui::SetNextWindowSize(ImVec2(std::min(scaled(760), d.x - 2 * margin), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(d.x - 2 * margin, d.y - 2 * margin));
   ImGui::SetNextWindowBgAlpha(0.98f);
   bool open = true;
   if (!ImGui::Begin("Input settings (I)", &open, ImGuiWindowFlags_NoSavedSettings |
@@ -97,7 +106,7 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
       req.map_gamepad = dev.instance;
     }
     ImGui::SameLine();
-    ImGui::Text("%s%s", dev.name.c_str(), dev.mapped ? "" : "  (SDL has no mapping for it)");
+    ImGui::TextWrapped("%s%s", dev.name.c_str(), dev.mapped ? "" : "  (SDL has no mapping for it)");
   }
   if (!in.message.empty()) ImGui::TextWrapped("%s", in.message.c_str());
   ImGui::Separator();
@@ -107,12 +116,14 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
                          "Mode 3 (left: pitch + roll, right: thrust + yaw)",
                          "Mode 4 (left: thrust + roll, right: pitch + yaw)"};
   int mode = s.mode - 1;
-  ImGui::SetNextItemWidth(420);
+  ImGui::SetNextItemWidth(std::min(28.0f * em, ImGui::GetContentRegionAvail().x -
+                                                   labelled_width("stick mode", 0.0f)));
   if (ImGui::Combo("stick mode", &mode, modes, 4)) s.mode = mode + 1;
-  ImGui::SetNextItemWidth(200);
+  const float wide = 13.0f * em, narrow = 10.5f * em;
+  ImGui::SetNextItemWidth(wide);
   slider("max tilt [deg]", s.max_tilt_deg, 5, 60, "%.0f");
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(200);
+  same_line_or_wrap(labelled_width("thrust range (x hover)", wide));
+  ImGui::SetNextItemWidth(wide);
   slider("thrust range (x hover)", s.thrust_range, 0.05, 1, "%.2f");
 
   // Each axis: its shaping and its curve with the live stick.
@@ -128,11 +139,12 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
       ImGui::Text("%s  %+.2f", axes[i].first, input::shape(live[i], a));
       const float w = ImGui::GetContentRegionAvail().x;
       axis_curve("curve", a, live[i], ImVec2(w, w * 0.75f));
-      ImGui::SetNextItemWidth(w * 0.55f);
+      const float field = -labelled_width("deadzone", 0.0f);  // the longest label's room
+      ImGui::SetNextItemWidth(field);
       slider("deadzone", a.deadzone, 0, 0.5, "%.2f");
-      ImGui::SetNextItemWidth(w * 0.55f);
+      ImGui::SetNextItemWidth(field);
       slider("expo", a.expo, 0, 1, "%.2f");
-      ImGui::SetNextItemWidth(w * 0.55f);
+      ImGui::SetNextItemWidth(field);
       slider("rate", a.rate, 0.1, 2, "%.2f");
       ImGui::Checkbox("invert", &a.invert);
       ImGui::PopID();
@@ -140,18 +152,18 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
     ImGui::EndTable();
   }
   ImGui::Separator();
-  ImGui::SetNextItemWidth(160);
+  ImGui::SetNextItemWidth(narrow);
   slider("input timeout [s]", s.input_timeout_s, 0.02, 1, "%.2f");
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(160);
+  same_line_or_wrap(labelled_width("return time [s]", narrow));
+  ImGui::SetNextItemWidth(narrow);
   slider("return time [s]", s.return_time_s, 0, 5, "%.1f");
   ImGui::Checkbox("haptic cue", &s.haptic.enabled);
-  ImGui::SameLine();
   ImGui::BeginDisabled(!s.haptic.enabled);
-  ImGui::SetNextItemWidth(160);
+  same_line_or_wrap(labelled_width("below lambda", narrow));
+  ImGui::SetNextItemWidth(narrow);
   slider("below lambda", s.haptic.threshold, 0.05, 1, "%.2f");
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(160);
+  same_line_or_wrap(labelled_width("strength", narrow));
+  ImGui::SetNextItemWidth(narrow);
   slider("strength", s.haptic.strength, 0, 1, "%.2f");
   ImGui::EndDisabled();
   ImGui::Separator();
@@ -160,9 +172,13 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   ImGui::SameLine();
   if (ImGui::Button("Save")) req.apply_settings = req.save_settings = true;
   ImGui::SameLine();
-  ImGui::TextDisabled("to %s", in.settings_path.c_str());
-  ImGui::SameLine();
   if (ImGui::Button("Defaults")) s = input::InputSettings{};
+  // Where Save writes: after the buttons, wrapping where the path is long.
+  const std::string to = "Save writes to " + in.settings_path;
+  same_line_or_wrap(std::min(ImGui::CalcTextSize(to.c_str()).x, 12.0f * em));
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  ImGui::TextWrapped("%s", to.c_str());
+  ImGui::PopStyleColor();
   ImGui::End();
   if (!open) {
     ui.show_settings = false;
@@ -174,8 +190,10 @@ void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
   if (!run.input || !run.input->wizard) return;
   const WizardView& w = *run.input->wizard;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
+  const float margin = ImGui::GetFontSize();
   ImGui::SetNextWindowPos(ImVec2(d.x * 0.5f, d.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, d.x - 40), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(std::min(scaled(640), d.x - 2 * margin), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(d.x - 2 * margin, d.y - 2 * margin));
   ImGui::SetNextWindowBgAlpha(0.98f);
   ImGui::SetNextWindowFocus();
   ImGui::Begin("Map a gamepad", nullptr,
@@ -198,11 +216,12 @@ void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
   ImGui::TextDisabled("%s", w.hint.empty() ? " " : w.hint.c_str());
   // What the device reports, raw: axes as bars, pressed buttons, hats.
   if (const input::RawJoystick* r = w.raw; r && r->instance >= 0) {
+    const float bar_w = 9.5f * ImGui::GetFontSize();
     for (int a = 0; a < r->num_axes; ++a) {
       char label[24];
       std::snprintf(label, sizeof label, "a%d %+.2f", a, double(r->axes[std::size_t(a)]));
-      ImGui::ProgressBar(0.5f * (r->axes[std::size_t(a)] + 1.0f), ImVec2(140, 0), label);
-      if (a % 4 != 3 && a + 1 < r->num_axes) ImGui::SameLine();
+      if (a > 0) same_line_or_wrap(bar_w);
+      ImGui::ProgressBar(0.5f * (r->axes[std::size_t(a)] + 1.0f), ImVec2(bar_w, 0), label);
     }
     std::string pressed;
     for (int b = 0; b < r->num_buttons; ++b)
@@ -262,14 +281,18 @@ void draw_input_banner(const History& h, const RunInfo& run, ImVec2 min, ImVec2 
       c = colour::kCaution;
       break;
   }
+  // Larger than the text around it where the view is wide; wrapped where it is narrow.
   ImDrawList* dl = ImGui::GetForegroundDrawList();
-  const ImVec2 ts = ImGui::CalcTextSize(text);
-  const float scale = std::clamp((max.x - min.x - 48) / std::max(ts.x, 1.0f), 1.0f, 1.4f);
-  const ImVec2 size(ts.x * scale + 32, ts.y * scale + 20);
+  const ImVec2 pad(scaled(16), scaled(10));
+  const float room = std::max(1.0f, max.x - min.x - 2 * pad.x - 2 * ImGui::GetFontSize());
+  const float scale = std::clamp(room / std::max(ImGui::CalcTextSize(text).x, 1.0f), 1.0f, 1.4f);
+  const float size_px = ImGui::GetFontSize() * scale;
+  const ImVec2 ts = ImGui::GetFont()->CalcTextSizeA(size_px, FLT_MAX, room, text);
+  const ImVec2 size(ts.x + 2 * pad.x, ts.y + 2 * pad.y);
   const ImVec2 p(0.5f * (min.x + max.x - size.x), min.y + 0.42f * (max.y - min.y));
-  dl->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), colour::rgb(0x10, 0x10, 0x10, 230), 6.0f);
-  dl->AddRect(p, ImVec2(p.x + size.x, p.y + size.y), c, 6.0f, 0, 2.5f);
-  dl->AddText(ImGui::GetFont(), ImGui::GetFontSize() * scale, ImVec2(p.x + 16, p.y + 10), c, text);
+  dl->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), colour::rgb(0x10, 0x10, 0x10, 230), scaled(6.0f));
+  dl->AddRect(p, ImVec2(p.x + size.x, p.y + size.y), c, scaled(6.0f), 0, scaled(2.5f));
+  dl->AddText(ImGui::GetFont(), size_px, ImVec2(p.x + pad.x, p.y + pad.y), c, text, nullptr, room);
 }
 
 }  // namespace mixpilot::ui

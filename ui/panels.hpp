@@ -1,6 +1,8 @@
 #pragma once
 // The panels of the screen (ui/screen.hpp), each drawing into the current ImGui window's
 // region [min, max) from the scene and the history.
+#include <string>
+
 #include <imgui.h>
 
 #include "ui/scene.hpp"
@@ -8,16 +10,20 @@
 
 namespace mixpilot::ui {
 
-// 3D arena of the quadrotor modes; the mouse orbits and zooms when over it.
-void draw_arena(const Scene& scene, const History& history, UiState& ui, ImVec2 min, ImVec2 max);
-// Where draw_arena puts the world point `p` on screen, `newest` being the newest telemetry;
-// false when it is behind the camera.
+// 3D arena of the quadrotor modes over the pane [min, max), framed in [frame, max) (what the
+// overlays leave of it; view_rect); the mouse orbits and zooms when over it.
+void draw_arena(const Scene& scene, const History& history, UiState& ui, ImVec2 min, ImVec2 max,
+                ImVec2 frame);
+// Where draw_arena puts the world point `p` on screen, `newest` being the newest telemetry and
+// [min, max) the frame (view_rect); false when it is behind the camera.
 bool project_in_arena(const Scene& scene, const Telemetry& newest, const UiState& ui, ImVec2 min,
                       ImVec2 max, const Eigen::Vector3d& p, ImVec2& px);
-// 2D side view of the Pendubot.
-void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec2 max);
-// The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour.
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max);
+// 2D side view of the Pendubot over the pane [min, max), framed in [frame, max).
+void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec2 max,
+                   ImVec2 frame);
+// The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour; with
+// `names`, the shares' names under it (a text line below max.y).
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true);
 // Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
 // The thrust stick is centred on the hover rotor speed `hover`.
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
@@ -40,5 +46,16 @@ void draw_mapping_wizard(const RunInfo& run, UiRequest& req);
 void draw_input_banner(const History& history, const RunInfo& run, ImVec2 min, ImVec2 max);
 // The flight keys held now (bit k: input::Key k).
 unsigned held_flight_keys();
+
+// Layout: rows that wrap instead of running out of their window, so a pane holds at any
+// display scale what it holds at 100 %.
+// The width ImGui gives a button, a radio button or checkbox, of `label`.
+float button_width(const char* label);
+float radio_width(const char* label);
+// Puts the next item (`width` wide) on the current row, `spacing` after the last (< 0: the
+// style's), when it fits in the window's content region; else at the start of the next row.
+void same_line_or_wrap(float width, float spacing = -1.0f);
+// `text` shortened in its middle ("start…end") to fit `width` pixels of the current font.
+std::string elide_middle(const std::string& text, float width);
 
 }  // namespace mixpilot::ui

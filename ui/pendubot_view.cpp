@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
@@ -20,7 +21,7 @@ void links(ImVec2 base, float scale, const Scene& sc, double q1, double q2, ImVe
 
 }  // namespace
 
-void draw_pendubot(const Scene& sc, const History& h, ImVec2 min, ImVec2 max) {
+void draw_pendubot(const Scene& sc, const History& h, ImVec2 min, ImVec2 max, ImVec2 frame) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
   dl->AddRectFilled(min, max, colour::kBackground);
@@ -29,37 +30,53 @@ void draw_pendubot(const Scene& sc, const History& h, ImVec2 min, ImVec2 max) {
     return;
   }
   const Telemetry& s = h.newest();
-  const ImVec2 base(0.5f * (min.x + max.x), 0.5f * (min.y + max.y));
-  const float scale = 0.42f * std::min(max.x - min.x, max.y - min.y) / float(sc.link1 + sc.link2);
-  dl->AddCircle(base, scale * float(sc.link1 + sc.link2), colour::kGrid, 64, 1.0f);
+  const ImVec2 base(0.5f * (frame.x + max.x), 0.5f * (frame.y + max.y));
+  const float scale = 0.42f * std::min(max.x - frame.x, max.y - frame.y) / float(sc.link1 + sc.link2);
+  dl->AddCircle(base, scale * float(sc.link1 + sc.link2), colour::kGrid, 64, scaled(1.0f));
   ImVec2 e, t;
+  const float upper = scaled(10.0f), lower = scaled(8.0f);  // the links' widths
   if (s.reference.size() >= 2) {  // the reference pose as a ghost
     links(base, scale, sc, s.reference(0), s.reference(1), e, t);
-    dl->AddLine(base, e, colour::rgb(0xEE, 0xEE, 0xEE, 70), 10.0f);
-    dl->AddLine(e, t, colour::rgb(0xEE, 0xEE, 0xEE, 70), 8.0f);
+    dl->AddLine(base, e, colour::rgb(0xEE, 0xEE, 0xEE, 70), upper);
+    dl->AddLine(e, t, colour::rgb(0xEE, 0xEE, 0xEE, 70), lower);
   }
   links(base, scale, sc, s.x(0), s.x(1), e, t);
   const bool lqr = channel_value(s, "LQR active", 0.0) > 0.5;
   const ImU32 c = lqr ? colour::kPlanner : colour::kMpc;
-  dl->AddLine(base, e, c, 10.0f);
-  dl->AddLine(e, t, c, 8.0f);
-  dl->AddCircleFilled(base, 7.0f, colour::kText, 16);
-  dl->AddCircleFilled(e, 6.0f, colour::kText, 16);
+  dl->AddLine(base, e, c, upper);
+  dl->AddLine(e, t, c, lower);
+  dl->AddCircleFilled(base, scaled(7.0f), colour::kText, 16);
+  dl->AddCircleFilled(e, scaled(6.0f), colour::kText, 16);
   // Torque: an arc at the shoulder, its length ∝ u / u_max.
   const double u = s.u.size() > 0 ? s.u(0) : 0.0;
   const double umax = std::max(1e-9, channel_value(s, "torque bound", 1.0));
-  const float r = 28.0f;
+  const float r = scaled(28.0f);
   const float a0 = -0.5f * float(M_PI);
   dl->PathArcTo(base, r, a0, a0 - float(std::clamp(u / umax, -1.0, 1.0) * M_PI), 24);
-  dl->PathStroke(colour::kCaution, 0, 3.0f);
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "controller: %s    torque %.3f N m (bound %.3f)", lqr ? "LQR" : "NMPC",
-                u, umax);
-  const float y0 = max.y - 2.0f * ImGui::GetTextLineHeightWithSpacing() - 8.0f;
-  dl->AddText(ImVec2(min.x + 8, y0), colour::kText, buf);
-  std::snprintf(buf, sizeof buf, "dq1 %.2f (bound %.2f) rad/s    dq2 %.2f (bound %.2f) rad/s", s.x(2),
-                channel_value(s, "dq1 bound", 0.0), s.x(3), channel_value(s, "dq2 bound", 0.0));
-  dl->AddText(ImVec2(min.x + 8, y0 + ImGui::GetTextLineHeightWithSpacing()), colour::kText, buf);
+  dl->PathStroke(colour::kCaution, 0, scaled(3.0f));
+  // The numbers at the bottom left, as many to a line as the view's width holds.
+  char parts[4][96];
+  std::snprintf(parts[0], sizeof parts[0], "controller: %s", lqr ? "LQR" : "NMPC");
+  std::snprintf(parts[1], sizeof parts[1], "torque %.3f N m (bound %.3f)", u, umax);
+  std::snprintf(parts[2], sizeof parts[2], "dq1 %.2f (bound %.2f) rad/s", s.x(2),
+                channel_value(s, "dq1 bound", 0.0));
+  std::snprintf(parts[3], sizeof parts[3], "dq2 %.2f (bound %.2f) rad/s", s.x(3),
+                channel_value(s, "dq2 bound", 0.0));
+  const float inset = ImGui::GetStyle().WindowPadding.x, gap = ImGui::CalcTextSize("    ").x;
+  const float width = max.x - frame.x - 2 * inset;
+  std::string lines[4];
+  int n = 0;
+  for (const char* part : parts) {
+    const std::string joined = n > 0 ? lines[n - 1] + "    " + part : std::string();
+    if (n > 0 && ImGui::CalcTextSize(lines[n - 1].c_str()).x + gap + ImGui::CalcTextSize(part).x <= width)
+      lines[n - 1] = joined;
+    else
+      lines[n++] = part;
+  }
+  const float line = ImGui::GetTextLineHeightWithSpacing();
+  for (int i = 0; i < n; ++i)
+    dl->AddText(ImVec2(frame.x + inset, max.y - inset - float(n - i) * line), colour::kText,
+                lines[i].c_str());
   dl->PopClipRect();
 }
 

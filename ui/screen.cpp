@@ -1,7 +1,11 @@
 #include "ui/screen.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cstdio>
+#include <vector>
+
+#include <imgui_internal.h>  // the panes' sizes of the last frame (FindWindowByName)
 
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
@@ -54,145 +58,182 @@ ImU32 state_colour(RunState s) {
   }
 }
 
-// `text` shortened in its middle ("start…end") to fit `width` pixels of the current font.
-std::string elide_middle(const std::string& text, float width) {
-  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
-  const std::string dots = "\u2026";
-  // Cut whole UTF-8 code points: never split a continuation byte (10xxxxxx).
-  auto cut = [&](std::size_t keep) {
-    std::size_t head = keep / 2, tail = text.size() - (keep - keep / 2);
-    while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
-    while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
-    return text.substr(0, head) + dots + text.substr(tail);
-  };
-  std::size_t lo = 0, hi = text.size();  // longest kept byte count that fits
-  while (lo < hi) {
-    const std::size_t mid = (lo + hi + 1) / 2;
-    if (ImGui::CalcTextSize(cut(mid).c_str()).x <= width) lo = mid; else hi = mid - 1;
-  }
-  return cut(lo);
-}
-
+// The status pill: as tall as a button, so the first row lines up.
 void pill(const char* text, ImU32 c) {
   const ImVec2 p = ImGui::GetCursorScreenPos();
   const ImVec2 ts = ImGui::CalcTextSize(text);
-  const ImVec2 size(ts.x + 20, ts.y + 8);
-  ImGui::GetWindowDrawList()->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), c, 10.0f);
-  ImGui::GetWindowDrawList()->AddText(ImVec2(p.x + 10, p.y + 4), colour::rgb(0x10, 0x10, 0x10),
+  const ImVec2 pad(ImGui::GetFontSize() * 0.66f, ImGui::GetStyle().FramePadding.y);
+  const ImVec2 size(ts.x + 2 * pad.x, ImGui::GetFrameHeight());
+  ImGui::GetWindowDrawList()->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), c, 0.5f * size.y);
+  ImGui::GetWindowDrawList()->AddText(ImVec2(p.x + pad.x, p.y + pad.y), colour::rgb(0x10, 0x10, 0x10),
                                       text);
   ImGui::Dummy(size);
 }
 
-void top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui, UiRequest& req,
-             ImVec2 pos, ImVec2 size) {
-  ImGui::SetNextWindowPos(pos);
-  ImGui::SetNextWindowSize(size);
-  ImGui::Begin("##top", nullptr, kPane);
+// A pane whose height is its content's: `width` wide at `pos`, its top left corner, or its
+// bottom left with pivot (0, 1). ImGui fits its height to what it held in the last frame.
+void begin_pane(const char* name, ImVec2 pos, float width, ImVec2 pivot = ImVec2(0, 0)) {
+  ImGui::SetNextWindowPos(pos, ImGuiCond_Always, pivot);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(width, 0.0f), ImVec2(width, FLT_MAX));
+  ImGui::Begin(name, nullptr, kPane | ImGuiWindowFlags_AlwaysAutoResize);
+}
+
+// The top bar: the pill, the title, Open and Help; then the flight's controls and time, the
+// recording mark and the app's message, wrapping onto further rows where the width runs out.
+// Returns its height.
+float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui, UiRequest& req,
+              float width) {
+  begin_pane("##top", ImVec2(0, 0), width);
   pill(to_string(run.state), state_colour(run.state));
   ImGui::SameLine();
+  // A replay has its controls and its time in the transport bar: here only the way back.
+  if (run.replay) {
+    if (ImGui::Button("Back to live (Esc)")) req.leave_replay = true;
+    ImGui::SameLine();
+  }
   // File and help at the right end; the title gives way to them (elided, full text on hover).
   const ImGuiStyle& st = ImGui::GetStyle();
-  const float right_w = ImGui::CalcTextSize("Open... (Ctrl+O)").x +
-                        ImGui::CalcTextSize("Help (F1)").x + 4 * st.FramePadding.x +
-                        2 * st.ItemSpacing.x + st.WindowPadding.x;
+  const float right_w = button_width("Open... (Ctrl+O)") + button_width("Help (F1)") +
+                        st.ItemSpacing.x;
+  const float right_x = ImGui::GetWindowContentRegionMax().x - right_w;
   const std::string title =
       sc.title + "   ·   " + to_string(sc.mode) + "   ·   " + sc.input_source;
-  const float title_w = size.x - right_w - ImGui::GetCursorPosX();
-  ImGui::TextUnformatted(elide_middle(title, title_w).c_str());
+  const float title_w = right_x - st.ItemSpacing.x - ImGui::GetCursorPosX();
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted(elide_middle(title, std::max(0.0f, title_w)).c_str());
   if (ImGui::IsItemHovered() && ImGui::CalcTextSize(title.c_str()).x > title_w)
     ImGui::SetTooltip("%s", title.c_str());
-  ImGui::SameLine(std::max(ImGui::GetCursorPosX(), size.x - right_w));
+  ImGui::SameLine(std::max(ImGui::GetCursorPosX(), right_x));
   if (ImGui::Button("Open... (Ctrl+O)")) ui.open_dialog.open = true;
   ImGui::SameLine();
   if (ImGui::Button("Help (F1)")) ui.show_help = !ui.show_help;
 
-  const Telemetry* s = h.empty() ? nullptr : &h.newest();
-  ImGui::PushFont(mono_font());
-  ImGui::Text("t %6.2f / %.0f s   speed %.2fx", s ? s->t : 0.0, sc.duration, run.speed);
-  ImGui::PopFont();
-  if (run.replay) {
-    if (ImGui::Button("Back to live (Esc)")) req.leave_replay = true;
-  } else {
+  // The second row: what the flight does now, the buttons first.
+  if (!run.replay) {
+    bool first = true;
+    const auto button = [&](const char* label) {
+      if (!first) same_line_or_wrap(button_width(label));
+      first = false;
+      return ImGui::Button(label);
+    };
     if (run.state == RunState::ready) {
-      if (ImGui::Button("Start (Space)")) req.start = true;
+      if (button("Start (Space)")) req.start = true;
     } else if (run.state == RunState::flying || run.state == RunState::paused) {
-      if (ImGui::Button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
+      if (button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
         req.toggle_pause = true;
     }
-    ImGui::SameLine();
-    if (run.can_restart && run.state != RunState::ready) {
-      if (ImGui::Button("Restart (R)")) req.restart = true;
-      ImGui::SameLine();
-    }
+    if (run.can_restart && run.state != RunState::ready && button("Restart (R)")) req.restart = true;
     for (double sp : {0.25, 0.5, 1.0}) {
       char label[16];
       std::snprintf(label, sizeof label, "%gx", sp);
+      if (!first) same_line_or_wrap(radio_width(label));
+      first = false;
       if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
-      ImGui::SameLine();
     }
+    const Telemetry* s = h.empty() ? nullptr : &h.newest();
+    ImGui::PushFont(mono_font());
+    char time[64];
+    std::snprintf(time, sizeof time, "t %6.2f / %.0f s", s ? s->t : 0.0, sc.duration);
+    same_line_or_wrap(ImGui::CalcTextSize(time).x + ImGui::CalcTextSize(" ").x);
+    ImGui::AlignTextToFramePadding();
+    ImGui::Text(" %s", time);
+    ImGui::PopFont();
   }
   if (run.recording) {
-    ImGui::SameLine();
+    same_line_or_wrap(ImGui::CalcTextSize("● REC").x);
     ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "● REC");
   }
   if (!run.message.empty()) {
+    // After the controls when a useful part of it fits there, else on a row of its own; what
+    // does not fit is elided and shown whole on hover.
+    const float full = ImGui::CalcTextSize(run.message.c_str()).x;
+    same_line_or_wrap(std::min(full, 16 * ImGui::GetFontSize()), 2 * st.ItemSpacing.x);
+    const float w = ImGui::GetWindowContentRegionMax().x - ImGui::GetCursorPosX();
+    const std::string shown = elide_middle(run.message, w);
     if (run.message_is_error)
-      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", run.message.c_str());
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", shown.c_str());
     else
-      ImGui::TextUnformatted(run.message.c_str());
+      ImGui::TextUnformatted(shown.c_str());
+    if (shown != run.message && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", run.message.c_str());
   }
+  const float height = ImGui::GetWindowHeight();
   ImGui::End();
+  return height;
 }
 
-// The HUD under the authority bar: deviation, time in B, RTI time, fallbacks, misses, and a
-// remote vehicle's round-trip time.
+// The HUD's longest item: it needs at least this width.
+constexpr const char* kWidestHudItem = "in B 100.0 % of the last 60 s";
+
+// The HUD: the authority bar, then deviation, time in B, RTI time, fallbacks, deadline
+// misses and a remote vehicle's round trip, each item wrapping within `width`. Compact (for a
+// short view): a thinner bar without the shares' names under it, and fewer lines.
 // Returns the screen y of its bottom edge.
-float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, ImVec2 size) {
+float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, float width,
+          bool compact) {
   ImGui::SetNextWindowPos(pos);
-  ImGui::Begin("##hud", nullptr, kOverlay | ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::SetNextWindowSize(ImVec2(width, 0.0f));
+  // A translucent backing keeps its text readable over the scene.
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  ImGui::Begin("##hud", nullptr,
+               (kOverlay & ~ImGuiWindowFlags_NoBackground) | ImGuiWindowFlags_AlwaysAutoResize);
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
-  const ImVec2 bar_min = ImGui::GetCursorScreenPos();
+  const float w = ImGui::GetContentRegionAvail().x;
   if (sc.mode == ModeKind::mixed_initiative) {
     // Before the first solve (the initial state) the pilot has the authority.
-    draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + size.x - 16, bar_min.y + 30));
-    ImGui::Dummy(ImVec2(size.x - 16, 30 + ImGui::GetTextLineHeightWithSpacing()));
+    const ImVec2 bar_min = ImGui::GetCursorScreenPos();
+    const float bar_h = (compact ? 1.4f : 2.0f) * ImGui::GetFontSize();
+    draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min,
+                       ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact);
+    ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
   }
-  // Over the last minute at most (a replay's history is the whole flight up to the playhead).
-  std::int64_t in_ball = 0;
-  const std::size_t from = h.empty() ? 0 : h.first_at_or_after(h.newest().t - 60.0 + 0.5 * sc.dt);
-  for (std::size_t i = from; i < h.size(); ++i) {
-    in_ball += channel_value(h[i], "deviation") <= sc.ball_radius ? 1 : 0;
-  }
-  const std::size_t n = h.size() - from;
-  const double dev = s ? channel_value(*s, "deviation") : 0.0;
   ImGui::PushFont(mono_font());
+  const float gap = ImGui::CalcTextSize("   ").x;
+  bool first = true;
+  const auto item = [&](const char* text, ImU32 colour) {
+    if (!first) same_line_or_wrap(ImGui::CalcTextSize(text).x, gap);
+    first = false;
+    ImGui::PushStyleColor(ImGuiCol_Text, colour);
+    ImGui::TextUnformatted(text);
+    ImGui::PopStyleColor();
+  };
+  char text[96];
   if (sc.mode == ModeKind::mixed_initiative) {
-    char deviation[64], ball[64];
-    std::snprintf(deviation, sizeof deviation, "deviation %.3f m (r %.2f)", dev, sc.ball_radius);
-    std::snprintf(ball, sizeof ball, "in B %5.1f %% of the last %.0f s",
-                  n ? 100.0 * double(in_ball) / double(n) : 100.0,
-                  n ? h.newest().t - h[from].t + sc.dt : 0.0);
-    // One line where the arena is wide enough, two where it is not.
-    ImGui::TextUnformatted(deviation);
-    const float one_line = ImGui::CalcTextSize(deviation).x + ImGui::CalcTextSize("   ").x +
-                           ImGui::CalcTextSize(ball).x;
-    if (one_line <= size.x - 16) ImGui::SameLine(0, ImGui::CalcTextSize("   ").x);
-    ImGui::TextUnformatted(ball);
+    // Over the last minute at most (a replay's history is the whole flight up to the playhead).
+    std::int64_t in_ball = 0;
+    const std::size_t from = h.empty() ? 0 : h.first_at_or_after(h.newest().t - 60.0 + 0.5 * sc.dt);
+    for (std::size_t i = from; i < h.size(); ++i)
+      in_ball += channel_value(h[i], "deviation") <= sc.ball_radius ? 1 : 0;
+    const std::size_t n = h.size() - from;
+    std::snprintf(text, sizeof text, "deviation %.3f m (r %.2f)",
+                  s ? channel_value(*s, "deviation") : 0.0, sc.ball_radius);
+    item(text, colour::kText);
+    const double share = n ? 100.0 * double(in_ball) / double(n) : 100.0;
+    if (compact)
+      std::snprintf(text, sizeof text, "in B %5.1f %%", share);
+    else
+      std::snprintf(text, sizeof text, "in B %5.1f %% of the last %.0f s", share,
+                    n ? h.newest().t - h[from].t + sc.dt : 0.0);
+    item(text, colour::kText);
   }
-  ImGui::Text("RTI %5.0f us   fallbacks %lld", s ? s->stats.total_us : 0.0,
-              static_cast<long long>(run.fallbacks));
-  ImGui::SameLine();
+  first = !compact;  // the solver on a line of its own, where there is room
+  std::snprintf(text, sizeof text, "RTI %5.0f us", s ? s->stats.total_us : 0.0);
+  item(text, colour::kText);
+  std::snprintf(text, sizeof text, "fallbacks %lld", static_cast<long long>(run.fallbacks));
+  item(text, colour::kText);
   // Deadline misses in the caution colour once there are any (UI.md §8).
-  if (run.deadline_misses > 0) ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
-  ImGui::Text("  deadline misses %lld", static_cast<long long>(run.deadline_misses));
-  if (run.deadline_misses > 0) ImGui::PopStyleColor();
+  std::snprintf(text, sizeof text, "deadline misses %lld", static_cast<long long>(run.deadline_misses));
+  item(text, run.deadline_misses > 0 ? colour::kCaution : colour::kText);
   // A remote vehicle (SPEC §9): the round-trip time the predictor uses, and the newest sample.
   if (const double rtt = s ? channel_value(*s, "RTT estimate", -1.0) : -1.0; rtt >= 0.0) {
-    ImGui::Text("remote vehicle: RTT %5.1f ms estimated, last sample %5.1f ms", 1e3 * rtt,
-                1e3 * channel_value(*s, "RTT sample", 0.0));
+    first = true;
+    item("remote vehicle:", colour::kText);
+    std::snprintf(text, sizeof text, "RTT %5.1f ms estimated,", 1e3 * rtt);
+    item(text, colour::kText);
+    std::snprintf(text, sizeof text, "last sample %5.1f ms", 1e3 * channel_value(*s, "RTT sample", 0.0));
+    item(text, colour::kText);
   }
   ImGui::PopFont();
-  const float bottom = ImGui::GetCursorScreenPos().y;
+  const float bottom = ImGui::GetWindowPos().y + ImGui::GetWindowHeight();
   ImGui::End();
   return bottom;
 }
@@ -226,14 +267,48 @@ const char* meaning(const std::string& key) {
   return "";
 }
 
-void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
+// The width of a table's last column, the explanations `texts`: as wide as the widest, or
+// narrower (its text wraps) where the display has less room beside the other columns (`fixed`
+// wide together).
+float wrapped_column(const char* const* texts, std::size_t count, float fixed, ImVec2 display) {
+  const ImGuiStyle& st = ImGui::GetStyle();
+  float widest = 0.0f;
+  for (std::size_t i = 0; i < count; ++i) widest = std::max(widest, ImGui::CalcTextSize(texts[i]).x);
+  const float room = display.x - 2.0f * ImGui::GetFontSize() - 2.0f * st.WindowPadding.x - fixed -
+                     6.0f * st.CellPadding.x - st.ScrollbarSize;
+  return std::max(8.0f * ImGui::GetFontSize(), std::min(widest, room));
+}
+
+// A modal-like window in the display's centre that fits its content, within the display (it
+// scrolls when it would not fit).
+void begin_centred(const char* title, bool* open, ImVec2 display) {
+  const float margin = ImGui::GetFontSize();
   ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
                           ImVec2(0.5f, 0.5f));
-  bool open = true;
-  ImGui::Begin("Score card", &open,
+  ImGui::SetNextWindowSizeConstraints(
+      ImVec2(0, 0), ImVec2(std::max(1.0f, display.x - 2 * margin), std::max(1.0f, display.y - 2 * margin)));
+  ImGui::Begin(title, open,
                ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
+}
+
+void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
+  bool open = true;
+  begin_centred("Score card", &open, display);
+  std::vector<const char*> meanings;
+  float key_w = 0.0f;
+  for (const auto& [key, value] : run.metrics) {
+    meanings.push_back(meaning(key));
+    key_w = std::max(key_w, ImGui::CalcTextSize(key.c_str()).x);
+  }
+  ImGui::PushFont(mono_font());
+  const float value_w = ImGui::CalcTextSize("-0.0000e+00").x;
+  ImGui::PopFont();
+  const float meaning_w = wrapped_column(meanings.data(), meanings.size(), key_w + value_w, display);
   if (ImGui::BeginTable("##score", 3, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    ImGui::TableSetupColumn("key", ImGuiTableColumnFlags_WidthFixed, key_w);
+    ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthFixed, value_w);
+    ImGui::TableSetupColumn("meaning", ImGuiTableColumnFlags_WidthFixed, meaning_w);
     for (const auto& [key, value] : run.metrics) {
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
@@ -243,7 +318,9 @@ void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
       ImGui::Text("%10.4g", value);
       ImGui::PopFont();
       ImGui::TableNextColumn();
-      ImGui::TextDisabled("%s", meaning(key));
+      ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+      ImGui::TextWrapped("%s", meaning(key));
+      ImGui::PopStyleColor();
     }
     ImGui::EndTable();
   }
@@ -253,12 +330,8 @@ void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
 
 // The shortcut sheet (F1 or ?), UI.md §10.
 void help_sheet(UiState& ui, ImVec2 display) {
-  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
-                          ImVec2(0.5f, 0.5f));
-  ImGui::Begin("Keyboard and mouse (F1)", &ui.show_help,
-               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
-                   ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
-  static const std::pair<const char*, const char*> kKeys[] = {
+  begin_centred("Keyboard and mouse (F1)", &ui.show_help, display);
+  static const char* const kKeys[][2] = {
       {"Space", "start / pause / resume the flight; play / pause a replay"},
       {"R", "restart the flight"},
       {"Ctrl+R", "record the next flight or not"},
@@ -274,15 +347,26 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"Esc", "leave the replay; close this sheet"},
       {"F1  ?", "this sheet"},
   };
+  std::vector<const char*> what;
+  float key_w = 0.0f;
+  ImGui::PushFont(mono_font());
+  for (const auto& k : kKeys) {
+    what.push_back(k[1]);
+    key_w = std::max(key_w, ImGui::CalcTextSize(k[0]).x);
+  }
+  ImGui::PopFont();
+  const float what_w = wrapped_column(what.data(), what.size(), key_w, display);
   if (ImGui::BeginTable("##keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
-    for (const auto& [key, what] : kKeys) {
+    ImGui::TableSetupColumn("key", ImGuiTableColumnFlags_WidthFixed, key_w);
+    ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed, what_w);
+    for (const auto& k : kKeys) {
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
       ImGui::PushFont(mono_font());
-      ImGui::TextUnformatted(key);
+      ImGui::TextUnformatted(k[0]);
       ImGui::PopFont();
       ImGui::TableNextColumn();
-      ImGui::TextUnformatted(what);
+      ImGui::TextWrapped("%s", k[1]);
     }
     ImGui::EndTable();
   }
@@ -344,79 +428,179 @@ void keys(UiState& ui, UiRequest& req, const RunInfo& run, const History& h) {
 
 }  // namespace
 
-void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max) {
-  const float top = 96.0f, right = std::clamp(0.3f * display.x, 280.0f, 460.0f);
-  const float bottom = run.replay ? 78.0f : 0.0f;  // the replay's transport bar
+namespace {
+
+// The height ImGui gave the pane `name` in the last frame (its content's), else `fallback`.
+float pane_height(const char* name, float fallback) {
+  const ImGuiWindow* w = ImGui::FindWindowByName(name);
+  return w && w->Size.y > 0.0f ? w->Size.y : fallback;
+}
+
+// Before a pane was ever laid out: `rows` rows of buttons.
+float rows_height(int rows) {
+  const ImGuiStyle& st = ImGui::GetStyle();
+  return 2.0f * st.WindowPadding.y + float(rows) * ImGui::GetFrameHeightWithSpacing() - st.ItemSpacing.y;
+}
+
+// The plots' width: a third of a wide display, never narrower than its legends need.
+float plots_width(float display_w) {
+  const float em = ImGui::GetFontSize();
+  return std::min(std::clamp(0.3f * display_w, 18.5f * em, 30.5f * em), 0.45f * display_w);
+}
+
+// The view pane: between the top bar and the transport, left of the plots.
+void view_pane(ImVec2 display, float top, float bottom, ImVec2& min, ImVec2& max) {
   min = ImVec2(0, top);
-  max = ImVec2(display.x - right, display.y - bottom);
+  max = ImVec2(display.x - plots_width(display.x), std::max(top, display.y - bottom));
+}
+
+// The session panel shows while no flight is under way.
+bool session_panel_shown(const RunInfo& run) {
+  return run.session && !run.replay && run.state != RunState::flying &&
+         run.state != RunState::paused;
+}
+
+// The session panel's width in a view `view_w` wide: narrower (down to what its buttons need)
+// where the view is narrow, to leave the scene some room.
+float session_panel_width(float view_w) {
+  const float em = ImGui::GetFontSize();
+  return std::min(std::clamp(view_w - 10.0f * em, 14.0f * em, 20.0f * em),
+                  view_w - 2.0f * ImGui::GetStyle().WindowPadding.x);
+}
+
+// The vehicle's half size on screen as a part of the frame's height (the chase camera's
+// distance and field of view), with a margin.
+constexpr float kVehicleInFrame = 0.13f;
+
+// Where the view frames its scene (the chase camera keeps the vehicle at its centre): the pane,
+// less the session panel at its left and the HUD above where they would cover that centre (a
+// small window, a large scale), so the vehicle stays in sight. `hud_bottom`: the HUD's bottom
+// edge (the pane's top without one).
+ImVec2 frame_min(ImVec2 min, ImVec2 max, const RunInfo& run, float hud_bottom) {
+  const float m = ImGui::GetStyle().WindowPadding.x, em = ImGui::GetFontSize();
+  ImVec2 f = min;
+  if (session_panel_shown(run)) {
+    const float panel_right = min.x + m + session_panel_width(max.x - min.x);
+    if (panel_right + 3.0f * em > 0.5f * (min.x + max.x)) f.x = std::min(panel_right + m, max.x - 1.0f);
+  }
+  if (hud_bottom + m > 0.5f * (min.y + max.y) - kVehicleInFrame * (max.y - min.y))
+    f.y = std::min(hud_bottom + m, max.y - 1.0f);
+  return f;
+}
+
+}  // namespace
+
+void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max) {
+  const float top = pane_height("##top", rows_height(2));
+  const float bottom = run.replay ? pane_height("##transport", rows_height(3)) : 0.0f;
+  view_pane(display, top, bottom, min, max);
+  const ImGuiWindow* hud = ImGui::FindWindowByName("##hud");
+  const float hud_bottom = hud && hud->Active ? hud->Pos.y + hud->Size.y : min.y;
+  min = frame_min(min, max, run, hud_bottom);
 }
 
 UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState& ui) {
   UiRequest req;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const float em = ImGui::GetFontSize();
+  // The panes take their heights from their content (top bar, transport), the view the rest.
+  const float top = top_bar(sc, h, run, ui, req, d.x);
+  float bottom = 0.0f;
+  if (run.replay) {
+    begin_pane("##transport", ImVec2(0, d.y), d.x, ImVec2(0, 1));
+    draw_transport(run, req);
+    bottom = ImGui::GetWindowHeight();
+    ImGui::End();
+  }
   ImVec2 vmin, vmax;
-  view_rect(d, run, vmin, vmax);
-  const float top = vmin.y, right = d.x - vmax.x, bottom = d.y - vmax.y;
-  top_bar(sc, h, run, ui, req, ImVec2(0, 0), ImVec2(d.x, top));
+  view_pane(d, top, bottom, vmin, vmax);
+  const float view_w = vmax.x - vmin.x;
 
-  ImGui::SetNextWindowPos(vmin);
-  ImGui::SetNextWindowSize(ImVec2(vmax.x - vmin.x, vmax.y - vmin.y));
-  ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
-  if (sc.mode == ModeKind::pendubot_swingup) draw_pendubot(sc, h, vmin, vmax);
-  else draw_arena(sc, h, ui, vmin, vmax);
-  ImGui::End();
-
-  // The session panel at the view's top left while no flight is under way.
-  const bool panel = run.session && !run.replay && run.state != RunState::flying &&
-                     run.state != RunState::paused;
-  const float panel_w = 300.0f;
+  // The overlays on the view first (the view pane stays behind them: ImGui keeps it at the
+  // back), so the scene can be framed in what they leave. They keep a margin from the view's
+  // edges and from each other.
+  const float m = st.WindowPadding.x;
+  const bool panel = session_panel_shown(run);
+  ImVec2 panel_max(vmin.x, vmin.y);  // its bottom right corner
   if (panel) {
-    ImGui::SetNextWindowPos(ImVec2(8, top + 8));
-    ImGui::SetNextWindowSize(ImVec2(panel_w, 0));
+    const float panel_w = session_panel_width(view_w);
+    ImGui::SetNextWindowPos(ImVec2(vmin.x + m, top + m));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(panel_w, 0),
+                                        ImVec2(panel_w, std::max(0.0f, vmax.y - top - 2 * m)));
     ImGui::Begin("Session", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                      ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                      ImGuiWindowFlags_AlwaysAutoResize);
     draw_session_panel(run, ui, req);
+    panel_max = ImVec2(ImGui::GetWindowPos().x + ImGui::GetWindowWidth(),
+                       ImGui::GetWindowPos().y + ImGui::GetWindowHeight());
     ImGui::End();
   }
 
-  const float view_w = d.x - right;
-  const float hud_w = std::min(0.6f * view_w, 640.0f);
-  const float hud_x = std::max(0.5f * (view_w - hud_w), panel ? panel_w + 16 : 0.0f);
-  const float hud_bottom =
-      hud(sc, h, run, ImVec2(hud_x, top + 8), ImVec2(std::min(hud_w, view_w - hud_x - 8), 110));
+  // The HUD at the top centre of the view, beside the session panel; where the view is too
+  // narrow for both (a small window, a large scale) it waits for the flight to start.
+  float hud_bottom = top;
+  {
+    const float lo = panel ? panel_max.x + m : vmin.x + m, room = vmax.x - m - lo;
+    const float widest = mono_font()->CalcTextSizeA(em, FLT_MAX, 0.0f, kWidestHudItem).x;
+    const float w = std::min(std::clamp(0.6f * view_w, 28.0f * em, 43.0f * em), room);
+    if (w >= widest + 2 * st.WindowPadding.x) {
+      const float x = std::max(lo, std::min(vmin.x + 0.5f * (view_w - w), vmax.x - m - w));
+      hud_bottom = hud(sc, h, run, ImVec2(x, top + m), w, vmax.y - vmin.y < 24.0f * em);
+    }
+  }
+  const ImVec2 frame = frame_min(vmin, vmax, run, hud_bottom);
+  const ImVec2 centre(0.5f * (frame.x + vmax.x), 0.5f * (frame.y + vmax.y));
 
-  // The sticks below the HUD, shrunk (down to a readable size) when the window is short.
-  const float sticks_ht = std::min(170.0f, d.y - bottom - 8 - hud_bottom);
-  if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty() &&
-      sticks_ht >= 100.0f) {
-    const float ht = sticks_ht, w = ht * 300.0f / 170.0f;
-    ImGui::SetNextWindowPos(ImVec2(0.5f * (view_w - w), d.y - bottom - ht - 8));
-    ImGui::SetNextWindowSize(ImVec2(w, ht));
-    ImGui::Begin("##sticks", nullptr, kOverlay);
-    const ImVec2 p = ImGui::GetCursorScreenPos();
-    draw_sticks(h.newest(), sc.hover_rotor_speed, p, ImVec2(p.x + w - 16, p.y + ht - 16));
-    ImGui::End();
+  ImGui::SetNextWindowPos(vmin);
+  ImGui::SetNextWindowSize(ImVec2(view_w, vmax.y - vmin.y));
+  ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
+  if (sc.mode == ModeKind::pendubot_swingup) draw_pendubot(sc, h, vmin, vmax, frame);
+  else draw_arena(sc, h, ui, vmin, vmax, frame);
+  ImGui::End();
+
+  // The sticks at the bottom of the frame over the camera line, below the vehicle or, where
+  // the view is short, beside it; shrunk down to a readable size.
+  if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty()) {
+    const float floor = vmax.y - ImGui::GetTextLineHeightWithSpacing() - m;
+    const float vehicle = kVehicleInFrame * (vmax.y - frame.y);
+    const float aspect = 300.0f / 170.0f, least = scaled(80);
+    const auto fit = [&](float above, float width) {
+      return std::min({scaled(170), floor - above, width / aspect});
+    };
+    // Below the vehicle, centred.
+    float ht = fit(std::max(hud_bottom, centre.y + vehicle) + m, vmax.x - frame.x - 2 * m);
+    float x = std::clamp(centre.x - 0.5f * ht * aspect, frame.x + m, vmax.x - m - ht * aspect);
+    if (ht < least) {  // at the bottom right, clear of the vehicle
+      const float beside = centre.x + vehicle + m;
+      ht = fit(std::max(hud_bottom, frame.y) + m, vmax.x - m - beside);
+      x = vmax.x - m - ht * aspect;
+    }
+    const float w = ht * aspect;
+    const bool clear_of_panel = !panel || x >= panel_max.x + m || floor - ht >= panel_max.y + m;
+    if (ht >= least && clear_of_panel) {
+      ImGui::SetNextWindowPos(ImVec2(x, floor - ht));
+      ImGui::SetNextWindowSize(ImVec2(w, ht));
+      ImGui::Begin("##sticks", nullptr, kOverlay);
+      const ImVec2 p = ImGui::GetCursorScreenPos();
+      draw_sticks(h.newest(), sc.hover_rotor_speed, p,
+                  ImVec2(p.x + w - 2 * st.WindowPadding.x, p.y + ht - 2 * st.WindowPadding.y));
+      ImGui::End();
+    }
   }
 
-  ImGui::SetNextWindowPos(ImVec2(d.x - right, top));
-  ImGui::SetNextWindowSize(ImVec2(right, d.y - top - bottom));
-  ImGui::Begin("##plots", nullptr, kPane);
+  // The plots scroll when the pane is too short for them all.
+  ImGui::SetNextWindowPos(ImVec2(vmax.x, top));
+  ImGui::SetNextWindowSize(ImVec2(d.x - vmax.x, vmax.y - top));
+  ImGui::Begin("##plots", nullptr, kPane & ~ImGuiWindowFlags_NoScrollbar);
   draw_plots(sc, h, ui);
   ImGui::End();
 
-  if (run.replay) {
-    ImGui::SetNextWindowPos(ImVec2(0, d.y - bottom));
-    ImGui::SetNextWindowSize(ImVec2(d.x, bottom));
-    ImGui::Begin("##transport", nullptr, kPane);
-    draw_transport(run, req);
-    ImGui::End();
-  }
   if (run.metrics.empty()) ui.score_card_closed = false;
   else if (!ui.score_card_closed) score_card(run, ui, d);
   if (ui.show_help) help_sheet(ui, d);
-  draw_input_banner(h, run, vmin, vmax);
+  draw_input_banner(h, run, frame, vmax);
   draw_input_settings(run, ui, req);
   draw_mapping_wizard(run, req);
   draw_open_dialog(ui, req);

@@ -169,7 +169,10 @@ double event_after(const std::vector<TimelineEvent>& events, double t, int direc
 UiRequest draw_screen(const Scene& scene, const History& history, const RunInfo& run,
                       UiState& ui);
 
-// The arena or Pendubot view's region of a display of size `display` [pixels].
+// Where the arena or Pendubot view frames its scene (the chase camera keeps the vehicle at its
+// centre) on a display of size `display` [pixels], as the last frame laid it out: the view pane
+// between the top bar, the plots and a replay's transport, less the session panel at its left
+// and the HUD above where they would cover the pane's centre.
 void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max);
 
 // Freezes the plots at the newest time of `h` (or lets them roll again).

@@ -34,11 +34,14 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
   // Choices apply to the next flight: fixed while one flies.
   const bool flying = run.state == RunState::flying || run.state == RunState::paused;
   ImGui::BeginDisabled(flying);
-  ImGui::SetNextItemWidth(-80);
+  // The fields take what their labels leave (the longest label, "scenario", and its gap).
+  const float fields = -(ImGui::CalcTextSize("scenario").x + ImGui::GetStyle().ItemInnerSpacing.x);
+  ImGui::PushTextWrapPos(0.0f);
+  ImGui::SetNextItemWidth(fields);
   int chosen = -1;
   if (combo("scenario", c.scenarios, c.scenario, chosen)) req.scenario = chosen;
   if (!c.pilots.empty()) {
-    ImGui::SetNextItemWidth(-80);
+    ImGui::SetNextItemWidth(fields);
     if (combo("pilot", c.pilots, c.pilot, chosen)) req.pilot = chosen;
   }
   if (run.input && !run.input->pilot.empty()) {
@@ -54,7 +57,7 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
     ui.draft_loaded = false;
   }
   if (ImGui::Button("Open file... (Ctrl+O)")) ui.open_dialog.open = true;
-  ImGui::SetNextItemWidth(-80);
+  ImGui::SetNextItemWidth(fields);
   if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())
     std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
   ImGui::InputTextWithHint("trainee", "your name", ui.trainee, sizeof ui.trainee);
@@ -64,11 +67,8 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
   }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) req.record = record ? 1 : 0;
-  if (c.record && !c.record_to.empty()) {
-    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + ImGui::GetContentRegionAvail().x);
-    ImGui::TextDisabled("to %s", c.record_to.c_str());
-    ImGui::PopTextWrapPos();
-  }
+  if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());
+  ImGui::PopTextWrapPos();
   ImGui::EndDisabled();
   if (run.state == RunState::ready) {
     if (ImGui::Button("Start flight (Space)", ImVec2(-1, 0))) req.start = true;
@@ -107,13 +107,20 @@ void draw_open_dialog(UiState& ui, UiRequest& req) {
     ImGui::OpenPopup("Open a scenario or a recording");
   }
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, display.x - 40), std::min(440.0f, display.y - 40)));
+  const float margin = ImGui::GetFontSize();
+  ImGui::SetNextWindowSize(ImVec2(std::min(scaled(640), display.x - 2 * margin),
+                                  std::min(scaled(440), display.y - 2 * margin)));
   ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   if (!ImGui::BeginPopupModal("Open a scenario or a recording", &d.open,
                               ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove))
     return;
   ImGui::TextDisabled("a scenario (.toml) to fly, or a recording (.mcap) to replay");
-  ImGui::TextUnformatted(d.folder.c_str());
+  // The folder, elided in its middle to leave room for "up" (the whole path on hover).
+  const float up_w = ImGui::CalcTextSize("up").x + 2 * ImGui::GetStyle().FramePadding.x +
+                     ImGui::GetStyle().ItemSpacing.x;
+  const std::string folder = elide_middle(d.folder, ImGui::GetContentRegionAvail().x - up_w);
+  ImGui::TextUnformatted(folder.c_str());
+  if (folder != d.folder && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", d.folder.c_str());
   ImGui::SameLine();
   if (ImGui::SmallButton("up")) {
     d.folder = std::filesystem::path(d.folder).parent_path().string();
@@ -139,12 +146,13 @@ void draw_open_dialog(UiState& ui, UiRequest& req) {
     d.folder = enter;
     list_folder(d);
   }
-  ImGui::SetNextItemWidth(-150);
+  const float button_w = std::max(button_width("Open"), button_width("Cancel"));
+  ImGui::SetNextItemWidth(-2 * (button_w + ImGui::GetStyle().ItemSpacing.x));
   const bool typed = ImGui::InputText("##path", d.path, sizeof d.path, ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
-  if ((ImGui::Button("Open", ImVec2(64, 0)) || typed) && d.path[0] != '\0') req.open = d.path;
+  if ((ImGui::Button("Open", ImVec2(button_w, 0)) || typed) && d.path[0] != '\0') req.open = d.path;
   ImGui::SameLine();
-  if (ImGui::Button("Cancel", ImVec2(64, 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
     d.open = false;
   if (!req.open.empty()) d.open = false;
   if (!d.open) ImGui::CloseCurrentPopup();

@@ -9,6 +9,7 @@ namespace mixpilot::ui {
 namespace {
 
 ImFont* g_mono = nullptr;
+float g_scale = 1.0f;
 
 // The file fontconfig matches for `pattern` ("DejaVu Sans"), or "" when it is not DejaVu.
 std::string find_font(const char* family) {
@@ -42,6 +43,7 @@ ImU32 authority_colour(double lambda) {
 }
 
 void apply_style(float scale) {
+  g_scale = scale;
   ImGui::StyleColorsDark();
   ImGuiStyle& st = ImGui::GetStyle();
   st.WindowRounding = 4.0f;
@@ -64,12 +66,18 @@ std::string load_fonts(float scale) {
   const std::string mono = find_font("DejaVu Sans Mono");
   ImFont* main = nullptr;
   if (!sans.empty()) main = io.Fonts->AddFontFromFileTTF(sans.c_str(), px, nullptr, ranges);
-  if (!main) io.Fonts->AddFontDefault();
+  if (!main) {
+    ImFontConfig built_in;
+    built_in.SizePixels = std::round(13.0f * scale);
+    io.Fonts->AddFontDefault(&built_in);
+  }
   g_mono = nullptr;
   if (main && !mono.empty())
     g_mono = io.Fonts->AddFontFromFileTTF(mono.c_str(), px, nullptr, ranges);
   return main ? sans : std::string();
 }
+
+float ui_scale() { return g_scale; }
 
 ImFont* mono_font() { return g_mono ? g_mono : ImGui::GetFont(); }
 

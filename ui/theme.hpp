@@ -30,12 +30,18 @@ inline constexpr ImU32 kText = rgb(0xE8, 0xE8, 0xE8);
 // The colour of authority λ ∈ [0, 1]: planner (0) … pilot (1), through grey.
 ImU32 authority_colour(double lambda);
 
-// Dark style, sizes scaled by `scale` (the monitor's content scale).
+// Dark style, sizes scaled by `scale` (the display's content scale: 1 at 96 dpi, 1.5 at 144).
 void apply_style(float scale);
 
+// The scale apply_style was given. Sizes the UI draws itself (line widths, radii, gaps) are
+// written for 100 % and pass through scaled(), so they grow with the fonts; layout is in units
+// of the font size and the style's metrics.
+float ui_scale();
+inline float scaled(float pixels_at_100) { return pixels_at_100 * ui_scale(); }
+
 // Loads DejaVu Sans (and Sans Mono) found through fontconfig at round(15·scale) px, with the
-// Greek glyphs (λ, φ, θ, Ω); ImGui's built-in font when none is found. Returns the file used,
-// or "" for the built-in.
+// Greek glyphs (λ, φ, θ, Ω); ImGui's built-in font (13·scale px) when none is found. Returns
+// the file used, or "" for the built-in.
 std::string load_fonts(float scale);
 
 // The monospace font for numbers (the default font when none was loaded).

@@ -65,24 +65,24 @@ ImU32 event_colour(EventKind k) {
 // input lost ○.
 void tick(ImDrawList* dl, float x, float top, float bottom, EventKind k) {
   const ImU32 c = event_colour(k);
-  const float s = 5.0f;
-  dl->AddLine(ImVec2(x, top), ImVec2(x, bottom), c, 1.5f);
+  const float s = scaled(5.0f);
+  dl->AddLine(ImVec2(x, top), ImVec2(x, bottom), c, scaled(1.5f));
   switch (k) {
     case EventKind::collision:
       dl->AddTriangleFilled(ImVec2(x, top - s), ImVec2(x - s, top + s), ImVec2(x + s, top + s), c);
       break;
     case EventKind::fallback:
-      dl->AddRectFilled(ImVec2(x - s + 1, top - s + 1), ImVec2(x + s - 1, top + s - 1), c);
+      dl->AddRectFilled(ImVec2(x - 0.8f * s, top - 0.8f * s), ImVec2(x + 0.8f * s, top + 0.8f * s), c);
       break;
     case EventKind::low_lambda:
       dl->AddTriangleFilled(ImVec2(x - s, top - s), ImVec2(x + s, top - s), ImVec2(x, top + s), c);
       break;
     case EventKind::lost:
-      dl->AddLine(ImVec2(x - s, top - s), ImVec2(x + s, top + s), c, 2.0f);
-      dl->AddLine(ImVec2(x - s, top + s), ImVec2(x + s, top - s), c, 2.0f);
+      dl->AddLine(ImVec2(x - s, top - s), ImVec2(x + s, top + s), c, scaled(2.0f));
+      dl->AddLine(ImVec2(x - s, top + s), ImVec2(x + s, top - s), c, scaled(2.0f));
       break;
     case EventKind::input_lost:
-      dl->AddCircle(ImVec2(x, top), s, c, 12, 2.0f);
+      dl->AddCircle(ImVec2(x, top), s, c, 12, scaled(2.0f));
       break;
   }
 }
@@ -94,7 +94,7 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const float w = ImGui::GetContentRegionAvail().x;
   const ImVec2 min = ImGui::GetCursorScreenPos();
-  const float height = 26.0f;
+  const float height = 1.75f * ImGui::GetFontSize();
   const ImVec2 max(min.x + w, min.y + height);
   // The scrubber: click or drag anywhere on it to move the playhead (within what is loaded).
   ImGui::InvisibleButton("##timeline", ImVec2(w, height));
@@ -105,47 +105,53 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
   };
   if (ImGui::IsItemActive()) req.seek = std::min(t_at_mouse(), r.loaded * span);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%.2f s", t_at_mouse());
-  const float ty = min.y + 0.5f * height;
-  dl->AddRectFilled(ImVec2(min.x, ty - 3), ImVec2(max.x, ty + 3), colour::rgb(0x30, 0x34, 0x3A), 3.0f);
-  dl->AddRectFilled(ImVec2(min.x, ty - 3), ImVec2(x_of(r.loaded * span), ty + 3),
-                    colour::rgb(0x50, 0x56, 0x60), 3.0f);
-  dl->AddRectFilled(ImVec2(min.x, ty - 3), ImVec2(x_of(r.t), ty + 3), colour::kPilot, 3.0f);
-  for (const TimelineEvent& e : r.events) tick(dl, x_of(e.t), min.y + 6, max.y - 2, e.kind);
-  dl->AddCircleFilled(ImVec2(x_of(r.t), ty), 7.0f, colour::kText, 16);
+  const float ty = min.y + 0.5f * height, th = scaled(3.0f);
+  dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(max.x, ty + th), colour::rgb(0x30, 0x34, 0x3A), th);
+  dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(x_of(r.loaded * span), ty + th),
+                    colour::rgb(0x50, 0x56, 0x60), th);
+  dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(x_of(r.t), ty + th), colour::kPilot, th);
+  for (const TimelineEvent& e : r.events)
+    tick(dl, x_of(e.t), min.y + scaled(6), max.y - scaled(2), e.kind);
+  dl->AddCircleFilled(ImVec2(x_of(r.t), ty), scaled(7.0f), colour::kText, 16);
 
+  // The controls, wrapping onto more rows where the bar is narrow.
   if (ImGui::Button(r.playing ? "Pause (Space)" : "Play (Space)")) req.toggle_pause = true;
-  ImGui::SameLine();
+  same_line_or_wrap(button_width("< previous event ["));
   if (ImGui::Button("< previous event [")) req.jump = -1;
-  ImGui::SameLine();
+  same_line_or_wrap(button_width("] next event >"));
   if (ImGui::Button("] next event >")) req.jump = +1;
-  ImGui::SameLine();
   ImGui::PushFont(mono_font());
-  ImGui::Text("%7.2f / %.2f s", r.t, r.duration);
+  char time[48];
+  std::snprintf(time, sizeof time, "%7.2f / %.2f s", r.t, r.duration);
+  same_line_or_wrap(ImGui::CalcTextSize(time).x);
+  ImGui::TextUnformatted(time);
   ImGui::PopFont();
   for (double sp : {0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
     char label[16];
     std::snprintf(label, sizeof label, "%gx", sp);
-    ImGui::SameLine();
+    same_line_or_wrap(radio_width(label));
     if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
   }
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(110);
+  const float slider_w = 7.5f * ImGui::GetFontSize();
+  same_line_or_wrap(slider_w);
+  ImGui::SetNextItemWidth(slider_w);
   float threshold = float(r.lambda_threshold);
   if (ImGui::SliderFloat("##lambda", &threshold, 0.05f, 0.95f, "λ below %.2f"))
     req.lambda_threshold = threshold;
   // The legend: each tick's shape and colour.
-  ImGui::SameLine();
+  const float lh = ImGui::GetTextLineHeight();
+  const float mark = scaled(14.0f);
   for (EventKind k : {EventKind::collision, EventKind::fallback, EventKind::low_lambda,
                       EventKind::lost, EventKind::input_lost}) {
+    same_line_or_wrap(mark + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(to_string(k)).x);
+    ImGui::AlignTextToFramePadding();
     const ImVec2 p = ImGui::GetCursorScreenPos();
-    const float lh = ImGui::GetTextLineHeight();
-    tick(dl, p.x + 6, p.y + 0.5f * lh, p.y + lh, k);
-    ImGui::Dummy(ImVec2(14, lh));
-    ImGui::SameLine();
+    const float y = p.y + ImGui::GetStyle().FramePadding.y;
+    tick(dl, p.x + 0.5f * mark, y + 0.5f * lh, y + lh, k);
+    ImGui::Dummy(ImVec2(mark, lh));
+    ImGui::SameLine(0, ImGui::GetStyle().ItemInnerSpacing.x);
     ImGui::TextUnformatted(to_string(k));
-    ImGui::SameLine();
   }
-  ImGui::NewLine();
   if (r.loaded < 1.0)
     ImGui::TextDisabled("flying the recording again to show it: %.0f %%", 100.0 * r.loaded);
 }

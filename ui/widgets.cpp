@@ -9,68 +9,117 @@
 
 namespace mixpilot::ui {
 
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max) {
+float button_width(const char* label) {
+  return ImGui::CalcTextSize(label, nullptr, true).x + 2.0f * ImGui::GetStyle().FramePadding.x;
+}
+
+float radio_width(const char* label) {
+  const float text = ImGui::CalcTextSize(label, nullptr, true).x;
+  return ImGui::GetFrameHeight() + (text > 0 ? ImGui::GetStyle().ItemInnerSpacing.x + text : 0.0f);
+}
+
+void same_line_or_wrap(float width, float spacing) {
+  // Decided before SameLine(): a SameLine() undone by NewLine() would count the spacing after
+  // the last item as content (as if it ran past the row's end).
+  if (spacing < 0.0f) spacing = ImGui::GetStyle().ItemSpacing.x;
+  const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+  if (ImGui::GetItemRectMax().x + spacing + width <= right) ImGui::SameLine(0.0f, spacing);
+}
+
+std::string elide_middle(const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
+  const std::string dots = "\u2026";
+  // Cut whole UTF-8 code points: never split a continuation byte (10xxxxxx).
+  auto cut = [&](std::size_t keep) {
+    std::size_t head = keep / 2, tail = text.size() - (keep - keep / 2);
+    while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
+    while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
+    return text.substr(0, head) + dots + text.substr(tail);
+  };
+  std::size_t lo = 0, hi = text.size();  // longest kept byte count that fits
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi + 1) / 2;
+    if (ImGui::CalcTextSize(cut(mid).c_str()).x <= width) lo = mid; else hi = mid - 1;
+  }
+  return cut(lo);
+}
+
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const double l = std::clamp(lambda, 0.0, 1.0);
   // The pilot's share λ fills from the left in the pilot's colour, the planner's share 1 − λ
   // the rest in the planner's colour; the needle sits at λ.
   const float x = float(min.x + l * (max.x - min.x));
-  dl->AddRectFilled(min, max, colour::kPlanner, 4.0f);
-  dl->AddRectFilled(min, ImVec2(x, max.y), colour::kPilot, 4.0f, ImDrawFlags_RoundCornersLeft);
+  const float round = scaled(4.0f);
+  dl->AddRectFilled(min, max, colour::kPlanner, round);
+  dl->AddRectFilled(min, ImVec2(x, max.y), colour::kPilot, round, ImDrawFlags_RoundCornersLeft);
   const float mid = 0.5f * (min.x + max.x);  // the 0.5 tick
-  dl->AddLine(ImVec2(mid, min.y - 3), ImVec2(mid, max.y + 3), colour::kText, 1.0f);
-  dl->AddLine(ImVec2(x, min.y - 5), ImVec2(x, max.y + 5), colour::kText, 3.0f);  // the needle
+  dl->AddLine(ImVec2(mid, min.y - scaled(3)), ImVec2(mid, max.y + scaled(3)), colour::kText, scaled(1.0f));
+  dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));  // the needle
   char label[64];
   std::snprintf(label, sizeof label, "%s %.2f", l >= 0.5 ? "PILOT" : "PLANNER", l);
   const ImVec2 ts = ImGui::CalcTextSize(label);
   const ImVec2 at(mid - 0.5f * ts.x, 0.5f * (min.y + max.y) - 0.5f * ts.y);
-  dl->AddRectFilled(ImVec2(at.x - 6, at.y - 1), ImVec2(at.x + ts.x + 6, at.y + ts.y + 1),
-                    colour::rgb(0x10, 0x12, 0x15, 200), 3.0f);
+  dl->AddRectFilled(ImVec2(at.x - scaled(6), at.y - scaled(1)),
+                    ImVec2(at.x + ts.x + scaled(6), at.y + ts.y + scaled(1)),
+                    colour::rgb(0x10, 0x12, 0x15, 200), scaled(3.0f));
   dl->AddText(at, colour::kText, label);
-  dl->AddText(ImVec2(min.x + 2, max.y + 4), colour::kPilot, "pilot share λ");
+  if (!names) return;
+  const float below = max.y + scaled(4);
+  dl->AddText(ImVec2(min.x + scaled(2), below), colour::kPilot, "pilot share λ");
   const ImVec2 ps = ImGui::CalcTextSize("planner share 1 − λ");
-  dl->AddText(ImVec2(max.x - ps.x - 2, max.y + 4), colour::kPlanner, "planner share 1 − λ");
+  dl->AddText(ImVec2(max.x - ps.x - scaled(2), below), colour::kPlanner, "planner share 1 − λ");
 }
 
 namespace {
 
-void gimbal(ImDrawList* dl, ImVec2 c, float half, const char* label, double hx, double hy,
-            double mx, double my, bool has_mpc) {
+// One stick's square at `c` with its label centred under it, within the column [lo, hi): the
+// short label where the long one would not fit.
+void gimbal(ImDrawList* dl, ImVec2 c, float half, float lo, float hi, const char* label,
+            const char* short_label, double hx, double hy, double mx, double my, bool has_mpc) {
   dl->AddRectFilled(ImVec2(c.x - half, c.y - half), ImVec2(c.x + half, c.y + half),
-                    colour::rgb(0x20, 0x23, 0x28, 230), 6.0f);
-  dl->AddLine(ImVec2(c.x - half, c.y), ImVec2(c.x + half, c.y), colour::kGrid);
-  dl->AddLine(ImVec2(c.x, c.y - half), ImVec2(c.x, c.y + half), colour::kGrid);
+                    colour::rgb(0x20, 0x23, 0x28, 230), scaled(6.0f));
+  dl->AddLine(ImVec2(c.x - half, c.y), ImVec2(c.x + half, c.y), colour::kGrid, scaled(1.0f));
+  dl->AddLine(ImVec2(c.x, c.y - half), ImVec2(c.x, c.y + half), colour::kGrid, scaled(1.0f));
+  const float inset = scaled(6.0f);
   const auto at = [&](double x, double y) {
-    return ImVec2(c.x + float(std::clamp(x, -1.0, 1.0)) * (half - 6),
-                  c.y - float(std::clamp(y, -1.0, 1.0)) * (half - 6));
+    return ImVec2(c.x + float(std::clamp(x, -1.0, 1.0)) * (half - inset),
+                  c.y - float(std::clamp(y, -1.0, 1.0)) * (half - inset));
   };
   const ImVec2 ph = at(hx, hy);
-  dl->AddCircleFilled(ph, 6.0f, colour::kPilot, 16);
+  dl->AddCircleFilled(ph, scaled(6.0f), colour::kPilot, 16);
   if (has_mpc) {  // the MPC's applied command: a diamond, joined to the pilot's by the correction
     const ImVec2 pm = at(mx, my);
-    dl->AddLine(ph, pm, colour::kMpc, 1.5f);
-    const float d = 8.0f;
+    dl->AddLine(ph, pm, colour::kMpc, scaled(1.5f));
+    const float d = scaled(8.0f);
     dl->AddQuad(ImVec2(pm.x, pm.y - d), ImVec2(pm.x + d, pm.y), ImVec2(pm.x, pm.y + d),
-                ImVec2(pm.x - d, pm.y), colour::kMpc, 2.5f);
+                ImVec2(pm.x - d, pm.y), colour::kMpc, scaled(2.5f));
   }
-  dl->AddText(ImVec2(c.x - half, c.y + half + 2), colour::kText, label);
+  if (ImGui::CalcTextSize(label).x > hi - lo) label = short_label;
+  const float w = ImGui::CalcTextSize(label).x;
+  dl->AddText(ImVec2(std::clamp(c.x - 0.5f * w, lo, std::max(lo, hi - w)), c.y + half + scaled(2)),
+              colour::kText, label);
 }
 
 }  // namespace
 
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
-  const float half = std::min(0.25f * (max.x - min.x), 0.5f * (max.y - min.y) - 12.0f);
-  const float cy = min.y + half + 2;
+  // Two square gimbals side by side, each with its label under it.
+  const float label = ImGui::GetTextLineHeight() + scaled(2);
+  const float half = std::max(1.0f, std::min(0.25f * (max.x - min.x) - scaled(4),
+                                             0.5f * (max.y - min.y - label)));
+  const float cy = min.y + half;
   // Normalised by a 30° tilt for roll and pitch (SPEC §6, angle mode).
   const double tilt = 30.0 * M_PI / 180.0;
   // Thrust: the mean commanded and applied rotor speeds, ±20 % around hover (the thesis's ν has
   // no yaw, SPEC §6).
   const double th = s.pilot.rotor_speed.mean() / hover - 1.0;
   const double tm = s.applied.rotor_speed.mean() / hover - 1.0;
-  gimbal(dl, ImVec2(min.x + 0.25f * (max.x - min.x), cy), half, "thrust", 0.0, 5.0 * th, 0.0,
-         5.0 * tm, s.solved);
-  gimbal(dl, ImVec2(min.x + 0.75f * (max.x - min.x), cy), half, "roll / pitch",
+  const float mid = 0.5f * (min.x + max.x);
+  gimbal(dl, ImVec2(min.x + 0.25f * (max.x - min.x), cy), half, min.x, mid, "thrust", "thrust", 0.0,
+         5.0 * th, 0.0, 5.0 * tm, s.solved);
+  gimbal(dl, ImVec2(min.x + 0.75f * (max.x - min.x), cy), half, mid, max.x, "roll / pitch", "tilt",
          s.pilot.roll / tilt, s.pilot.pitch / tilt, s.applied.roll / tilt, s.applied.pitch / tilt,
          s.solved);
 }
@@ -88,9 +137,11 @@ int channel_index(const Telemetry& s, const char* name) {
   return -1;
 }
 
-// One rolling plot of channels over [t_end − window, t_end].
+// One rolling plot of channels over [t_end − window, t_end] in a slot `slot` pixels high: its
+// title, a legend that wraps under it (each series' value at the right edge, or under the
+// mouse), and the curves in what is left (at least `min_height`).
 void plot(const History& h, const char* title, std::initializer_list<Series> named, double window,
-          double t_end, float height) {
+          double t_end, float slot, float min_height) {
   struct Indexed {
     int channel;
     ImU32 colour;
@@ -100,17 +151,38 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
   for (const Series& s : named)
     if (const int i = h.empty() ? -1 : channel_index(h.newest(), s.name); i >= 0 && count < 4)
       series[count++] = {i, s.colour};
+  const ImVec2 top = ImGui::GetCursorScreenPos();
+  const float width = ImGui::GetContentRegionAvail().x;
+  const double t1 = t_end, t0 = t1 - window;
+  const std::size_t first = h.empty() ? 0 : h.first_at_or_after(t0);
+  const std::size_t end = h.empty() ? 0 : h.first_at_or_after(t1 + 1e-9);  // past the right edge
+  // The sample the legend reads: under the mouse anywhere over the slot, else the newest shown.
+  const Telemetry* at = end > 0 ? &h[end - 1] : nullptr;
+  const bool hovered =
+      ImGui::IsMouseHoveringRect(top, ImVec2(top.x + width, top.y + slot)) && first < end;
+  if (hovered) {
+    const double tm = t0 + double(ImGui::GetIO().MousePos.x - top.x) / double(width) * window;
+    at = &h[std::min(end - 1, h.first_at_or_after(tm))];
+  }
   ImGui::TextUnformatted(title);
-  const ImVec2 title_at = ImGui::GetItemRectMax();
+  char buf[96];
+  for (int k = 0; at && k < count; ++k) {
+    const Indexed& s = series[k];
+    if (s.channel >= at->num_channels) continue;
+    const Channel& c = at->channels[std::size_t(s.channel)];
+    std::snprintf(buf, sizeof buf, "%s %.3g %s", c.name, c.value, c.unit);
+    same_line_or_wrap(ImGui::CalcTextSize(buf).x);
+    ImGui::PushStyleColor(ImGuiCol_Text, s.colour);
+    ImGui::TextUnformatted(buf);
+    ImGui::PopStyleColor();
+  }
   const ImVec2 min = ImGui::GetCursorScreenPos();
-  const ImVec2 max(min.x + ImGui::GetContentRegionAvail().x, min.y + height);
-  ImGui::Dummy(ImVec2(max.x - min.x, height));
+  const float height = std::max(min_height, top.y + slot - min.y);
+  const ImVec2 max(min.x + width, min.y + height);
+  ImGui::Dummy(ImVec2(width, height));
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->AddRectFilled(min, max, colour::rgb(0x12, 0x14, 0x18));
   if (h.empty()) return;
-  const double t1 = t_end, t0 = t1 - window;
-  const std::size_t first = h.first_at_or_after(t0);
-  const std::size_t end = h.first_at_or_after(t1 + 1e-9);  // past the right edge
   double lo = 1e300, hi = -1e300;
   for (std::size_t i = first; i < end; ++i) {
     for (int k = 0; k < count; ++k) {
@@ -134,6 +206,9 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
   };
   // One polyline per series through each pixel column's extremes, in the order they occur:
   // thousands of samples cost a few hundred points, and no spike is lost.
+  // An integer width lets ImGui draw the line from its anti-aliased texture: a third of the
+  // triangles of a fractional width, which a software rasterizer feels.
+  const float line_width = std::max(1.0f, std::round(scaled(2.0f)));
   for (int k = 0; k < count; ++k) {
     const Indexed& s = series[k];
     int column = -1;
@@ -162,33 +237,17 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
       }
     }
     flush();
-    // An integer width lets ImGui draw the line from its anti-aliased texture: a third of the
-    // triangles of a fractional width, which a software rasterizer feels.
-    dl->PathStroke(s.colour, 0, 2.0f);
+    dl->PathStroke(s.colour, 0, line_width);
   }
-  char buf[96];
+  const float inset = scaled(3.0f);
   std::snprintf(buf, sizeof buf, "%.3g", hi - pad);
-  dl->AddText(ImVec2(min.x + 3, min.y + 1), colour::rgb(170, 170, 170), buf);
+  dl->AddText(ImVec2(min.x + inset, min.y + scaled(1)), colour::rgb(170, 170, 170), buf);
   std::snprintf(buf, sizeof buf, "%.3g", lo + pad);
-  dl->AddText(ImVec2(min.x + 3, max.y - ImGui::GetTextLineHeight() - 1), colour::rgb(170, 170, 170), buf);
-  // The legend: each series' name and its value at the right edge, or under the mouse.
-  const Telemetry* at = end > 0 ? &h[end - 1] : nullptr;
-  if (ImGui::IsMouseHoveringRect(min, max) && first < end) {
-    const double tm = t0 + double(ImGui::GetIO().MousePos.x - min.x) / double(max.x - min.x) * window;
-    const std::size_t k = std::min(end - 1, h.first_at_or_after(tm));
-    at = &h[k];
+  dl->AddText(ImVec2(min.x + inset, max.y - ImGui::GetTextLineHeight() - scaled(1)),
+              colour::rgb(170, 170, 170), buf);
+  if (hovered) {
     const float x = to_px(at->t, 0.0).x;
-    dl->AddLine(ImVec2(x, min.y), ImVec2(x, max.y), colour::rgb(0xDD, 0xDD, 0xDD, 140), 1.0f);
-  }
-  float x = title_at.x + 12;
-  const float legend_y = title_at.y - ImGui::GetTextLineHeight();
-  for (int k = 0; at && k < count; ++k) {
-    const Indexed& s = series[k];
-    if (s.channel >= at->num_channels) continue;
-    const Channel& c = at->channels[std::size_t(s.channel)];
-    std::snprintf(buf, sizeof buf, "%s %.3g %s", c.name, c.value, c.unit);
-    dl->AddText(ImVec2(x, legend_y), s.colour, buf);
-    x += ImGui::CalcTextSize(buf).x + 12;
+    dl->AddLine(ImVec2(x, min.y), ImVec2(x, max.y), colour::rgb(0xDD, 0xDD, 0xDD, 140), scaled(1.0f));
   }
 }
 
@@ -202,26 +261,35 @@ void draw_plots(const Scene& sc, const History& h, UiState& ui) {
   if (ImGui::Checkbox("pause plots (P)", &paused)) set_plots_paused(ui, h, paused);
   if (h.empty()) return;
   const double t_end = ui.plots_paused ? ui.plots_paused_at : h.newest().t;
-  const float height = 80.0f;
+  // The plots share the pane's height; below a readable height each (its two axis labels and
+  // a curve between them) the pane scrolls.
+  const float min_height = 3.0f * ImGui::GetTextLineHeight();
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const auto slot = [&](int plots) {
+    return std::max(0.0f, (ImGui::GetContentRegionAvail().y + st.ItemSpacing.y) / float(plots) -
+                              st.ItemSpacing.y);
+  };
   if (sc.mode == ModeKind::mixed_initiative) {
-    plot(h, "authority λ", {{"lambda", colour::kPilot}}, ui.plot_window, t_end, height);
+    const float s = slot(6);
+    plot(h, "authority λ", {{"lambda", colour::kPilot}}, ui.plot_window, t_end, s, min_height);
     plot(h, "deviation |p − η_r| vs r",
          {{"deviation", colour::kPilot}, {"ball radius r", colour::kCaution}}, ui.plot_window,
-         t_end, height);
+         t_end, s, min_height);
     plot(h, "roll φ_h vs φ*₁", {{"roll pilot", colour::kPilot}, {"roll MPC", colour::kMpc}},
-         ui.plot_window, t_end, height);
+         ui.plot_window, t_end, s, min_height);
     plot(h, "pitch θ_h vs θ*₁", {{"pitch pilot", colour::kPilot}, {"pitch MPC", colour::kMpc}},
-         ui.plot_window, t_end, height);
+         ui.plot_window, t_end, s, min_height);
     plot(h, "rotor speed Ω vs bound",
          {{"rotor speed max", colour::kMpc}, {"rotor speed bound", colour::kCritical}},
-         ui.plot_window, t_end, height);
-    plot(h, "RTI time", {{"RTI time", colour::kCaution}}, ui.plot_window, t_end, height);
+         ui.plot_window, t_end, s, min_height);
+    plot(h, "RTI time", {{"RTI time", colour::kCaution}}, ui.plot_window, t_end, s, min_height);
     return;
   }
   const Telemetry& n = h.newest();
+  const float s = slot(std::max(1, n.num_channels));
   for (int i = 0; i < n.num_channels; ++i)
     plot(h, n.channels[std::size_t(i)].name, {{n.channels[std::size_t(i)].name, kCycle[i % 6]}},
-         ui.plot_window, t_end, 56.0f);
+         ui.plot_window, t_end, s, min_height);
 }
 
 }  // namespace mixpilot::ui

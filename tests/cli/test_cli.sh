@@ -107,6 +107,15 @@ check "--screenshot writes a PNG" sh -c "head -c 8 '$work/shot.png' | od -c | gr
   --screenshot 5:"$work/late.png" >"$work/late.out" 2>&1
 check "--screenshot beyond the flight is a usage error" test $? -eq 2
 check "... and nothing is written" test ! -e "$work/late.png"
+# --scale: the frame a 150 % display shows (larger text: another picture); out of range refused.
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --duration 1 \
+  --screenshot 0.5:"$work/shot150.png" --size 320x200 --scale 1.5 >"$work/shot150.out" 2>&1
+check "--scale 1.5 writes a PNG" test $? -eq 0 -a -s "$work/shot150.png"
+check "... another frame than at 100 %" sh -c "! cmp -s '$work/shot.png' '$work/shot150.png'"
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --duration 1 \
+  --scale 0.1 >"$work/scale.out" 2>&1
+check "--scale 0.1 is a usage error" test $? -eq 2
+check "... naming the range" grep -q "from 0.5 to 4" "$work/scale.out"
 
 # A recording flown longer than its scenario (--duration) replays at its own length, and
 # `replay` shows a recording of any mode headless.
