@@ -102,6 +102,7 @@ fi
 command -v debootstrap >/dev/null || apt-get install -y -qq debootstrap
 
 root=$(mktemp -d /var/tmp/mixpilot-root.XXXXXX)
+chmod 755 "$root"  # the root's /, which apt's unprivileged _apt user must traverse
 cleanup() {
   umount "$root/proc" 2>/dev/null || true
   rm -rf --one-file-system "$root" "$root.log"
