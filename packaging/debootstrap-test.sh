@@ -54,6 +54,7 @@ if [ -n "$mirror" ]; then
 else
   # The `deb` entries apt reads, "URI SUITE COMPONENT" a line in apt's order (deb-src, disabled
   # stanzas, options and comments are apt's business).
+  # shellcheck disable=SC2016  # $(...) is apt's format, not the shell's
   entries=$(apt-get indextargets --no-release-info 'Identifier: Packages' \
               --format '$(TARGET_OF) $(REPO_URI) $(RELEASE) $(COMPONENT)') ||
     die "apt cannot read this machine's sources (above); give a mirror with --mirror URL"
@@ -61,6 +62,7 @@ else
               <<<"$entries" | awk '!seen[$0]++')
   mirror=$(awk -v s="$suite" '$2 == s && $3 == "main" { print $1; exit }' <<<"$entries")
   if [ -z "$mirror" ]; then
+    list='' parts=''
     eval "$(apt-config shell list Dir::Etc::SourceList/f parts Dir::Etc::SourceParts/d)"
     die "no http(s) Debian mirror with '$suite main' in the apt sources ($list, ${parts}*.list," \
         "${parts}*.sources); give one with --mirror URL or DEBIAN_MIRROR=URL"
@@ -77,7 +79,7 @@ fi
 # apt's proxy for a scheme: the one for the mirror's host, else the scheme's; DIRECT is none.
 host=${mirror#*://}; host=${host%%/*}; host=${host##*@}; host=${host%:*}
 apt_proxy() {
-  local value= general=
+  local value='' general=''
   eval "$(apt-config shell value "Acquire::$1::Proxy::$host" general "Acquire::$1::Proxy")"
   value=${value:-$general}
   case "$value" in DIRECT|direct) echo none ;; *) echo "$value" ;; esac

@@ -14,7 +14,7 @@ fails=0
 # A fresh apt configuration: sources.list (absent until written), an empty sources.list.d and
 # conf.d, and the extra lines given.
 fresh() {
-  rm -rf "$work/etc" && mkdir -p "$work/etc/sources.list.d" "$work/etc/apt.conf.d" "$work/lists"
+  rm -rf "${work:?}/etc" && mkdir -p "$work/etc/sources.list.d" "$work/etc/apt.conf.d" "$work/lists"
   cat >"$work/apt.conf" <<EOF
 Dir::Etc::SourceList "$work/etc/sources.list";
 Dir::Etc::SourceParts "$work/etc/sources.list.d";
