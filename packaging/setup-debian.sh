@@ -22,8 +22,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev valgrind
   # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
   clang libclang-rt-dev
-  # tooling: independent MCAP reader in the recording tests; every file's license (reuse lint)
-  nodejs reuse
+  # tooling: independent MCAP reader in the recording tests
+  nodejs
   # the Debian package: man pages, dpkg-shlibdeps, its checks (packaging/build-deb.sh)
   help2man dpkg-dev lintian desktop-file-utils appstream
 )
