@@ -361,9 +361,6 @@ void print_realtime(const RealtimeStats& st, double dt) {
   std::printf("  simulated time fell %.3f s behind the wall clock%s\n", st.slip_s,
               st.slip_s > 0.1 * double(st.steps) * dt ? " (this machine could not keep real time)"
                                                          : "");
-  if (st.safe_hold_steps > 0)
-    std::printf("  SAFE HOLD: this machine could not keep up: the MPC's plan ran out and the safe "
-                "controller flew %.2f s\n", double(st.safe_hold_steps) * dt);
 }
 
 std::string seconds_text(double t) {

@@ -51,10 +51,11 @@ bool ScreenshotSink::open(int width, int height, std::string& error, float scale
 
 void ScreenshotSink::on_sample(const Telemetry& s) {
   history_.push(s);
+  ui::count_step(s, counts_);
   for (std::size_t i = 0; i < requests_.size(); ++i) {
     if (done_[i] || !(s.t <= requests_[i].t + 1e-12 && requests_[i].t < s.t + scene_.dt)) continue;
     done_[i] = true;
-    ui::RunInfo run;
+    ui::RunInfo run = counts_;
     run.state = ui::RunState::flying;
     // Two frames: ImGui sizes some items in the first.
     for (int f = 0; f < 2; ++f)

@@ -39,6 +39,8 @@ class ScreenshotSink : public TelemetrySink {
   // After the flight: false with the first failure (a write error, a time never reached).
   [[nodiscard]] bool finish(std::string& error) const;
   const std::vector<std::string>& written() const { return written_; }
+  // Fallbacks and deadline misses of the steps so far: what the screenshots' HUD shows.
+  const ui::RunInfo& counts() const { return counts_; }
 
  private:
   ui::Scene scene_;
@@ -47,6 +49,7 @@ class ScreenshotSink : public TelemetrySink {
   bool overwrite_;
   std::unique_ptr<Offscreen> offscreen_;
   ui::History history_;
+  ui::RunInfo counts_;  // fallbacks and deadline misses so far, as the window counts them
   ui::UiState ui_;
   std::vector<std::string> written_;
   std::string error_;

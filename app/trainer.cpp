@@ -258,7 +258,7 @@ void Trainer::update_live() {
   if (!f.closed) {
     while (f.runner->telemetry().pop(f.sample)) {
       f.history.push(f.sample);
-      if (f.sample.events & (kEventFallback | kEventOverrun)) ++f.fallbacks;
+      ui::count_step(f.sample, f.counts);
     }
   }
   const Mode& mode = *f.flight.mode;
@@ -270,15 +270,14 @@ void Trainer::update_live() {
   if (over && f.metrics.empty())
     f.metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
                                    : with_lost_fields(mode.metrics(), mode);
-  const RealtimeStats st = f.runner->stats();
   run_.state = !f.started ? ui::RunState::ready
                : mode.lost() ? ui::RunState::lost
                : over ? ui::RunState::finished
                : f.runner->paused() ? ui::RunState::paused
                                     : ui::RunState::flying;
   run_.speed = f.runner->speed();
-  run_.deadline_misses = st.deadline_misses;
-  run_.fallbacks = f.fallbacks;
+  run_.deadline_misses = f.counts.deadline_misses;
+  run_.fallbacks = f.counts.fallbacks;
   run_.recording = !f.record_path.empty() && !f.closed;
   run_.can_restart = true;
   run_.metrics = f.metrics;
@@ -312,8 +311,9 @@ void Trainer::update_replay(double wall_dt) {
   run_.deadline_misses = 0;
   run_.fallbacks = 0;
   const std::size_t k = tape_index(r, info.t);
-  for (const ui::TimelineEvent& e : info.events)
-    run_.fallbacks += e.kind == ui::EventKind::fallback && e.t <= info.t + 1e-9 ? 1 : 0;
+  // The replay marks the recorded flight's overruns and deadline misses (Mode::replay_timing):
+  // the tape counts what the flight counted.
+  for (std::size_t i = 0; i < ready && i <= k; ++i) ui::count_step(r.tape()[i], run_);
   run_.recording = false;
   run_.can_restart = false;
   run_.metrics = r.done() && ready > 0 && k + 1 >= ready ? r.metrics() : Metrics{};

@@ -31,7 +31,7 @@ struct LiveFlight {
   ui::Scene scene;
   ui::History history;
   Telemetry sample;  // the ring's values are copied into it (sized once)
-  std::int64_t fallbacks = 0;
+  ui::RunInfo counts;  // fallbacks and deadline misses so far (ui::count_step)
   bool started = false, closed = false;
   bool waiting = false;  // Start asked for, waiting for the gamepad
   Metrics metrics;   // once the run is over

@@ -116,9 +116,17 @@ TEST(GamepadFlight, UnpluggingHandsThePlannerTheVehicleAndRecentringReturnsIt) {
   EXPECT_LE(double(lost) * dt, 5.0 + dt + 0.002);
   EXPECT_GT(double(lost) * dt, 5.0 - dt);
   EXPECT_NE(r->channels[lost].events & kEventInputLost, 0u);
+  // The summary says for how long (10 s, to a step either side of the unplug's timing).
+  const std::string out = read_file(dir / "out.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("input was lost for ([0-9.]+) s in all")))
+      << out;
+  EXPECT_NEAR(std::stod(m[1]), 10.0, 2 * dt + 1e-9);
   for (std::size_t k = lost; k < lost + std::size_t(10.0 / dt); ++k) {
     ASSERT_EQ(r->lambda[k].lambda, 0.0) << k;
     EXPECT_EQ(r->pilot[k].authority, 0.0);
+    // The planner flies every step: its QP at λ = 0 is solved, never a fallback.
+    EXPECT_EQ(r->channels[k].events & kEventFallback, 0u) << k;
     // 10 s in B and nothing hit.
     EXPECT_LE(channel(r->channels[k], "deviation"), channel(r->channels[k], "ball radius r")) << k;
     EXPECT_EQ(r->channels[k].events & kEventCollision, 0u) << k;

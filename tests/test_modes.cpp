@@ -258,8 +258,9 @@ TEST_P(EveryMode, OverrunsInARowHandTheVehicleToTheSafeControllerAndBack) {
   for (std::int64_t k = 0; k < total; ++k) {
     const bool safe = (events[std::size_t(k)] & kEventSafeHold) != 0;
     ASSERT_EQ(safe, k >= safe_from && k <= safe_to) << "step " << k;
-    if (k == safe_from || k == safe_to + 1)
+    if (k == safe_from || k == safe_to + 1) {
       EXPECT_NE(events[std::size_t(k)] & kEventSwitch, 0u) << "step " << k;
+    }
   }
   const MetricMap m = metric_map(mode->metrics());
   if (c.kind == ModeKind::mixed_initiative) {  // held, then flown back into B: nothing hit

@@ -77,7 +77,9 @@ TEST(Overload, TheSafeControllerFliesWhileTheSolverCannotKeepUpAndTheReplayIsExa
   std::int64_t first_safe = -1, last_safe = -1, misses = 0;
   for (std::int64_t k = 0; k < std::int64_t(rec->channels.size()); ++k) {
     const std::uint32_t e = rec->channels[std::size_t(k)].events;
-    if (k >= slow_from && k <= slow_to) EXPECT_NE(e & kEventOverrun, 0u) << "step " << k;
+    if (k >= slow_from && k <= slow_to) {
+      EXPECT_NE(e & kEventOverrun, 0u) << "step " << k;
+    }
     if (e & kEventSafeHold) {
       if (first_safe < 0) first_safe = k;
       last_safe = k;

@@ -14,7 +14,9 @@
 #include <imgui.h>
 #include <imgui_internal.h>
 
+#include "app/cli.hpp"
 #include "app/offscreen.hpp"
+#include "app/screenshot.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/session.hpp"
 #include "ui/scene.hpp"
@@ -110,6 +112,50 @@ TEST_F(Ui, AuthorityBarFillMatchesLambda) {
   ASSERT_GE(best_row, 0) << "no authority bar found";
   // The needle and the 0.5 tick hide a few pixels: within 2 % of the bar's width.
   EXPECT_NEAR(double(pilot) / double(pilot + planner), lambda, 0.02) << "row " << best_row;
+}
+
+// Sustained overload: while the safe controller flies, the HUD says so in the critical colour
+// (and not before); a headless screenshot's HUD counts the fallbacks and deadline misses of the
+// steps before it, as the window does (it showed 0 whatever the flight did).
+TEST_F(Ui, TheHudSaysWhenTheMachineCannotKeepUpAndCountsWhatHappened) {
+  ModeRequest request;
+  request.duration = 3.0;
+  request.pilot_name = "novice";
+  std::string error;
+  auto mode = load_mode(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml",
+                        std::move(request), error);
+  ASSERT_TRUE(mode) << error;
+  std::vector<std::int64_t> overruns;
+  for (std::int64_t k = 100; k < 150; ++k) overruns.push_back(k);
+  mode->replay_timing(overruns, {100, 101});
+  const ui::Scene scene = ui::scene_of(*mode, "novice");
+  cli::ScreenshotSink shots(scene, {}, true);
+  ui::History h;
+  int critical_before = -1, critical_during = -1;
+  const auto critical = [&] {
+    ui::UiState st;
+    const auto px = render(scene, h, st);
+    // Inside the HUD's window only (the plots have critical-coloured lines of their own).
+    const ImGuiWindow* hud = ImGui::FindWindowByName("##hud");
+    if (!hud) return -1;
+    int n = 0;
+    for (int y = int(hud->Pos.y); y < int(hud->Pos.y + hud->Size.y) && y < kH; ++y)
+      for (int x = int(hud->Pos.x); x < int(hud->Pos.x + hud->Size.x) && x < kW; ++x)
+        n += near(&px[(std::size_t(y) * kW + std::size_t(x)) * 4], rgb_of(ui::colour::kCritical), 40);
+    if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"))
+      (void)cli::write_file(std::string(dir) + "/safe_hold_" + std::to_string(h.newest().step) +
+                                ".png", screen_.png(), true, error);
+    return n;
+  };
+  while (mode->step()) {
+    h.push(mode->telemetry());
+    shots.on_sample(mode->telemetry());
+    if (mode->telemetry().step == 90) critical_before = critical();
+    if (mode->telemetry().step == 120) critical_during = critical();
+  }
+  EXPECT_GT(critical_during, critical_before + 300) << critical_before;  // the line's text
+  EXPECT_EQ(shots.counts().fallbacks, 50);
+  EXPECT_EQ(shots.counts().deadline_misses, 50);  // each overrun, the two recorded among them
 }
 
 // A frame depends only on what it draws: rendered twice, the same pixels.

@@ -223,6 +223,12 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
   // Deadline misses in the caution colour once there are any (UI.md §8).
   std::snprintf(text, sizeof text, "deadline misses %lld", static_cast<long long>(run.deadline_misses));
   item(text, run.deadline_misses > 0 ? colour::kCaution : colour::kText);
+  // The MPC's plan ran out (SPEC §4's failure policy exhausted): the safe controller flies.
+  if (s && (s->events & kEventSafeHold)) {
+    first = true;
+    item("SAFE HOLD: this machine cannot keep up;", colour::kCritical);
+    item("the safe controller flies", colour::kCritical);
+  }
   // A remote vehicle (SPEC §9): the round-trip time the predictor uses, and the newest sample.
   if (const double rtt = s ? channel_value(*s, "RTT estimate", -1.0) : -1.0; rtt >= 0.0) {
     first = true;
@@ -254,9 +260,11 @@ const char* meaning(const std::string& key) {
       {"stick_smoothness", "RMS change of the pilot's command per step [rad]"},
       {"rti_median_us", "median RTI time per step [us]"},
       {"rti_p99_us", "99th percentile RTI time [us]"},
-      {"deadline_misses", "steps whose RTI time exceeded the control period"},
+      {"deadline_misses", "steps whose control came after their period (real time only)"},
       {"fallbacks", "steps that applied the previous solution's input"},
       {"skill", "the score: progress x quality / (1 + collisions), 0-100"},
+      {"input_lost_s", "time the pilot's input was lost: the planner flew [s]"},
+      {"safe_hold_s", "time the safe controller flew: the MPC fell behind [s]"},
       {"lost", "1: the vehicle was lost"},
       {"lost_at_s", "when it was lost [s]"},
       {"rtt_s", "round-trip time to the vehicle (remote: the median sample) [s]"},

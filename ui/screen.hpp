@@ -92,8 +92,10 @@ struct InputInfo {
 struct RunInfo {
   RunState state = RunState::ready;
   double speed = 1.0;            // real-time factor (slow motion < 1)
+  // So far: steps marked kEventDeadlineMiss, and steps that applied the previous solution's
+  // input (count_step() adds one step's).
   std::int64_t deadline_misses = 0;
-  std::int64_t fallbacks = 0;    // steps that applied the previous solution's input, so far
+  std::int64_t fallbacks = 0;
   bool recording = false;
   bool can_restart = false;      // the app can start the flight again (Restart, R)
   std::string message;           // a line for the status area ("" none)
@@ -103,6 +105,13 @@ struct RunInfo {
   const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
 };
+
+// Adds step `s` to the run's counts: the live flight, a replay's tape and a headless
+// screenshot count the same events.
+inline void count_step(const Telemetry& s, RunInfo& run) {
+  run.fallbacks += (s.events & (kEventFallback | kEventOverrun)) != 0;
+  run.deadline_misses += (s.events & kEventDeadlineMiss) != 0;
+}
 
 // A file browser's state (File → Open): the folder shown and what it holds.
 struct OpenDialog {

@@ -290,6 +290,13 @@ std::string MiMode::summary() const {
                 s.max_deviation_m, s.rms_deviation_m, 100.0 * s.time_in_ball, 100.0 * s.progress,
                 s.collisions, s.min_clearance_m, s.override_rms, s.skill);
   std::string out = buf;
+  if (s.input_lost_s > 0.0) {
+    std::snprintf(buf, sizeof buf,
+                  "  the pilot's input was lost for %.2f s in all: the planner flew meanwhile\n",
+                  s.input_lost_s);
+    out += buf;
+  }
+  out += safe_hold_summary(safety_, dt_, "a hover-hold controller");
   if (lost_ && link_) {
     std::snprintf(buf, sizeof buf, "  the remote vehicle was lost at t = %.3f s: %s\n", lost_at_,
                   lost_reason_);

@@ -313,7 +313,7 @@ std::string ObstacleMode::summary() const {
                 r.min_distance_control_m, r.violations, r.tracking_rms_m, r.final_error_m,
                 r.rti_median_us, r.rti_p99_us, r.rti_max_us, r.fallbacks,
                 r.lost ? "\n  the vehicle was lost" : "");
-  return buf;
+  return buf + safe_hold_summary(safety_, settings_.dt, "a hover-hold LQR");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -420,6 +420,8 @@ std::string PendubotMode::summary() const {
                 run.rti_median_us, run.rti_p99_us, run.nmpc_steps, (long long)run.fallbacks,
                 run.lqr_entry_time, run.lqr_time, run.lqr_entries, run.final_angle_norm);
   out += buf;
+  out += safe_hold_summary(safety_, scenario_.controller.dt,
+                           "the LQR near the top (no torque elsewhere)");
   return out;
 }
 

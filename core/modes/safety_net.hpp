@@ -8,6 +8,8 @@
 // follows from the steps' RTI outcomes, which a replay reproduces (recorded overruns are
 // forced), so a replay switches at the same steps.
 #include <cstdint>
+#include <cstdio>
+#include <string>
 
 #include "core/numerics/types.hpp"
 
@@ -52,5 +54,17 @@ class SafetyNet {
   int engagements_ = 0;
   std::int64_t steps_engaged_ = 0;
 };
+
+// The summary's line about the safe controller ("" when it never flew): how long, and why.
+inline std::string safe_hold_summary(const SafetyNet& net, double dt, const char* controller) {
+  if (net.steps_engaged() == 0) return "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "  SAFE HOLD for %.2f s (%d time%s): the MPC fell behind %d steps in a row, so %s "
+                "flew (this machine could not keep up)\n",
+                double(net.steps_engaged()) * dt, net.engagements(),
+                net.engagements() == 1 ? "" : "s", net.after(), controller);
+  return buf;
+}
 
 }  // namespace mixpilot

@@ -467,6 +467,7 @@ std::string TrackingMode::summary() const {
     out += lost_reason_;
     out += "\n";
   }
+  out += safe_hold_summary(safety_, scenario_.controller.dt, "the LQR");
   return out;
 }
 
