@@ -1,6 +1,7 @@
 #include "app/replay.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
@@ -51,29 +52,33 @@ std::vector<std::int64_t> recorded_steps(const RecordingContents& rec, std::uint
   return steps;
 }
 
+// The planned length of the recorded flight in steps (its metadata), or 0 where a recording
+// older than the key does not say.
+std::int64_t planned_steps(const RecordingContents& rec) {
+  const auto it = rec.metadata.find("planned_steps");
+  if (it == rec.metadata.end()) return 0;
+  char* end = nullptr;
+  const long long n = std::strtoll(it->second.c_str(), &end, 10);
+  return end != it->second.c_str() && *end == '\0' && n > 0 && n <= (1ll << 40) ? n : 0;
+}
+
 std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
   const auto kind = scenario_mode(text, source, error);
   if (!kind) return nullptr;
+  const bool mi = *kind == "mixed_initiative";
+  // As many steps as were recorded (an interrupted run, or one flown with --duration), in a
+  // flight of the planned length: the metrics are those the flight had.
+  const auto recorded = std::int64_t(mi ? rec.pilot.size() : rec.states.size());
+  const double dt = rec.control_period_ns > 0 ? 1e-9 * double(rec.control_period_ns) : 0.0;
   ModeRequest request;
   request.duration = duration;
-  if (*kind == "mixed_initiative") {
-    if (!duration) {
-      const auto scenario = parse_scenario(text, source, error);
-      if (!scenario) return nullptr;
-      request.duration = double(rec.pilot.size()) * scenario->controller.dt;
-    }
-    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
-    return make_mode(text, source, std::move(request), error);
-  }
+  if (!duration && dt > 0.0)
+    request.duration = double(std::max(planned_steps(rec), recorded)) * dt;
+  if (mi) request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
   auto mode = make_mode(text, source, std::move(request), error);
-  if (mode && !duration && std::int64_t(rec.states.size()) != mode->steps_total()) {
-    // As many steps as were recorded: an interrupted run, or one flown with --duration.
-    ModeRequest same;
-    same.duration = double(rec.states.size()) * mode->dt();
-    mode = make_mode(text, source, std::move(same), error);
-  }
+  if (mode && !duration) mode->stop_after(recorded);
   return mode;
 }
 

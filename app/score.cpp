@@ -49,6 +49,8 @@ struct ScoreRow {
   bool ok = false;
   std::string difference;  // what differed first; empty: every step replayed bit for bit
   std::string error;
+  // The flight stopped before its planned end: "interrupted at t = 3.0 s of 30.0 s" ("" if not).
+  std::string ended_early;
 };
 
 ScoreRow score_recording(const std::string& path) {
@@ -78,6 +80,13 @@ ScoreRow score_recording(const std::string& path) {
   session.run();
   row.metrics = replay_metrics(*mode, *rec, &row.score);
   row.difference = check.first_difference(mode->steps_done());
+  if (rec->end && rec->end->interrupted) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "interrupted at t = %.1f s of %.1f s",
+                  double(mode->steps_done()) * mode->dt(),
+                  double(mode->steps_total()) * mode->dt());
+    row.ended_early = buf;
+  }
   row.ok = true;
   return row;
 }
@@ -161,7 +170,8 @@ int score_command(int argc, char** argv) {
     }
     const Score& s = r.score;
     const bool exact = r.difference.empty();
-    const char* replay = exact ? "exact" : "DIFFERS from recording";
+    std::string replay = exact ? "exact" : "DIFFERS from recording";
+    if (!r.ended_early.empty()) replay += " (" + r.ended_early + ")";
     if (!exact) {
       ++mismatches;
       std::fprintf(stderr, "%s: the replay differs from the recording: %s\n", r.file.c_str(),
@@ -170,15 +180,16 @@ int score_command(int argc, char** argv) {
     if (r.mode == "mixed_initiative") {
       std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
                   r.pilot.c_str(), s.duration_s, s.mean_lambda, s.min_lambda, s.max_deviation_m,
-                  s.collisions, static_cast<long long>(s.fallbacks), s.skill, replay);
+                  s.collisions, static_cast<long long>(s.fallbacks), s.skill, replay.c_str());
     } else {  // the other modes' metrics are in the JSON
       std::printf("%-32s %-12.12s %8s %7s %7s %8s %5s %6s %7s %s\n", r.file.c_str(),
-                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay);
+                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay.c_str());
     }
     if (json.size() > 2) json += ",\n";
     Labels labels = {{"file", r.file}, {"mode", r.mode}, {"scenario", r.scenario}};
     if (!r.pilot.empty()) labels.emplace_back("pilot", r.pilot);
     labels.emplace_back("replay", exact ? "exact" : "differs");
+    if (!r.ended_early.empty()) labels.emplace_back("interrupted", "true");
     json += to_json(labels, r.metrics);
   }
   json += "\n]\n";

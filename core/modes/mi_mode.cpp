@@ -174,7 +174,7 @@ void MiMode::set_channels() {
 }
 
 bool MiMode::step() {
-  if (finished_) return false;
+  if (finished_ || stopped_at(step_)) return false;
   const auto started = std::chrono::steady_clock::now();
   const double t = double(step_) * dt_;
   Telemetry& s = telemetry_;

@@ -137,6 +137,11 @@ class Mode {
     period_us_ = period_us;
   }
 
+  // A replay of a flight that ended early (interrupted, or cut short): step() does nothing
+  // from step `steps` on, while the mode keeps the flight's planned length, so its metrics
+  // (progress against the whole reference, for one) are those of the flight as it was flown.
+  void stop_after(std::int64_t steps) { stop_after_ = steps; }
+
   // A replay: what depended on the wall clock in the recorded flight, as it happened there.
   // The RTI solves of steps `overruns` are overruns (their fallbacks are reproduced bit for
   // bit) and steps `misses` missed their deadline (ascending step indices each).
@@ -147,6 +152,8 @@ class Mode {
   }
 
  protected:
+  // Whether a replay stops before step k (stop_after()).
+  bool stopped_at(std::int64_t k) const { return stop_after_ >= 0 && k >= stop_after_; }
   // Whether step k's solve is a recorded overrun (asked with increasing k).
   bool forced_overrun(std::int64_t k) { return take(forced_overruns_, next_forced_, k); }
   // kEventDeadlineMiss for step k whose control input took `compute_us` from the step's start,
@@ -167,6 +174,7 @@ class Mode {
   std::vector<std::int64_t> forced_overruns_, forced_misses_;
   std::size_t next_forced_ = 0, next_miss_ = 0;
   double late_us_ = 0.0, period_us_ = 0.0;
+  std::int64_t stop_after_ = -1;
 };
 
 }  // namespace mixpilot

@@ -125,7 +125,7 @@ void ObstacleMode::reset_telemetry() {
 // One control period
 
 bool ObstacleMode::step() {
-  if (finished_) return false;
+  if (finished_ || stopped_at(step_)) return false;
   const auto started = std::chrono::steady_clock::now();
   const int k = int(step_);
   const double t = k * settings_.dt;

@@ -280,7 +280,7 @@ void PendubotMode::record_angle_norm() {
 }
 
 bool PendubotMode::step() {
-  if (finished_) return false;
+  if (finished_ || stopped_at(step_)) return false;
   const auto started = std::chrono::steady_clock::now();
   measure();
   const bool switched = switch_controller();

@@ -269,7 +269,7 @@ void TrackingMode::lose(double at, const char* reason) {
 }
 
 bool TrackingMode::step() {
-  if (finished_) return false;
+  if (finished_ || stopped_at(step_)) return false;
   if (link_) return step_remote();
   const long k = long(step_);
   const auto started = std::chrono::steady_clock::now();

@@ -344,6 +344,7 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                                       {"pilot", info.pilot},
                                       {"trainee", info.trainee},
                                       {"vehicle", info.vehicle},
+                                      {"planned_steps", std::to_string(info.planned_steps)},
                                       {"control_period_ns", std::to_string(period_ns_)}});
   if (!writer_.error().empty()) {
     error = writer_.error();

@@ -154,6 +154,7 @@ struct SessionInfo {
   std::string pilot;          // pilot source, as in PilotCommandMsg::source (mixed initiative)
   std::string trainee = {};   // the person flying, as typed in the app ("" unknown)
   std::string vehicle = {};   // "dds": a remote vehicle flew (fly --vehicle dds); "": simulated
+  std::int64_t planned_steps = 0;  // the flight's planned length (its mode's steps_total)
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by

@@ -23,7 +23,9 @@ bool RecordingSink::open(const std::string& path, const Mode& mode, const Sessio
   mode_ = mode.kind();
   pilot_name_ = info.pilot;
   const auto period_ns = std::uint64_t(std::llround(mode.dt() * 1e9));
-  if (!recorder_.open(path, period_ns, info, error, overwrite)) return false;
+  SessionInfo planned = info;
+  planned.planned_steps = mode.steps_total();
+  if (!recorder_.open(path, period_ns, planned, error, overwrite)) return false;
   // Slots sized like the mode's telemetry: copying a step into one then allocates nothing.
   slots_.assign(std::size_t(std::max(settings.slots, 2)), mode.telemetry());
   head_ = 0;

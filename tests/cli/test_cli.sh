@@ -82,8 +82,13 @@ check "SIGINT exits 130" test $? -eq 130
 check "interrupted flight says so" grep -q "interrupted at t" "$work/int.out"
 check "interrupted recording is complete" test -f "$work/int.mcap" -a -z "$(ls "$work" | grep 'int\.mcap.*\.tmp$')"
 check "interrupted report is marked" grep -q '"interrupted": "true"' "$work/int.json"
-"$mixpilot" score "$work/int.mcap" >"$work/int.score" 2>&1
+"$mixpilot" score "$work/int.mcap" --json "$work/int_score.json" >"$work/int.score" 2>&1
 check "interrupted recording replays exactly" grep -q "exact" "$work/int.score"
+# One flight, one score: scored against its planned length, as the live flight was, and said.
+check "score says the recording was interrupted" grep -q "interrupted at t = .* s of 60.0 s" "$work/int.score"
+check "... and marks it in the JSON" grep -q '"interrupted": "true"' "$work/int_score.json"
+check "the interrupted flight's report and its score agree exactly" \
+  diff <(fields "$work/int.json") <(fields "$work/int_score.json")
 
 # Usage errors exit 2 with a message; --help exits 0.
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --headless --record "$work/same" --report "$work/same" >"$work/e7" 2>&1
