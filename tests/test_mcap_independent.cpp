@@ -197,7 +197,8 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.end(']');
   j.key("metadata").begin('[').begin('{').key("name").str("mixpilot").key("keys").begin('[');
   for (const char* k :
-       {"control_period_ns", "mode", "pilot", "scenario", "scenario_path", "seed", "trainee", "vehicle", "version"})
+       {"control_period_ns", "mode", "pilot", "planned_steps", "scenario", "scenario_path", "seed",
+        "trainee", "vehicle", "version"})
     j.str(k);
   j.end(']').end('}');
   j.begin('{').key("name").str("mixpilot_end").key("keys").begin('[');
