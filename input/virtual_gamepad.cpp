@@ -53,8 +53,11 @@ std::optional<std::vector<ScriptRow>> parse_script(const std::string& text,
     for (std::string c; std::getline(ss, c, ',');) cells.push_back(trim(c));
     if (rows.empty() && cells[0] == "t") continue;  // the header
     ScriptRow r;
-    if (!number(cells[0], r.t) || r.t < 0)
-      return fail("expected a time in seconds ≥ 0 first, got \"" + cells[0] + "\"");
+    // Bounded: a script's times become nanoseconds on the steady clock (int64), and nothing
+    // flies longer than a day.
+    if (!number(cells[0], r.t) || r.t < 0 || r.t > kMaxScriptSeconds)
+      return fail("expected a time in seconds from 0 to " + std::to_string(int(kMaxScriptSeconds)) +
+                  " first, got \"" + cells[0] + "\"");
     if (!rows.empty() && r.t < rows.back().t)
       return fail("time " + cells[0] + " is earlier than the row before");
     if (cells.size() == 2 && (cells[1] == "unplug" || cells[1] == "plug")) {

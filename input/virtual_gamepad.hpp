@@ -20,6 +20,9 @@
 
 namespace mixpilot::input {
 
+// A script's times are at most a day.
+inline constexpr double kMaxScriptSeconds = 86400.0;
+
 struct ScriptRow {
   double t = 0;
   enum Kind { axes, unplug, plug } kind = axes;

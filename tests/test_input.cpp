@@ -388,6 +388,12 @@ TEST(Script, RowsAndTheirErrors) {
   EXPECT_FALSE(parse_script("0,0,0\n", "s.csv", error));
   EXPECT_NE(error.find("s.csv:1: expected t,left_x"), std::string::npos) << error;
   EXPECT_FALSE(parse_script("# nothing\n", "s.csv", error));
+  // Times become int64 nanoseconds: 1e300 s wrapped around and played at the first step.
+  for (const char* t : {"1e300", "9.3e9", "86400.5"}) {
+    EXPECT_FALSE(parse_script(std::string("0,0,0,0,0\n") + t + ",0,0,0.5,0\n", "s.csv", error)) << t;
+    EXPECT_EQ(error, std::string("s.csv:2: expected a time in seconds from 0 to 86400 first, got \"") +
+                         t + "\"");
+  }
 }
 
 // Waits (up to 2 s) for `done`.
