@@ -69,8 +69,10 @@ TEST(GamepadFlight, TheNovicesCommandsThroughSdlInRealTime) {
                 "--record " + rec.string() + " --report " + report.string(), dir), 0)
       << read_file(dir / "out.txt");
   const auto live = numbers(read_file(report));
+  // How well it flew depends on when each script row reached the controller, which is the
+  // machine's timing, not a property of the path; what holds whatever the timing: nothing is hit
+  // (the MPC's safety constraints), and the recording replays to the live score (below).
   EXPECT_EQ(live.at("collisions"), 0.0);
-  EXPECT_EQ(live.at("time_in_ball"), 1.0);
   std::string error;
   const auto r = read_recording(rec.string(), error);
   ASSERT_TRUE(r) << error;
@@ -111,9 +113,11 @@ TEST(GamepadFlight, UnpluggingHandsThePlannerTheVehicleAndRecentringReturnsIt) {
   std::size_t lost = 0;
   while (lost < r->pilot.size() && r->pilot[lost].input_state != 1) ++lost;
   ASSERT_LT(lost, r->pilot.size()) << "the unplug was never seen";
-  // Within one control step of the unplug (5 s): the step that starts next is the first lost,
-  // and the planner has the whole authority from it on.
-  EXPECT_LE(double(lost) * dt, 5.0 + dt + 0.002);
+  // Within the input timeout of the unplug (5 s; a device that stops reporting is lost then at
+  // the latest, however the threads were scheduled), and the planner has the whole authority
+  // from it on.
+  const double timeout = input::InputSettings{}.input_timeout_s;
+  EXPECT_LE(double(lost) * dt, 5.0 + timeout + dt);
   EXPECT_GT(double(lost) * dt, 5.0 - dt);
   EXPECT_NE(r->channels[lost].events & kEventInputLost, 0u);
   // The summary says for how long (10 s, to a step either side of the unplug's timing).
@@ -121,7 +125,7 @@ TEST(GamepadFlight, UnpluggingHandsThePlannerTheVehicleAndRecentringReturnsIt) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(out, m, std::regex("input was lost for ([0-9.]+) s in all")))
       << out;
-  EXPECT_NEAR(std::stod(m[1]), 10.0, 2 * dt + 1e-9);
+  EXPECT_NEAR(std::stod(m[1]), 10.0, 2 * (timeout + dt));  // each end seen within the timeout
   for (std::size_t k = lost; k < lost + std::size_t(10.0 / dt); ++k) {
     ASSERT_EQ(r->lambda[k].lambda, 0.0) << k;
     EXPECT_EQ(r->pilot[k].authority, 0.0);
