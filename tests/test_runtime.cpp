@@ -149,6 +149,26 @@ class IdleMode final : public Mode {
   Telemetry telemetry_;
 };
 
+// Paced by the wall clock: K steps of Δt at speed s take at least (K − 1) Δt / s of wall time,
+// whatever else the machine does (a runner never runs ahead of its schedule; a loaded machine
+// can only make it later, so only the lower bound is a verdict). At 1×, 0.5× and 0.25×; a
+// runner without its sleep finished 0.3 s of flight in 25 ms.
+TEST(RealtimeRunner, PacingFollowsTheWallClockAtEverySpeed) {
+  for (const double speed : {1.0, 0.5, 0.25}) {
+    IdleMode mode(20);  // 0.3 s of 15 ms steps
+    Session session(mode);
+    RealtimeRunner runner(session, 64);
+    runner.set_speed(speed);
+    const auto t0 = std::chrono::steady_clock::now();
+    runner.start();
+    while (runner.running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    runner.stop();
+    EXPECT_EQ(runner.stats().steps, 20);
+    EXPECT_GE(wall, 19 * mode.dt() / speed) << "speed " << speed;
+  }
+}
+
 // A step that ends after its period makes the next one's input late by as much: a deadline
 // miss, counted once (the schedule restarts from its end, so the steps after it are on time
 // again; were it kept, the six steps due during the 100 ms overrun would all end late), and

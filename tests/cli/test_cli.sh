@@ -103,6 +103,12 @@ check "--realtime without --headless is a usage error" test $? -eq 2
   --duration 0.5 >"$work/rt.out" 2>&1
 check "fly --headless --realtime exits 0" test $? -eq 0
 check "... and reports deadline misses" grep -q "real time: [0-9]* deadline misses" "$work/rt.out"
+# Paced: 0.5 s of flight take at least 0.5 s less a period of wall time (never less, however
+# loaded the machine; without the runner's sleep they took milliseconds).
+wall=$(sed -n 's/.* s flown in \([0-9.]*\) s of wall time.*/\1/p' "$work/rt.out")
+check "Pacing: 0.5 s of flight take at least 0.485 s of wall time (took ${wall:-?})" \
+  python3 -c "import sys; sys.exit(0 if float('${wall:-0}') >= 0.485 else 1)"
+check "... and the summary says how far simulated time fell behind" grep -q "simulated time fell" "$work/rt.out"
 
 # Headless screenshots (EGL): a PNG at the requested time; a time beyond the flight is refused.
 "$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot novice --headless --duration 1 \
