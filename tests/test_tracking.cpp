@@ -82,13 +82,18 @@ TEST(TrackingDelay, RttStudy) {
     EXPECT_NEAR(nmpc[i][1].overshoot_m, nmpc[0][1].overshoot_m, 1e-6) << rtts[i];
     EXPECT_NEAR(lqr[i][1].tracking_rms_m, lqr[0][1].tracking_rms_m, 1e-6) << rtts[i];
   }
-  // At the thesis's 60 ms the predictor's error is clearly below the uncompensated one.
-  // Here the uncompensated NMPC does not survive 30 ms or more at all (TrackingDelay.Fig56).
-  for (int i = 1; i < 4; ++i) {
-    EXPECT_TRUE(nmpc[i][0].lost || nmpc[i][1].tracking_rms_m <= 0.7 * nmpc[i][0].tracking_rms_m)
-        << rtts[i];
+  // From 30 ms on the uncompensated NMPC does not survive at all (past the ≈ 18 ms delay
+  // margin of SPEC §5.2), the compensated one flies as without delay.
+  for (int i = 1; i < 4; ++i) EXPECT_TRUE(nmpc[i][0].lost) << rtts[i];
+  // Inside the margin, from one control period on, both fly and the predictor's error is
+  // clearly below the uncompensated one (below a period the delay only softens the reference's
+  // own overshoot, and the uncompensated error is no larger).
+  for (const double rtt : {0.015, 0.018, 0.021}) {
+    const TrackingResult off = fly(base, TrackingControllerKind::nmpc, rtt, false);
+    const TrackingResult on = fly(base, TrackingControllerKind::nmpc, rtt, true);
+    ASSERT_FALSE(off.lost) << rtt;
+    EXPECT_LE(on.tracking_rms_m, 0.7 * off.tracking_rms_m) << rtt;
   }
-  EXPECT_TRUE(nmpc[2][0].lost);
   // The LQR baseline (reference input as feedforward) flies the step without delay; its very
   // stiff gains (z: 9e5 against R = 0.12) lose the vehicle with any uncompensated delay.
   EXPECT_LT(lqr[0][0].final_error_m, 0.01);
