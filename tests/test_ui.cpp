@@ -204,6 +204,16 @@ TEST_F(Ui, ScoreCardAtTheEnd) {
     active = card && card->Active;
   });
   EXPECT_TRUE(active);
+  // The card explains every field it shows, in every mode (the report's and the lost ones).
+  for (const char* scenario : {"mi_helix.toml", "pendubot_swingup.toml", "tracking_helix.toml",
+                               "tracking_smooth_step.toml", "obstacles_cluttered.toml"}) {
+    Flown g = fly(scenario, 0.3);
+    ASSERT_TRUE(g.mode) << scenario;
+    for (const auto& [key, value] : g.mode->metrics())
+      EXPECT_STRNE(ui::score_field_meaning(key), "") << scenario << ": " << key;
+    for (const char* key : {"lost", "lost_at_s"})
+      EXPECT_STRNE(ui::score_field_meaning(key), "") << key;
+  }
 }
 
 // Every mode renders, and its view is not empty: many pixels differ from the background.

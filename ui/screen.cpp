@@ -244,8 +244,10 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
   return bottom;
 }
 
-// What each score field means (README, Scoring), for the score card.
-const char* meaning(const std::string& key) {
+}  // namespace
+
+// What each field of every mode's report means (README, Scoring), for the score card.
+const char* score_field_meaning(const std::string& key) {
   static const std::pair<const char*, const char*> kMeanings[] = {
       {"duration_s", "time flown [s]"},
       {"progress", "share of the reference flown"},
@@ -269,11 +271,45 @@ const char* meaning(const std::string& key) {
       {"lost_at_s", "when it was lost [s]"},
       {"rtt_s", "round-trip time to the vehicle (remote: the median sample) [s]"},
       {"rtt_estimated_s", "the online round-trip estimate at the end [s]"},
+      // Pendubot swing-up (SPEC §5.1).
+      {"swingup_time_s", "when both links reached up-up and stayed there [s]"},
+      {"hold_time_s", "time balanced at up-up after the swing-up [s]"},
+      {"final_angle_norm", "distance of the links from up-up at the end [rad]"},
+      {"max_abs_u", "largest shoulder torque applied [N m]"},
+      {"velocity_violations", "steps whose joint speeds exceeded their bounds"},
+      {"worst_velocity_violation", "largest excess of a joint speed over its bound [rad/s]"},
+      {"tracking_rms", "RMS angle error against the swing-up reference [rad]"},
+      {"rti_max_us", "longest RTI time of a step [us]"},
+      {"nmpc_steps", "steps flown by the NMPC (the others by the LQR)"},
+      {"lqr_entry_time_s", "when the LQR first took over near the top [s]"},
+      {"lqr_time_s", "time flown by the LQR [s]"},
+      {"lqr_entries", "times the LQR took over"},
+      {"quantization", "1: angles read through quantizing encoders"},
+      // Tracking under delay (SPEC §5.2) and obstacle avoidance (SPEC §5.3).
+      {"tracking_rms_m", "RMS distance from the reference [m]"},
+      {"max_error_m", "largest distance from the reference [m]"},
+      {"final_error_m", "distance from the reference at the end [m]"},
+      {"overshoot_m", "how far past the step's target the vehicle went [m]"},
+      {"settle_time_s", "when the vehicle last entered 5 cm of the target [s]"},
+      {"lqr_median_us", "median LQR time per step [us]"},
+      {"lqr_p99_us", "99th percentile LQR time [us]"},
+      {"predictor_median_us", "median time of the delay predictor per step [us]"},
+      {"max_input_violation", "largest excess of a rotor command over its bounds [krpm]"},
+      {"compensation", "1: the state was predicted over the round trip"},
+      {"steps", "control steps flown"},
+      {"min_distance_m", "closest approach to an obstacle's centre [m]"},
+      {"min_margin_m", "closest approach less the clearance d_C [m]"},
+      {"min_distance_control_m", "closest approach at the control instants [m]"},
+      {"clearance_m", "the clearance d_C the constraint keeps [m]"},
+      {"violations", "steps that came closer than d_C"},
+      {"form", "0: the LCL constraint, 1: the squared form"},
   };
   for (const auto& [k, v] : kMeanings)
     if (key == k) return v;
   return "";
 }
+
+namespace {
 
 // The width of a table's last column, the explanations `texts`: as wide as the widest, or
 // narrower (its text wraps) where the display has less room beside the other columns (`fixed`
@@ -306,7 +342,7 @@ void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
   std::vector<const char*> meanings;
   float key_w = 0.0f;
   for (const auto& [key, value] : run.metrics) {
-    meanings.push_back(meaning(key));
+    meanings.push_back(score_field_meaning(key));
     key_w = std::max(key_w, ImGui::CalcTextSize(key.c_str()).x);
   }
   ImGui::PushFont(mono_font());
@@ -327,7 +363,7 @@ void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
       ImGui::PopFont();
       ImGui::TableNextColumn();
       ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
-      ImGui::TextWrapped("%s", meaning(key));
+      ImGui::TextWrapped("%s", score_field_meaning(key));
       ImGui::PopStyleColor();
     }
     ImGui::EndTable();

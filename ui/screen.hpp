@@ -106,6 +106,9 @@ struct RunInfo {
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
 };
 
+// What a field of a mode's report means, with its unit ("" for a field it does not know).
+const char* score_field_meaning(const std::string& key);
+
 // Adds step `s` to the run's counts: the live flight, a replay's tape and a headless
 // screenshot count the same events.
 inline void count_step(const Telemetry& s, RunInfo& run) {
