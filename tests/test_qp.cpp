@@ -821,6 +821,9 @@ TEST(QpDenseActiveSet, HardGeneralRowsFailCleanly) {
     EXPECT_LE((sol.u[0] - r.u[0]).lpNorm<Eigen::Infinity>(), 1e-7) << "seed " << seed;
   }
   RecordProperty("solved", solved);
+  // The comparison above ran: 6 of the 8 seeds are solved (the method is deterministic; a
+  // change that solves fewer is a regression, and failing them all would check nothing).
+  EXPECT_GE(solved, 6);
 }
 
 TEST(QpDenseActiveSet, PendubotQpColdAndWarmWithChangedX0) {

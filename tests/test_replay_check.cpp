@@ -3,6 +3,7 @@
 // applied input — is caught.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "app/replay.hpp"
@@ -69,9 +70,22 @@ TEST(ReplayCheck, TheLastPilotCommandIsCovered) {
 }
 
 TEST(ReplayCheck, AnEarlierCommandChangesTheStates) {
-  RecordingContents rec = record(kMi, 1.5, "novice");
+  const RecordingContents original = record(kMi, 1.5, "novice");
+  RecordingContents rec = original;
   rec.pilot[40].pitch -= 1e-3;
   EXPECT_EQ(replay(rec, kMi), "the applied input of step 40 differs from the recorded one");
+  // The states flown from the changed command on differ from the recorded ones; before it, not.
+  std::string error;
+  auto mode = replay_mode(rec, "rec.mcap", rec.metadata.at("scenario"), kMi, {}, error);
+  ASSERT_TRUE(mode) << error;
+  std::size_t first_different = 0;
+  while (mode->step()) {
+    const Telemetry& s = mode->telemetry();
+    const auto& x = original.states[std::size_t(s.step)].x;
+    const bool same = std::equal(x.begin(), x.end(), s.x.data());
+    if (!same && first_different == 0) first_different = std::size_t(s.step);
+  }
+  EXPECT_EQ(first_different, 41u);  // the state after the changed command acted
 }
 
 TEST(ReplayCheck, AMissingStepIsCaught) {
