@@ -99,8 +99,11 @@ TEST(RtiClosedLoop, CrazyflieStepSettles) {
   for (const auto* r : {&rti, &sqp}) {
     EXPECT_EQ(r->fallbacks, 0);
     EXPECT_LE(r->max_bound_violation, 1e-9);  // input bounds hold (QP tolerance)
-    EXPECT_LT(r->final_error, 0.05);
-    EXPECT_LT(r->settle_time, 5.0);
+    // The loop converges to the target (6e-12 m after 7.5 s: the QP's tolerance, not a
+    // residual offset) and settles within a step either side of the 0.69 s it takes (the
+    // run is deterministic; the slack covers QP-tolerance changes of the last digits).
+    EXPECT_LT(r->final_error, 1e-6);
+    EXPECT_NEAR(r->settle_time, 0.69, 0.015 + 1e-9);
   }
   // One RTI iteration per step tracks the converged controller closely.
   EXPECT_NEAR(rti.settle_time, sqp.settle_time, 0.3);
