@@ -280,23 +280,37 @@ TEST(SessionRecorder, FailedSessionKeepsItsTmp) {
   EXPECT_EQ(r->metadata.at("pilot"), "novice");
 }
 
+// A real crash: a child process records 7 steps, flushes and is killed (SIGKILL: no
+// destructor, no close). What was flushed is on disk in its temporary.
 TEST(SessionRecorder, CrashMidSessionLosesNothingFlushed) {
   const fs::path p = temp_path("crashed.mcap");
-  {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0) << std::strerror(errno);
+  if (child == 0) {
     SessionRecorder rec;
     std::string err;
-    ASSERT_TRUE(rec.open(p.string(), kPeriodNs, test_info(), err)) << err;
+    if (!rec.open(p.string(), kPeriodNs, test_info(), err)) _exit(1);
     record_session(rec, 7);
-    ASSERT_TRUE(rec.flush());
-    const auto partial = slurp(rec.writer().tmp_path());
-    McapReadOptions lenient;
-    lenient.allow_truncated = true;
-    auto f = parse_mcap(partial, "crashed.mcap.tmp", err, lenient);
-    ASSERT_TRUE(f) << err;
-    const auto r = decode_recording(*f, "crashed.mcap.tmp", err);
-    ASSERT_TRUE(r) << err;
-    EXPECT_EQ(r->predictions.size(), 7u);  // everything up to the flush is on disk
+    if (!rec.flush()) _exit(2);
+    raise(SIGKILL);
+    _exit(3);  // not reached
   }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
+      << "the child did not die by SIGKILL (exit " << (WIFEXITED(status) ? WEXITSTATUS(status) : -1)
+      << ")";
+  const std::vector<fs::path> tmp = temporaries_of(p);
+  ASSERT_EQ(tmp.size(), 1u) << "the killed recorder's temporary";
+  EXPECT_FALSE(fs::exists(p));  // never put in place
+  std::string err;
+  McapReadOptions lenient;
+  lenient.allow_truncated = true;
+  auto f = parse_mcap(slurp(tmp[0]), "crashed.mcap.tmp", err, lenient);
+  ASSERT_TRUE(f) << err;
+  const auto r = decode_recording(*f, "crashed.mcap.tmp", err);
+  ASSERT_TRUE(r) << err;
+  EXPECT_EQ(r->predictions.size(), 7u);  // everything up to the flush is on disk
 }
 
 // A small recording for the exhaustive malformed-input tests.
@@ -751,15 +765,33 @@ TEST(OutputFile, UnwritableDirectoriesAreErrorsWithTheReason) {
   const fs::path under_file = file / "x.mcap";
   EXPECT_FALSE(check_output_path(under_file.string(), false, err));
   EXPECT_EQ(err, under_file.string() + ": cannot check the output path: " + std::strerror(ENOTDIR));
-  if (::geteuid() != 0) {  // root may create files in a read-only (0500) directory
-    const fs::path ro = temp_path("read_only_dir");
-    fs::create_directories(ro);
-    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+  // A read-only directory (0555). Root may create files in it whatever its mode, so as root
+  // the check runs in a child process that has dropped to the unprivileged user 65534.
+  const fs::path ro = temp_path("read_only_dir");
+  fs::create_directories(ro);
+  fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                          fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const std::string expected = (ro / "x").string() + ": cannot create a file in " + ro.string() +
+                               ": " + std::strerror(EACCES);
+  if (::geteuid() != 0) {
     EXPECT_FALSE(check_output_path((ro / "x").string(), false, err));
-    EXPECT_EQ(err, (ro / "x").string() + ": cannot create a file in " + ro.string() + ": " +
-                       std::strerror(EACCES));
-    fs::permissions(ro, fs::perms::owner_all);
+    EXPECT_EQ(err, expected);
+  } else {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0) << std::strerror(errno);
+    if (child == 0) {
+      if (::setgid(65534) != 0 || ::setuid(65534) != 0) _exit(2);
+      std::string e;
+      const bool refused = !check_output_path((ro / "x").string(), false, e);
+      _exit(refused && e == expected ? 0 : 1);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << "the unprivileged check crashed";
+    ASSERT_NE(WEXITSTATUS(status), 2) << "could not drop to user 65534";
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "a read-only directory was not refused with: " << expected;
   }
+  fs::permissions(ro, fs::perms::owner_all);
 }
 
 TEST(OutputFile, SymbolicLinkToAFileIsWrittenThrough) {
