@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 #include "app/replay.hpp"
 #include "core/modes/make_mode.hpp"
@@ -119,6 +120,43 @@ TEST(ReplayCheck, RecordedOverrunsAreReplayed) {
     for (auto& c : stripped.channels) c.events &= ~std::uint32_t(kEventOverrun);
     EXPECT_NE(replay(stripped, scenario), "") << scenario;
   }
+}
+
+// Seeded measurement noise and an input delay (SPEC §5.4's plant options): two flights of the
+// same seed are identical, another seed flies differently (the noise is really there), and a
+// recording replays bit for bit.
+TEST(Noise, SeededMeasurementNoiseAndInputDelayReplayBitForBit) {
+  std::string error, text;
+  ASSERT_TRUE(read_text_file(kMi, text, error)) << error;
+  const auto with = [&](const char* seed) {
+    std::string t = text;
+    const auto set = [&](const std::string& key, const std::string& value) {
+      const auto at = t.find("\n" + key + " = ");
+      ASSERT_NE(at, std::string::npos) << key;
+      t.replace(at + 1, t.find('\n', at + 1) - at - 1, key + " = " + value);
+    };
+    set("input_delay", "0.03");
+    set("position_noise", "0.01");
+    set("seed", seed);
+    const std::string path =
+        test::fresh_path("replay_check", std::string("noisy_") + seed + ".toml").string();
+    std::ofstream(path) << t;
+    return path;
+  };
+  const std::string one = with("7"), same = with("7"), other = with("8");
+  const RecordingContents a = record(one, 1.5, "novice");
+  const RecordingContents b = record(same, 1.5, "novice");
+  const RecordingContents c = record(other, 1.5, "novice");
+  ASSERT_EQ(a.states.size(), 100u);
+  bool identical = true, differs = false;
+  for (std::size_t k = 0; k < a.states.size(); ++k) {
+    identical = identical && a.states[k].x == b.states[k].x;
+    differs = differs || a.states[k].x != c.states[k].x;
+  }
+  EXPECT_TRUE(identical) << "the same seed flew differently";
+  EXPECT_TRUE(differs) << "another seed flew the same: no noise?";
+  EXPECT_EQ(replay(a, one), "");
+  EXPECT_EQ(replay(c, other), "");
 }
 
 TEST(ReplayCheck, OtherModesReplayToo) {

@@ -14,6 +14,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "models/mikrokopter.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot {
@@ -189,6 +190,60 @@ TEST(MixedInitiative, ThePlannerFliesEveryStepWhileTheInputIsLost) {
   EXPECT_EQ(mode.score().fallbacks, 0);
   EXPECT_LE(deviation, sc.controller.ph.r);
   EXPECT_FALSE(mode.lost());
+}
+
+// A pilot who holds the roll stick at φ_h and hover thrust, with a fixed authority.
+class HoldsRoll final : public PilotSource {
+ public:
+  HoldsRoll(double roll, double authority) : roll_(roll), authority_(authority) {}
+  std::string name() const override { return "holds-roll"; }
+  bool command(std::int64_t, double, const Eigen::VectorXd&, PilotCommand& out) override {
+    out.roll = roll_;
+    out.pitch = 0.0;
+    out.rotor_speed.setConstant(models::MikroKopter{}.hover_speed());
+    out.authority = authority_;
+    return true;
+  }
+
+ private:
+  double roll_, authority_;
+};
+
+// λ blends the pilot's reference and the planner's inside the cost (SPEC §5.4). With the ball
+// so wide that the PH index stays at 1, λ is the pilot's authority: near 1 the MPC's attitude
+// follows the pilot's (the planner's reference has no weight), near 0 it ignores it and the
+// vehicle tracks the planner's reference.
+TEST(Blend, ThePilotFliesAtLambdaNearOneAndThePlannerNearZero) {
+  Scenario sc = mi_helix();
+  sc.duration = 1.0;
+  sc.controller.ph.r = 100.0;
+  constexpr double kRoll = 0.15;  // [rad]
+  struct Result {
+    double lambda = 0, roll_gap = 0, deviation = 0;
+  };
+  const auto fly_with = [&](double authority) {
+    MiMode mode;
+    EXPECT_TRUE(mode.setup(sc, std::make_unique<HoldsRoll>(kRoll, authority)));
+    Result r;
+    while (mode.step()) {
+      const Telemetry& s = mode.telemetry();
+      if (s.t < 0.5) continue;  // the attitude has settled
+      r.lambda = std::max(r.lambda, s.lambda);
+      r.roll_gap = std::max(r.roll_gap, std::abs(s.applied.roll - kRoll));
+      r.deviation = std::max(r.deviation, (s.x.head<3>() - s.reference).norm());
+    }
+    return r;
+  };
+  const Result pilot = fly_with(1.0), planner = fly_with(0.0);
+  std::printf("λ %.4f: roll gap %.4f rad, deviation %.3f m | λ %.4f: roll gap %.4f rad, "
+              "deviation %.3f m\n", pilot.lambda, pilot.roll_gap, pilot.deviation, planner.lambda,
+              planner.roll_gap, planner.deviation);
+  EXPECT_GT(pilot.lambda, 0.999);
+  EXPECT_EQ(planner.lambda, 0.0);
+  EXPECT_LT(pilot.roll_gap, 0.02);        // the MPC flies the pilot's roll
+  EXPECT_GT(pilot.deviation, 0.2);        // and the vehicle leaves the planner's path
+  EXPECT_GT(planner.roll_gap, 0.1);       // the pilot's roll is ignored
+  EXPECT_LT(planner.deviation, 0.06);     // the planner's reference is tracked (its own lag)
 }
 
 // Every sample of a session, for exact comparisons.

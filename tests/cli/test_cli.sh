@@ -186,6 +186,17 @@ printf 'name = "x"\nmode = "mixed_initiative"\nmodel = "mikrokopter"\n[controlle
 check "bad scenario fails" test $? -eq 1
 check "bad scenario names file, line and key" grep -q "bad.toml:5:5: controller.N" "$work/e5"
 
+# An input settings file named on the command line that is broken stops the flight (the user's
+# own config file only gives a note and the defaults): exit 1, file:line:col, nothing written.
+printf 'mode = 7\n' >"$work/bad_input.toml"
+printf 't,left_x,left_y,right_x,right_y\n0,0,0,0,0\n' >"$work/pad.csv"
+"$mixpilot" fly --scenario "$src/scenarios/mi_helix.toml" --pilot gamepad --gamepad-script "$work/pad.csv" \
+  --input-settings "$work/bad_input.toml" --headless --realtime --duration 1 \
+  --record "$work/bad_input.mcap" >"$work/bi.out" 2>&1
+check "a broken --input-settings file stops the flight" test $? -eq 1
+check "... saying where and what" grep -q "bad_input.toml:1:8: mode: value outside \[1, 4\], got 7" "$work/bi.out"
+check "... and nothing is recorded" test -z "$(ls "$work" | grep bad_input.mcap)"
+
 # Special files as inputs are refused, with the reason.
 mkfifo "$work/fifo.toml"
 timeout 10 "$mixpilot" fly --scenario "$work/fifo.toml" --headless >"$work/e9" 2>&1
