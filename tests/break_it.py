@@ -28,11 +28,11 @@ from pathlib import Path
 MUTATIONS = [
     ("allocation in RTI prepare", "core/nlp/rti.cpp",
      "  bool finite = true;\n",
-     "  bool finite = true;\n  { volatile auto* p = new int[16]; delete[] p; }\n",
+     "  bool finite = true;\n  { void* volatile p = std::malloc(64); std::free(p); }\n",
      "test_no_malloc", "NoMalloc.*"),
     ("allocation in the MI mode's step", "core/modes/mi_mode.cpp",
      "  const double t = double(step_) * dt_;\n",
-     "  const double t = double(step_) * dt_;\n  { volatile auto* p = new int[16]; delete[] p; }\n",
+     "  const double t = double(step_) * dt_;\n  { void* volatile p = std::malloc(64); std::free(p); }\n",
      "test_modes", "Shipped/EveryMode.RunsDeterministically*/mi_helix_novice"),
     ("runner does not sleep", "core/runtime/realtime_runner.cpp",
      "    std::this_thread::sleep_until(next);\n", "\n",
