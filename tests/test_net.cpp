@@ -142,6 +142,67 @@ TEST_F(Net, MalformedSamplesAndASecondPublisherAreRejectedAndCounted) {
   peer.stop();
 }
 
+// A stamp ahead of this machine's clock by more than the tolerance (50 ms) is stale, as the
+// docs say; one within it is taken. And a sample from the future cannot make the honest
+// samples after it stale: the order is kept against when it arrived, not what it claims.
+TEST_F(Net, JoySamplesFromTheFutureAreStaleAndCannotPoisonLaterOnes) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_future"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_future", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const auto send = [&](float x, std::int64_t ahead_ns) {
+    ASSERT_TRUE(w.write({x, 0, 0, 0}, {}, system_ns() + ahead_ns, "pad", error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+  };
+  send(0.1f, 300'000'000);  // 0.3 s ahead
+  send(0.2f, 450'000'000);  // 0.45 s ahead
+  send(0.3f, 40'000'000);   // within the tolerance
+  for (int i = 0; i < 20; ++i) send(0.4f, 0);  // honest, within 0.45 s of the one above
+  ASSERT_TRUE(eventually([&] { return peer.stats().accepted + peer.stats().stale >= 23; }));
+  const JoyPeerStats s = peer.stats();
+  std::printf("%llu taken, %llu stale; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.stale,
+              s.last_rejection.c_str());
+  EXPECT_EQ(s.stale, 2u);
+  EXPECT_EQ(s.accepted, 21u);
+  EXPECT_NE(s.last_rejection.find("stale: stamped 0.45 s ahead of this machine's clock"),
+            std::string::npos) << s.last_rejection;
+  EXPECT_FLOAT_EQ(float(peer.latest().sticks.left_x), 0.4f);
+  peer.stop();
+}
+
+// Buttons are 0 or 1 (sensor_msgs/Joy, and the recording's /joy); a stamp's nanoseconds are
+// below a second; a frame id is a name, not a payload.
+TEST_F(Net, JoyButtonsStampsAndFrameIdsOutsideTheirMeaningAreRejected) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_fields"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_fields", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const auto send = [&](std::vector<std::int32_t> buttons, std::int64_t stamp,
+                        const std::string& frame) {
+    ASSERT_TRUE(w.write({0, 0, 0, 0}, buttons, stamp, frame, error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  };
+  send({0, 1}, system_ns(), "pad");                       // good
+  send({0, 2}, system_ns(), "pad");                       // a button of 2
+  send({-1, 0}, system_ns(), "pad");                      // a button of -1
+  send({}, -1, "pad");                                    // nanoseconds 4294967295
+  send({}, system_ns(), std::string(100000, 'f'));        // a 100 kB frame id
+  ASSERT_TRUE(eventually([&] {
+    const JoyPeerStats s = peer.stats();
+    return s.accepted + s.rejected() >= 5;
+  }));
+  const JoyPeerStats s = peer.stats();
+  EXPECT_EQ(s.accepted, 1u);
+  EXPECT_EQ(s.bad_value, 3u);
+  EXPECT_EQ(s.bad_size, 1u);
+  peer.stop();
+}
+
 // A peer that stops publishing is an input loss: the planner gets the authority at once.
 TEST_F(Net, ASilentPeerIsAnInputLoss) {
   JoyPeer peer;

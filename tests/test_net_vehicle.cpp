@@ -100,8 +100,7 @@ TEST_F(Net, VehicleStatesThatAreMalformedStaleOrForeignAreRejectedAndCounted) {
   w.write(state(0, 1000, 0.01, 0));   // empty
   w.write(state(5, 1000, 0.01, 13));  // echoes a command never sent
   w.write(state(0, 999, 0.01, 13));   // echoes command 0 with another stamp
-  stamp = 1;
-  w.write(state(0, 1000, 0.02, 13));  // measured before the last one taken
+  w.write(state(0, 1000, 0.0, 13));   // measured no later than the last one taken
   stamp = 100;
   w.write(state(-1, 0, 0.0, 13));     // a command older than the one in effect
   other.write(state(0, 1000, 0.03, 13));  // a second vehicle
@@ -172,6 +171,113 @@ TEST_F(Net, RotorCommandsThatAreMalformedStaleOrForeignAreRejectedAndCounted) {
   EXPECT_EQ(taken[0].step, 0);
   EXPECT_EQ(taken[1].step, 1);
   EXPECT_TRUE(taken[2].end);
+}
+
+// Times and values a vehicle cannot mean are rejected, and none of them can make the honest
+// states after it stale: an age longer than the time since its command left; a value no
+// vehicle state has (1e300, finite); an unknown status; a stamp far ahead of what its other
+// states say of the vehicle's clock (order is kept by the echoed command and its age, which
+// the controller can check).
+TEST_F(Net, VehicleStatesWithImpossibleTimesOrValuesAreRejectedAndPoisonNothing) {
+  RemoteVehicle vehicle;
+  std::string error;
+  ASSERT_TRUE(vehicle.start({domain_, 13, 0.25}, error)) << error;
+  RawWriter<StateMsg> w(domain_, &mixpilot_msgs_msg_dds__VehicleState__desc,
+                        "rt/mixpilot/vehicle/state");
+  ASSERT_TRUE(w.ok());
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const double u[4] = {15, 15, 15, 15};
+  double x[13] = {0, 0, 0.4, 1};
+  const std::int64_t vehicle_clock = 5'000'000'000'000;  // the vehicle's own clock, elsewhere
+  std::int64_t sent_stamp = 0;
+  const auto send = [&](std::int64_t k) {
+    sent_stamp = vehicle_clock_ns();
+    vehicle.send(k, sent_stamp, u, 4);
+  };
+  const auto state = [&](std::int64_t command, double age, std::int64_t stamp = 0) {
+    StateMsg m{};
+    m.stamp_ns = stamp != 0 ? stamp : vehicle_clock + vehicle_clock_ns();
+    m.command_step = command;
+    m.command_stamp_ns = sent_stamp;
+    m.command_age_s = age;
+    m.x._length = m.x._maximum = 13;
+    m.x._buffer = x;
+    return m;
+  };
+  for (std::int64_t k = 0; k < 5; ++k) {  // good: five commands acknowledged
+    send(k);
+    w.write(state(k, 0.0));
+  }
+  ASSERT_TRUE(eventually([&] { return vehicle.stats().accepted == 5; }));
+  w.write(state(4, 10.0));  // command 4 acted 10 s, yet it left 0.1 s ago
+  x[0] = 1e300;
+  w.write(state(4, 0.001));  // a position of 1e300 m
+  x[0] = 0;
+  StateMsg odd = state(4, 0.002);
+  odd.status = 7;
+  w.write(odd);  // no such status
+  send(5);
+  w.write(state(5, 0.0, INT64_MAX / 2));  // stamped centuries ahead of the vehicle's clock
+  w.write(state(5, 0.001));               // honest again
+  send(6);
+  w.write(state(6, 0.0));
+  ASSERT_TRUE(eventually([&] {
+    const RemoteVehicleStats s = vehicle.stats();
+    return s.accepted + s.bad_value + s.stale >= 11;
+  }));
+  const RemoteVehicleStats s = vehicle.stats();
+  std::printf("%llu taken, %llu bad values, %llu stale; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.bad_value,
+              (unsigned long long)s.stale, s.last_rejection.c_str());
+  EXPECT_EQ(s.accepted, 7u);
+  EXPECT_EQ(s.bad_value, 2u);
+  EXPECT_EQ(s.stale, 2u);
+  EXPECT_NE(s.last_rejection.find("stale: stamped 4.61e+09 s off the vehicle's clock"),
+            std::string::npos) << s.last_rejection;
+  const VehicleSample& v = vehicle.latest();
+  EXPECT_EQ(v.command, 6);
+  EXPECT_EQ(v.x(0), 0.0);
+  vehicle.stop();
+}
+
+// At the vehicle: one command whose step is far ahead of the controller's pace (INT64_MAX) is
+// rejected and cannot make the honest commands after it stale; a rotor value farther outside
+// the rotors' limits than their range is not a rotor command.
+TEST_F(Net, RotorCommandsFarAheadOrNotRotorCommandsAreRejectedAndPoisonNothing) {
+  VehicleEndpoint vehicle;
+  std::string error;
+  ASSERT_TRUE(vehicle.open(domain_, 4, error)) << error;
+  RawWriter<CommandMsg> w(domain_, &mixpilot_msgs_msg_dds__RotorCommand__desc,
+                          "rt/mixpilot/vehicle/command");
+  ASSERT_TRUE(w.ok());
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  double u[4] = {15, 15, 15, 15};
+  const auto command = [&](std::int64_t step) {
+    CommandMsg m{};
+    m.step = step;
+    m.stamp_ns = vehicle_clock_ns();
+    m.u._length = m.u._maximum = 4;
+    m.u._buffer = u;
+    return m;
+  };
+  std::vector<VehicleCommand> taken;
+  for (std::int64_t k : {0, 1}) w.write(command(k));
+  w.write(command(INT64_MAX));
+  for (std::int64_t k : {2, 3, 4}) w.write(command(k));
+  u[1] = 1e300;
+  w.write(command(5));
+  u[1] = 15;
+  w.write(command(6));
+  for (int i = 0; i < 20; ++i) vehicle.wait(DDS_MSECS(5), taken);
+  const VehicleEndpointStats s = vehicle.stats();
+  std::printf("%llu taken, %llu stale, %llu bad values; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.stale,
+              (unsigned long long)s.bad_value, s.last_rejection.c_str());
+  ASSERT_EQ(taken.size(), 6u);
+  const std::int64_t want[] = {0, 1, 2, 3, 4, 6};
+  for (std::size_t i = 0; i < taken.size(); ++i) EXPECT_EQ(taken[i].step, want[i]);
+  EXPECT_EQ(s.stale, 1u);
+  EXPECT_EQ(s.bad_value, 1u);
 }
 
 // --- Two processes ----------------------------------------------------------------------
