@@ -268,6 +268,36 @@ TEST_F(Net, TwoProcessesFlyARecordingsSticksOverDds) {
   EXPECT_NEAR(b.at("mean_lambda"), a.at("mean_lambda"), 0.05);
 }
 
+// A publisher whose samples all arrive and are all rejected is not told to start the publisher:
+// the flight that gives up says how many arrived, why they were rejected, and the newest's
+// reason in numbers.
+TEST_F(Net, APilotWhoseSamplesAreAllRejectedIsToldWhy) {
+  const fs::path dir = test::fresh_path("net", "joy_rejected");
+  fs::create_directories(dir);
+  const std::string d = std::to_string(domain_);
+  start("fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot dds:joy_rejected --domain " +
+            d + " --headless --realtime --duration 2",
+        dir, "fly.txt");
+  JoyWriter w;
+  std::string error;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_rejected", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }, 10));
+  int rc = -1;
+  for (int i = 0; i < 1500 && rc < 0; ++i) {  // stamped 2 s ahead, until the flight gives up
+    ASSERT_TRUE(w.write({0, 0, 0, 0}, {}, system_ns() + 2'000'000'000, "pad", error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+    rc = exit_status(dir, "fly.txt");
+  }
+  const std::string out = read_file(dir / "fly.txt");
+  std::printf("%s", out.c_str());
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(out.find("start the publisher"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(
+      R"(\d+ sensor_msgs/msg/Joy samples arrived on rt/joy_rejected .* none was taken \(\d+ stale; )"
+      R"(the newest as stale: stamped [12][.0-9]* s ahead of this machine's clock)")))
+      << out;
+}
+
 // fly --publish in one process; an independent subscriber (tests/net/dds_echo.c: C, its own
 // types from the same IDL, none of mixpilot's code) in another sees the four topics with ROS 2's
 // type names and plausible values.
