@@ -23,6 +23,7 @@
 #include "input/device_pilot.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/joy_peer.hpp"
+#include "input/net/peer_checks.hpp"
 #include "models/mikrokopter.hpp"
 #include "ros2_msgs.h"
 #include "net_test.hpp"
@@ -54,6 +55,100 @@ TEST(NetConfig, TheLoopbackCheckRefusesWhatWouldLeaveTheMachine) {
   EXPECT_TRUE(loopback_only(why)) << why;
   if (before) setenv("CYCLONEDDS_URI", saved.c_str(), 1);
   else unsetenv("CYCLONEDDS_URI");
+}
+
+// --- The checks themselves, on a clock of the test's (no DDS) ------------------------------
+
+constexpr std::int64_t kSecond = 1'000'000'000;
+
+// Joy: 0.5 s old and 0.05 s ahead are the limits; a taken sample orders as its stamp or its
+// arrival, whichever is earlier, so a claim from the future stales nothing after it.
+TEST(PeerChecks, JoyTimesAreCheckedAgainstTheReceiversClock) {
+  JoyCheck check;
+  check.setup({0.5, 0.05});
+  const float axes[4] = {0, 0, 0, 0};
+  const std::int64_t now = 1000 * kSecond;
+  std::int64_t stamp = 0;
+  RejectionNote note;
+  const auto at = [&](std::int64_t arrival, std::int64_t sent) {
+    const JoyFields f{std::int32_t(sent / kSecond), std::uint32_t(sent % kSecond), 3, 4, axes, 0,
+                      nullptr};
+    return check.check(f, arrival, stamp, note);
+  };
+  EXPECT_EQ(at(now, now - kSecond / 2), Rejection::none);           // 0.5 s old
+  EXPECT_EQ(at(now, now - kSecond / 2 - 1'000'000), Rejection::stale);  // older
+  EXPECT_EQ(at(now, now + 51'000'000), Rejection::stale);           // 51 ms ahead
+  EXPECT_EQ(at(now, now + 49'000'000), Rejection::none);            // 49 ms ahead: taken
+  EXPECT_EQ(at(now + 1'000'000, now + 500'000), Rejection::none);   // honest, after it
+  EXPECT_EQ(at(now + 2'000'000, now + 400'000), Rejection::stale);  // older than the last
+  char text[256];
+  describe(note, text, sizeof text);
+  EXPECT_STREQ(text, "stale: stamped 0.0001 s before the last sample taken");
+  check.forget_order();  // another writer
+  EXPECT_EQ(at(now + 3'000'000, now + 400'000), Rejection::none);
+}
+
+// States: an age no longer than since the command left (1 ms of clock tolerance); a stamp far
+// from the vehicle's other stamps is refused without moving their median; order by command and
+// age, so the honest states after a refused one are taken.
+TEST(PeerChecks, VehicleStateTimesAreCheckedAgainstTheCommandsSent) {
+  SentCommands sent;
+  StateCheck check;
+  StateCheck::Limits limits;
+  limits.nx = 13;
+  limits.max_abs.fill(1e6);
+  check.setup(limits);
+  double x[13] = {0, 0, 0.4, 1};
+  RejectionNote note;
+  const std::int64_t offset = 123 * kSecond;  // the vehicle's clock against the controller's
+  // Command k left at 1 s + 15k ms; its state, measured `age` after it acted, arrives at
+  // `received`; `shift` moves the vehicle's stamp off its clock.
+  const auto state = [&](std::int64_t k, double age, std::int64_t received, std::int64_t shift) {
+    const std::int64_t sent_at = k * 15'000'000 + kSecond;
+    const StateFields f{sent_at + offset + std::int64_t(age * 1e9) + shift, k, sent_at, age, 0,
+                        13, x};
+    return check.check(f, received, sent, note);
+  };
+  for (std::int64_t k = 0; k < 6; ++k) sent.note(k, k * 15'000'000 + kSecond);
+  const auto arrival = [](std::int64_t k) { return k * 15'000'000 + kSecond + 30'000'000; };
+  for (std::int64_t k = 0; k < 4; ++k) EXPECT_EQ(state(k, 0.0, arrival(k), 0), Rejection::none);
+  EXPECT_EQ(state(3, 0.0312, arrival(3), 0), Rejection::stale);  // acted longer than since sent
+  EXPECT_EQ(state(3, 0.0305, arrival(3), 0), Rejection::none);   // within the 1 ms
+  EXPECT_EQ(state(3, 0.0305, arrival(3), 0), Rejection::stale);  // measured no later
+  EXPECT_EQ(state(4, 0.0, arrival(4), 10 * kSecond), Rejection::stale);  // 10 s off its clock
+  EXPECT_EQ(state(4, 0.0, arrival(4), 0), Rejection::none);              // honest again
+  EXPECT_EQ(state(5, 0.0, arrival(5), 400'000'000), Rejection::none);   // 0.4 s: delay jitter
+  EXPECT_EQ(state(2, 0.0, arrival(5), 0), Rejection::stale);            // an older command
+  x[7] = 2e6;
+  EXPECT_EQ(state(5, 0.001, arrival(5), 0), Rejection::bad_value);
+}
+
+// Commands: in pace with the vehicle's clock from the first one taken; a step ahead of the pace
+// (within 0.5 s) is taken, and orders as the step due then, so the honest steps after it are
+// taken too; rotor values more than the rotors' range outside their limits are refused.
+TEST(PeerChecks, RotorCommandStepsKeepPaceWithTheVehiclesClock) {
+  CommandCheck check;
+  check.setup({4, 0.015, 0.0, 22.0, 0.5});
+  double u[4] = {15, 15, 15, 15};
+  RejectionNote note;
+  const std::int64_t t0 = 50 * kSecond, c0 = 7 * kSecond;  // vehicle's and controller's clocks
+  const auto command = [&](std::int64_t k, double at_s) {
+    const CommandFields f{k, c0 + std::int64_t(double(k) * 0.015 * 1e9), 4, u};
+    return check.check(f, t0 + std::int64_t(at_s * 1e9), note);
+  };
+  EXPECT_EQ(command(40, 0.0), Rejection::stale);  // a flight starts near step 0
+  EXPECT_EQ(command(0, 0.0), Rejection::none);
+  EXPECT_EQ(command(6, 0.1), Rejection::none);
+  EXPECT_EQ(command(1000, 0.1), Rejection::stale);  // 14.9 s ahead of the pace
+  EXPECT_EQ(command(30, 0.1), Rejection::none);     // 0.35 s ahead: taken...
+  EXPECT_EQ(command(7, 0.105), Rejection::none);    // ...without staling the next honest one
+  EXPECT_EQ(command(7, 0.106), Rejection::stale);   // a repeat
+  u[2] = 44.5;
+  EXPECT_EQ(command(8, 0.12), Rejection::bad_value);  // beyond 22 + 22
+  u[2] = 43.0;
+  EXPECT_EQ(command(8, 0.12), Rejection::none);  // saturates at 22
+  const CommandFields late{9, c0 + 10 * kSecond, 4, u};  // stamped 10 s after command 0
+  EXPECT_EQ(check.check(late, t0 + 135'000'000, note), Rejection::stale);
 }
 
 // ROS 2's names: rt/<topic>, <pkg>::msg::dds_::<Type>_.
