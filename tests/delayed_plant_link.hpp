@@ -61,13 +61,14 @@ class DelayedPlantLink final : public VehicleLink {
   }
   void finish() override { finished_ = true; }
   double timeout_s() const override { return timeout; }
-  std::int64_t now_ns() const override { return sent_ * dt_ns_; }
+  std::int64_t now_ns() const override { return sent_ * dt_ns_ + paused_ns; }
 
   bool finished() const { return finished_; }
 
   // What the vehicle claims for command k's state (the true one in, the claim out).
   std::function<void(std::int64_t k, VehicleSample& v)> mutate;
   double timeout = 1.0;  // [s]
+  std::int64_t paused_ns = 0;  // the controller's clock ran on this long without a step
 
  private:
   IntegratorErk4<Model> erk4_;

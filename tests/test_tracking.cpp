@@ -718,6 +718,25 @@ TEST(TrackingRemote, AVehicleOfNoUseIsLostWithItsReason) {
   }
 }
 
+// A controller that pauses (0.9 s without a step, less than the link's 1 s timeout) asks
+// nothing of its vehicle meanwhile: the vehicle, which acknowledged every command sent, flies on.
+TEST(TrackingRemote, APauseOfTheControllerIsNotTheVehiclesFault) {
+  TrackingScenario sc = load(kStep);
+  sc.duration = 2.0;
+  const models::Crazyflie model;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state(sc.plant.start),
+                                                 sc.controller.dt, 15, 0.03, 0.03, 1000);
+  ASSERT_TRUE(mode.set_vehicle(&link));
+  for (int k = 0; k < 60; ++k) ASSERT_TRUE(mode.step());
+  link.paused_ns = 900'000'000;
+  while (mode.step()) {
+  }
+  EXPECT_FALSE(mode.lost()) << mode.lost_reason();
+  EXPECT_EQ(mode.steps_done(), mode.steps_total());
+}
+
 // States claiming their command had acted 10 s, in a 4 s flight, are impossible: the vehicle is
 // lost at the first, and the settle time stays within the flight (the feed never places a
 // state after the step that reads it).

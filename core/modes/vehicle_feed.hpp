@@ -8,8 +8,9 @@
 //  - says its flight has ended;
 //  - went silent: no state taken for the link's timeout (the reason says whether states
 //    arrived and were rejected, and the newest rejection);
-//  - stops acknowledging: the newest command its states echo left more than the timeout plus
-//    kMaxRtt ago (or none ever did);
+//  - stops acknowledging: the first command sent after the newest one its states echo (command 0
+//    before any) left more than the timeout plus kMaxRtt ago — a pause that sends nothing asks
+//    for nothing;
 //  - does not move: its state stays the same (every value to kStateChange, relative) for the
 //    timeout while the commands acting on it changed (by kCommandChange, relative) — for the
 //    models flown remotely, a change of that size moves some state value by orders of
@@ -121,6 +122,8 @@ class VehicleFeed {
     run_valid_ = false;
     last_u_valid_ = false;
     changed_.fill(false);
+    sent_stamps_.fill(0);
+    sent_ = 0;
   }
 
   // Step k at `now` (link.now_ns()); substeps_per_period: of the predictor.
@@ -169,6 +172,8 @@ class VehicleFeed {
       last_u_[std::size_t(i)] = u[i];
     }
     changed_[std::size_t(k % kChangeRing)] = last_u_valid_ && changed;
+    sent_stamps_[std::size_t(k % kChangeRing)] = now;
+    sent_ = k + 1;
     last_u_valid_ = true;
     link.send(k, now, u, nu);
   }
@@ -183,7 +188,7 @@ class VehicleFeed {
   double horizon_s() const { return double(horizon_substeps_) * h_; }
 
  private:
-  static constexpr int kChangeRing = 128;  // steps whose command change is remembered
+  static constexpr int kChangeRing = 128;  // steps whose command change and stamp are remembered
   using StateVector = VehicleSample::StateVector;
 
   template <class... Args>
@@ -260,15 +265,25 @@ class VehicleFeed {
     }
     if (k == 0 || !heard) return;
     if (v.command >= 0) acked_ = true;
+    // The first command it has not acknowledged, if one was sent (beyond the ring: long ago).
+    const std::int64_t next = std::max<std::int64_t>(v.command + 1, 0);
+    if (next >= sent_) return;
     const double unacked =
-        1e-9 * double(now - (v.command >= 0 ? v.command_stamp_ns : t0_ns_));
+        sent_ - next > kChangeRing
+            ? std::numeric_limits<double>::infinity()
+            : 1e-9 * double(now - sent_stamps_[std::size_t(next % kChangeRing)]);
     if (unacked <= timeout + kMaxRtt) return;
     if (!acked_)
       return lose(r, "it never acknowledged a command: %.2f s after command 0 left, its states "
                      "still echo none",
                   unacked);
-    lose(r, "it stopped acknowledging commands: the newest it echoes (step %lld) left %.2f s ago",
-         static_cast<long long>(v.command), unacked);
+    if (unacked > 1e3)
+      return lose(r, "it stopped acknowledging commands: step %lld, the first after the newest "
+                     "it echoes, left more than %d steps ago",
+                  static_cast<long long>(next), kChangeRing);
+    lose(r, "it stopped acknowledging commands: step %lld, the first after the newest it echoes, "
+            "left %.2f s ago",
+         static_cast<long long>(next), unacked);
   }
 
   int nx_ = 0;
@@ -294,6 +309,8 @@ class VehicleFeed {
   std::array<double, kMaxInputs> last_u_{};
   bool last_u_valid_ = false;
   std::array<bool, kChangeRing> changed_{};  // command k differed from k − 1, at k mod ring
+  std::array<std::int64_t, kChangeRing> sent_stamps_{};  // command k's stamp, at k mod ring
+  std::int64_t sent_ = 0;                                // commands sent
 };
 
 }  // namespace mixpilot
