@@ -260,8 +260,8 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
     case End::controller_silent:
       if (rejected_since > 0) {
         std::fprintf(stderr,
-                     "mixpilot vehicle: no command taken for %.2f s: %llu arrived from the "
-                     "controller and were rejected (the newest as %s): flight over\n",
+                     "mixpilot vehicle: no command taken for %.2f s: %llu commands arrived and "
+                     "were rejected (the newest as %s): flight over\n",
                      o.timeout_s, (unsigned long long)rejected_since, st.last_rejection.c_str());
       } else {
         std::fprintf(stderr,

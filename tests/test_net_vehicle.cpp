@@ -553,7 +553,7 @@ TEST_F(Net, AVehicleWhoseCommandsAreAllRejectedSaysWhy) {
   EXPECT_EQ(rc, 1);
   EXPECT_EQ(out.find("went silent"), std::string::npos) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(
-      R"(no command taken for 0\.50 s: \d+ arrived from the controller and were rejected \(the )"
+      R"(no command taken for 0\.50 s: \d+ commands arrived and were rejected \(the )"
       R"(newest as stale: step 5 is not after the last one taken \(9\)\))")))
       << out;
 }
