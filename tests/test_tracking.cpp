@@ -689,6 +689,11 @@ TEST(TrackingRemote, AVehicleOfNoUseIsLostWithItsReason) {
          if (k >= 60) v.x.setConstant(1e300);
        },
        "it left the world", 60 * 0.015 + 0.1},
+      {"echoes a step never sent",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 60) v.command = INT64_MAX;
+       },
+       "it echoes step 9223372036854775807, which was never sent", 60 * 0.015 + 0.1},
       {"ends its flight",
        [&](std::int64_t k, VehicleSample& v) { v.ended = k >= 60; },
        "it ended its flight", 60 * 0.015 + 0.1},

@@ -16,8 +16,8 @@
 //    models flown remotely, a change of that size moves some state value by orders of
 //    magnitude more within one period, so only a vehicle that ignores its commands stays put;
 //  - jumps: its position moves faster than kMaxSpeed between two states (plus kJumpSlack);
-//  - claims a command acted longer than since it left (which input/net's link rejects
-//    already; here for any link).
+//  - echoes a command never sent, or claims one acted longer than since it left (which
+//    input/net's link rejects already; here for any link).
 // Where its world ends is the mode's to say (VehicleWorld for the tracking mode).
 //
 // setup() sizes; read() and send() allocate nothing.
@@ -204,6 +204,9 @@ class VehicleFeed {
   // A new state: ended, jumped, or still for too long.
   void judge_new(const VehicleSample& v, double timeout, Reading& r) {
     if (v.ended) return lose(r, "it ended its flight (status 2) before the controller did");
+    if (v.command >= sent_)
+      return lose(r, "it echoes step %lld, which was never sent (%lld sent)",
+                  static_cast<long long>(v.command), static_cast<long long>(sent_));
     if (v.command >= 0) {
       const double since_sent = 1e-9 * double(v.received_ns - v.command_stamp_ns);
       if (!(v.command_age_s <= since_sent + kClockTolerance))
@@ -266,8 +269,8 @@ class VehicleFeed {
     if (k == 0 || !heard) return;
     if (v.command >= 0) acked_ = true;
     // The first command it has not acknowledged, if one was sent (beyond the ring: long ago).
+    if (v.command >= sent_ - 1) return;
     const std::int64_t next = std::max<std::int64_t>(v.command + 1, 0);
-    if (next >= sent_) return;
     const double unacked =
         sent_ - next > kChangeRing
             ? std::numeric_limits<double>::infinity()
