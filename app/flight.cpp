@@ -20,6 +20,42 @@ namespace mixpilot::cli {
 
 namespace {
 
+// "3 stale, 1 bad value" (the non-zero counts).
+std::string rejection_counts(const net::JoyPeerStats& s) {
+  std::string out;
+  const auto add = [&](std::uint64_t n, const char* what) {
+    if (n > 0) out += (out.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  add(s.bad_value, "bad value");
+  add(s.bad_size, "bad size");
+  add(s.stale, "stale");
+  add(s.other_publisher, "of another publisher");
+  return out;
+}
+
+// What a remote vehicle's state may hold before it is not a state (input/net/peer_checks.hpp):
+// positions well beyond any world, a quaternion's parts (unit, with the integrator's drift),
+// speeds and rates no quadrotor reaches; Euler angles integrate freely, so only their size is
+// bounded; the MikroKopter's rotor speeds a hundred times their limit.
+net::RemoteVehicle::StateBounds state_bounds(ModeKind kind) {
+  net::RemoteVehicle::StateBounds b = net::RemoteVehicle::any_state();
+  const auto set = [&](int from, int n, double bound) {
+    for (int i = from; i < from + n; ++i) b[std::size_t(i)] = bound;
+  };
+  set(0, 3, 1e4);  // p [m]
+  if (kind == ModeKind::crazyflie_tracking) {
+    set(3, 4, 2.0);  // q
+    set(7, 3, 1e3);  // v_b [m/s]
+    set(10, 3, 1e4);  // ω [rad/s]
+  } else {
+    set(3, 3, 1e6);  // γ [rad]
+    set(6, 3, 1e3);  // v_b [m/s]
+    set(9, 3, 1e4);  // ω [rad/s]
+    set(12, 4, 100 * models::MikroKopter().p.omega_max);  // Ω
+  }
+  return b;
+}
+
 // Reads the scenario and, for a replay, the recording; on failure `status` may name a more
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
@@ -82,9 +118,18 @@ std::shared_ptr<Devices> open_devices(const FlyOptions& o, const std::string& sc
       while (!d->peer->heard() && std::chrono::steady_clock::now() < until)
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       if (!d->peer->heard()) {
-        error = "no sensor_msgs/msg/Joy on " + po.topic + " in DDS domain " +
-                std::to_string(po.domain) + " within 10 s: start the publisher (e.g. mixpilot "
-                "joy-publish --from REC.mcap --domain " + std::to_string(po.domain) + ")";
+        const net::JoyPeerStats s = d->peer->stats();
+        if (s.rejected() > 0) {
+          // Samples arrived: the publisher is there, its samples are not fit to fly.
+          error = std::to_string(s.rejected()) + " sensor_msgs/msg/Joy samples arrived on " +
+                  po.topic + " in DDS domain " + std::to_string(po.domain) +
+                  " within 10 s and none was taken (" + rejection_counts(s) + "; the newest as " +
+                  s.last_rejection + ")";
+        } else {
+          error = "no sensor_msgs/msg/Joy on " + po.topic + " in DDS domain " +
+                  std::to_string(po.domain) + " within 10 s: start the publisher (e.g. mixpilot "
+                  "joy-publish --from REC.mcap --domain " + std::to_string(po.domain) + ")";
+        }
         return nullptr;
       }
     }
@@ -170,6 +215,7 @@ bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
             " has no remote vehicle (crazyflie_tracking and mixed_initiative have)";
     return false;
   }
+  vo.max_abs = state_bounds(kind);
   net::use_loopback_unless_configured();
   f.vehicle = std::make_unique<net::RemoteVehicle>();
   if (!f.vehicle->start(vo, error)) {
@@ -180,9 +226,17 @@ bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
               "vehicle --scenario ...)\n", o.command, o.vehicle_wait_s, unsigned(o.domain));
   std::fflush(stdout);
   if (!f.vehicle->wait_for_vehicle(o.vehicle_wait_s)) {
-    error = "--vehicle dds: no vehicle heard on rt/mixpilot/vehicle/state in DDS domain " +
-            std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
-            " s (start `mixpilot vehicle --scenario ...` first)";
+    const net::RemoteVehicleStats s = f.vehicle->stats();
+    if (s.rejected() > 0) {
+      error = "--vehicle dds: " + std::to_string(s.rejected()) +
+              " states arrived on rt/mixpilot/vehicle/state in DDS domain " +
+              std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
+              " s and none was taken (the newest as " + s.last_rejection + ")";
+    } else {
+      error = "--vehicle dds: no vehicle heard on rt/mixpilot/vehicle/state in DDS domain " +
+              std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
+              " s (start `mixpilot vehicle --scenario ...` first)";
+    }
     return false;
   }
   if (!f.mode->set_vehicle(f.vehicle.get())) {
@@ -277,6 +331,8 @@ void print_peer(const net::JoyPeer& peer) {
     std::printf("  peer latency, publisher stamp to the control step's read: p50 %.1f ms, "
                 "p99 %.1f ms (%llu samples)\n",
                 s.latency_p50_ms, s.latency_p99_ms, (unsigned long long)s.latency_samples);
+  if (!s.last_rejection.empty())
+    std::printf("  the newest sample rejected: %s\n", s.last_rejection.c_str());
   if (s.publishers > 1)
     std::printf("  WARNING: %u publishers on %s; only the first one heard flew\n", s.publishers,
                 peer.options().topic.c_str());
@@ -291,6 +347,8 @@ void print_vehicle(const net::RemoteVehicle& vehicle) {
               (unsigned long long)s.bad_value, (unsigned long long)s.bad_size,
               (unsigned long long)s.unknown_command, (unsigned long long)s.stale,
               (unsigned long long)s.other_publisher, s.publishers);
+  if (!s.last_rejection.empty())
+    std::printf("  the newest state rejected: %s\n", s.last_rejection.c_str());
   if (s.publishers > 1)
     std::printf("  WARNING: %u vehicles publish states; only the first one heard flew\n",
                 s.publishers);

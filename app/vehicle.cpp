@@ -7,7 +7,9 @@
 // link's delay), echoing the command's step and stamp with age 0. Without new commands a state
 // goes out every other control period (every period before the first command), echoing the
 // command in effect and its age, so the controller hears the vehicle. Before its first command
-// the vehicle rests in hover at the scenario's start.
+// the vehicle rests in hover at the scenario's start. Its world (core/modes/vehicle_feed.hpp's
+// VehicleWorld) is the controller's, with the ground under the tracking mode's ball: leaving it,
+// through the floor included, stops the plant there and every later state says so (status 1).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -23,8 +25,10 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
+#include "core/modes/vehicle_feed.hpp"
 #include "core/modes/vehicle_link.hpp"
 #include "core/numerics/integrator_erk4.hpp"
+#include "core/numerics/types.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/scenario/tracking_scenario.hpp"
 #include "input/net/dds.hpp"
@@ -66,6 +70,7 @@ struct VehicleSpec {
   double h = 0.001;       // plant substep [s]
   Eigen::Vector3d start;  // hover position [m]
   double u_min = 0, u_max = 0;  // input bounds, where the rotors saturate
+  VehicleWorld world;     // where it may fly
 };
 
 std::int64_t ns_of(double seconds) { return std::int64_t(std::llround(seconds * 1e9)); }
@@ -98,7 +103,9 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   // SCHED_FIFO where the system allows (the scope lasts the flight).
   const input::RealtimeThreadsScope realtime;
   net::VehicleEndpoint link;
-  if (!link.open(o.domain, Model::nu, error)) {
+  if (!link.open(o.domain, net::CommandCheck::Limits{Model::nu, spec.dt, spec.u_min, spec.u_max,
+                                                     VehicleFeed::kMaxRtt},
+                 error)) {
     std::fprintf(stderr, "mixpilot vehicle: %s\n", error.c_str());
     return kExitError;
   }
@@ -107,6 +114,8 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   Input u = model.hover_input();
   std::int64_t cmd_step = -1, cmd_stamp = 0, applied_ns = 0;
   std::uint8_t status = 0;
+  const char* left_how = nullptr;  // how it left its world
+  std::int64_t left_at = 0;
 
   struct Inbound {
     std::int64_t due, step, stamp;
@@ -134,8 +143,12 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
       const std::int64_t dt = std::min(h, to - t_plant);
       erk4.template step<double>(x, u, 1e-9 * double(dt), xn);
       t_plant += dt;
-      if (!xn.allFinite() || (xn.template head<3>() - spec.start).norm() > 100.0) {
-        status = 1;  // left its world: the last finite state stays
+      const char* outside = xn.allFinite() ? spec.world.outside(xn.template head<3>())
+                                            : "its state stopped being finite";
+      if (outside) {
+        status = 1;  // left its world: the last state inside stays
+        left_how = outside;
+        left_at = t_plant;
         t_plant = to;
         return;
       }
@@ -157,6 +170,7 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   const std::int64_t period = ns_of(spec.dt);
   std::int64_t last_measured = started - period, last_heard = started, first_applied = -1;
   std::int64_t applied = 0;
+  std::uint64_t rejected_at_heard = 0;  // the link's rejections when a command was last taken
   bool end_asked = false;
   End end = End::by_controller;
   std::vector<net::VehicleCommand> taken;
@@ -171,6 +185,7 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
     now = vehicle_clock_ns();
     for (const net::VehicleCommand& c : taken) {
       last_heard = now;
+      rejected_at_heard = link.rejected();
       if (c.end) {
         end_asked = true;
         continue;
@@ -230,18 +245,39 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
               (unsigned long long)st.bad_value, (unsigned long long)st.bad_size,
               (unsigned long long)st.stale, (unsigned long long)st.other_publisher,
               unsigned(st.publishers));
-  std::printf("  final position (%.3f, %.3f, %.3f) m%s\n", x(0), x(1), x(2),
-              status == 1 ? "; the vehicle left its world" : "");
+  std::printf("  final position (%.3f, %.3f, %.3f) m\n", x(0), x(1), x(2));
+  if (status == 1)
+    std::printf("  the vehicle left its world at t = %.2f s (%s); every state after said so\n",
+                1e-9 * double(left_at - first_applied), left_how);
+  if (!st.last_rejection.empty())
+    std::printf("  the newest command rejected: %s\n", st.last_rejection.c_str());
+  // Commands that arrived and were all rejected are not silence: say which and why.
+  const std::uint64_t rejected_since = st.rejected() - rejected_at_heard;
   switch (end) {
     case End::by_controller:
       std::printf("  the controller ended the flight\n");
       return kExitOk;
     case End::controller_silent:
-      std::fprintf(stderr, "mixpilot vehicle: the controller went silent for %.2f s: flight over\n",
-                   o.timeout_s);
+      if (rejected_since > 0) {
+        std::fprintf(stderr,
+                     "mixpilot vehicle: no command taken for %.2f s: %llu commands arrived and "
+                     "were rejected (the newest as %s): flight over\n",
+                     o.timeout_s, (unsigned long long)rejected_since, st.last_rejection.c_str());
+      } else {
+        std::fprintf(stderr,
+                     "mixpilot vehicle: the controller went silent for %.2f s: flight over\n",
+                     o.timeout_s);
+      }
       return kExitError;
     case End::no_controller:
-      std::fprintf(stderr, "mixpilot vehicle: no controller within %.0f s\n", o.wait_s);
+      if (st.rejected() > 0) {
+        std::fprintf(stderr,
+                     "mixpilot vehicle: no command taken within %.0f s: %llu arrived and were "
+                     "rejected (the newest as %s)\n",
+                     o.wait_s, (unsigned long long)st.rejected(), st.last_rejection.c_str());
+      } else {
+        std::fprintf(stderr, "mixpilot vehicle: no controller within %.0f s\n", o.wait_s);
+      }
       return kExitError;
     case End::interrupted:
       std::printf("  interrupted\n");
@@ -299,8 +335,15 @@ int vehicle_command(int argc, char** argv) {
       return kExitError;
     }
     const models::Crazyflie model;
-    const VehicleSpec spec{sc->name, "crazyflie", sc->controller.dt, 1.0 / sc->plant.rate_hz,
-                           sc->plant.start, model.p.omega_min, model.p.omega_max};
+    const VehicleSpec spec{sc->name,
+                           "crazyflie",
+                           sc->controller.dt,
+                           1.0 / sc->plant.rate_hz,
+                           sc->plant.start,
+                           model.p.omega_min,
+                           model.p.omega_max,
+                           VehicleWorld::ball(sc->plant.start, tracking_defaults::kLostRadius,
+                                              -VehicleWorld::kGroundMargin)};
     return fly_vehicle(model, spec, o);
   }
   if (*mode == "mixed_initiative") {
@@ -310,8 +353,15 @@ int vehicle_command(int argc, char** argv) {
       return kExitError;
     }
     const models::MikroKopter model;
-    const VehicleSpec spec{sc->name, "mikrokopter", sc->controller.dt, 1.0 / sc->plant.rate_hz,
-                           sc->reference.position(0.0), model.p.tau_min, model.p.tau_max};
+    const VehicleSpec spec{
+        sc->name,
+        "mikrokopter",
+        sc->controller.dt,
+        1.0 / sc->plant.rate_hz,
+        sc->reference.position(0.0),
+        model.p.tau_min,
+        model.p.tau_max,
+        VehicleWorld::box(sc->arena.min, sc->arena.max, mi_defaults::kLostMargin)};
     return fly_vehicle(model, spec, o);
   }
   std::fprintf(stderr, "mixpilot vehicle: %s: mode '%s' has no remote vehicle; it flies "

@@ -5,9 +5,13 @@
 // arrives τ_m later, echoing k and its stamp with age 0. The controller's clock is the time of
 // the step in progress. With it a mode's remote path can be compared with its simulated plant
 // step for step, and checked for allocations. setup() sizes; the rest allocates nothing.
+//
+// A hostile vehicle is the same link with `mutate` set: it may rewrite each state (what the
+// vehicle claims) before it is sent; `timeout` is the link's silence limit.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/modes/vehicle_link.hpp"
@@ -50,15 +54,21 @@ class DelayedPlantLink final : public VehicleLink {
       v.command_stamp_ns = stamp_ns;
       v.command_age_s = 0.0;
       v.received_ns = stamp_ns + rtt_ns_;
+      if (mutate) mutate(k, v);
       pending_.push_back(v);
     }
     ++sent_;
   }
   void finish() override { finished_ = true; }
-  double timeout_s() const override { return 1.0; }
-  std::int64_t now_ns() const override { return sent_ * dt_ns_; }
+  double timeout_s() const override { return timeout; }
+  std::int64_t now_ns() const override { return sent_ * dt_ns_ + paused_ns; }
 
   bool finished() const { return finished_; }
+
+  // What the vehicle claims for command k's state (the true one in, the claim out).
+  std::function<void(std::int64_t k, VehicleSample& v)> mutate;
+  double timeout = 1.0;  // [s]
+  std::int64_t paused_ns = 0;  // the controller's clock ran on this long without a step
 
  private:
   IntegratorErk4<Model> erk4_;

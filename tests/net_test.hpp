@@ -54,6 +54,11 @@ inline void start(const std::string& args, const std::filesystem::path& dir,
                           "' 2>&1; echo $? >'" + (dir / out).string() + ".rc' ) &";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
 }
+// The exit status of a start()ed command if it has ended, else −1 (no wait).
+inline int exit_status(const std::filesystem::path& dir, const std::string& out) {
+  const std::string text = test::read_file(dir / (out + ".rc"));
+  return !text.empty() && text.back() == '\n' ? std::stoi(text) : -1;
+}
 // The exit status of a start()ed command, waiting up to `seconds` for it to end (−1: still
 // running).
 inline int finished(const std::filesystem::path& dir, const std::string& out, double seconds) {

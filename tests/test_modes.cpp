@@ -5,6 +5,7 @@
 // one state and one channel message per step.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -353,6 +354,57 @@ TEST(RemoteVehicle, TheTrackingModeStepsItWithoutAllocating) {
   const MetricMap m = metric_map(mode->metrics());
   EXPECT_NEAR(m.at("rtt_estimated_s"), 0.06, 1e-12);
   EXPECT_LT(m.at("tracking_rms_m"), 0.05);
+}
+
+// A remote MikroKopter that keeps talking but is of no use ends the mixed-initiative flight as
+// lost with its reason, within the link's timeout (plus the longest round trip when it never
+// acknowledges), instead of flying on with fallbacks: one that sits still, never acknowledges,
+// or jumps to exactly the loss margin outside the arena.
+TEST(RemoteVehicle, AMixedInitiativeVehicleOfNoUseIsLostWithItsReason) {
+  const ModeCase c{"mi", "mi_helix.toml", "novice", ModeKind::mixed_initiative, nullptr};
+  struct Case {
+    const char* name;
+    std::function<void(std::int64_t, VehicleSample&)> mutate;
+    const char* reason;  // how the lost reason starts
+    double lost_by;      // [s]
+  };
+  const auto probe = make(c);
+  ASSERT_TRUE(probe);
+  const auto& mi0 = dynamic_cast<const MiMode&>(*probe);
+  const Eigen::VectorXd x0 = mi0.state();
+  const double edge = mi0.scenario().arena.max.x() + mi_defaults::kLostMargin;
+  const Case cases[] = {
+      {"sits still", [&](std::int64_t, VehicleSample& v) { v.x = x0; }, "it does not move", 0.35},
+      {"never acknowledges",
+       [](std::int64_t, VehicleSample& v) {
+         v.command = -1;
+         v.command_stamp_ns = 0;
+       },
+       "it never acknowledged a command", 0.8},
+      {"jumps to exactly the loss margin",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 40) v.x(0) = edge;
+       },
+       "it left the arena", 40 * 0.015 + 0.05},
+  };
+  for (const Case& cs : cases) {
+    auto mode = make(c);
+    ASSERT_TRUE(mode);
+    const models::MikroKopter model;
+    test::DelayedPlantLink<models::MikroKopter> link(model, x0, mode->dt(), 15, 0.0, 0.0,
+                                                     std::size_t(mode->steps_total()));
+    link.timeout = 0.25;
+    link.mutate = cs.mutate;
+    ASSERT_TRUE(mode->set_vehicle(&link));
+    while (mode->step()) {
+    }
+    const std::string summary = mode->summary();
+    std::printf("%s:\n%s", cs.name, summary.c_str());
+    EXPECT_TRUE(mode->lost()) << cs.name;
+    EXPECT_NE(summary.find(std::string(" s: ") + cs.reason), std::string::npos) << cs.name;
+    EXPECT_LE(mode->lost_at(), cs.lost_by) << cs.name;
+    EXPECT_TRUE(link.finished()) << cs.name;
+  }
 }
 
 // Modes without a remote vehicle say so.

@@ -23,6 +23,7 @@
 #include "input/device_pilot.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/joy_peer.hpp"
+#include "input/net/peer_checks.hpp"
 #include "models/mikrokopter.hpp"
 #include "ros2_msgs.h"
 #include "net_test.hpp"
@@ -54,6 +55,100 @@ TEST(NetConfig, TheLoopbackCheckRefusesWhatWouldLeaveTheMachine) {
   EXPECT_TRUE(loopback_only(why)) << why;
   if (before) setenv("CYCLONEDDS_URI", saved.c_str(), 1);
   else unsetenv("CYCLONEDDS_URI");
+}
+
+// --- The checks themselves, on a clock of the test's (no DDS) ------------------------------
+
+constexpr std::int64_t kSecond = 1'000'000'000;
+
+// Joy: 0.5 s old and 0.05 s ahead are the limits; a taken sample orders as its stamp or its
+// arrival, whichever is earlier, so a claim from the future stales nothing after it.
+TEST(PeerChecks, JoyTimesAreCheckedAgainstTheReceiversClock) {
+  JoyCheck check;
+  check.setup({0.5, 0.05});
+  const float axes[4] = {0, 0, 0, 0};
+  const std::int64_t now = 1000 * kSecond;
+  std::int64_t stamp = 0;
+  RejectionNote note;
+  const auto at = [&](std::int64_t arrival, std::int64_t sent) {
+    const JoyFields f{std::int32_t(sent / kSecond), std::uint32_t(sent % kSecond), 3, 4, axes, 0,
+                      nullptr};
+    return check.check(f, arrival, stamp, note);
+  };
+  EXPECT_EQ(at(now, now - kSecond / 2), Rejection::none);           // 0.5 s old
+  EXPECT_EQ(at(now, now - kSecond / 2 - 1'000'000), Rejection::stale);  // older
+  EXPECT_EQ(at(now, now + 51'000'000), Rejection::stale);           // 51 ms ahead
+  EXPECT_EQ(at(now, now + 49'000'000), Rejection::none);            // 49 ms ahead: taken
+  EXPECT_EQ(at(now + 1'000'000, now + 500'000), Rejection::none);   // honest, after it
+  EXPECT_EQ(at(now + 2'000'000, now + 400'000), Rejection::stale);  // older than the last
+  char text[256];
+  describe(note, text, sizeof text);
+  EXPECT_STREQ(text, "stale: stamped 0.0001 s before the last sample taken");
+  check.forget_order();  // another writer
+  EXPECT_EQ(at(now + 3'000'000, now + 400'000), Rejection::none);
+}
+
+// States: an age no longer than since the command left (1 ms of clock tolerance); a stamp far
+// from the vehicle's other stamps is refused without moving their median; order by command and
+// age, so the honest states after a refused one are taken.
+TEST(PeerChecks, VehicleStateTimesAreCheckedAgainstTheCommandsSent) {
+  SentCommands sent;
+  StateCheck check;
+  StateCheck::Limits limits;
+  limits.nx = 13;
+  limits.max_abs.fill(1e6);
+  check.setup(limits);
+  double x[13] = {0, 0, 0.4, 1};
+  RejectionNote note;
+  const std::int64_t offset = 123 * kSecond;  // the vehicle's clock against the controller's
+  // Command k left at 1 s + 15k ms; its state, measured `age` after it acted, arrives at
+  // `received`; `shift` moves the vehicle's stamp off its clock.
+  const auto state = [&](std::int64_t k, double age, std::int64_t received, std::int64_t shift) {
+    const std::int64_t sent_at = k * 15'000'000 + kSecond;
+    const StateFields f{sent_at + offset + std::int64_t(age * 1e9) + shift, k, sent_at, age, 0,
+                        13, x};
+    return check.check(f, received, sent, note);
+  };
+  for (std::int64_t k = 0; k < 6; ++k) sent.note(k, k * 15'000'000 + kSecond);
+  const auto arrival = [](std::int64_t k) { return k * 15'000'000 + kSecond + 30'000'000; };
+  for (std::int64_t k = 0; k < 4; ++k) EXPECT_EQ(state(k, 0.0, arrival(k), 0), Rejection::none);
+  EXPECT_EQ(state(3, 0.0312, arrival(3), 0), Rejection::stale);  // acted longer than since sent
+  EXPECT_EQ(state(3, 0.0305, arrival(3), 0), Rejection::none);   // within the 1 ms
+  EXPECT_EQ(state(3, 0.0305, arrival(3), 0), Rejection::stale);  // measured no later
+  EXPECT_EQ(state(4, 0.0, arrival(4), 10 * kSecond), Rejection::stale);  // 10 s off its clock
+  EXPECT_EQ(state(4, 0.0, arrival(4), 0), Rejection::none);              // honest again
+  EXPECT_EQ(state(5, 0.0, arrival(5), 400'000'000), Rejection::none);   // 0.4 s: delay jitter
+  EXPECT_EQ(state(2, 0.0, arrival(5), 0), Rejection::stale);            // an older command
+  x[7] = 2e6;
+  EXPECT_EQ(state(5, 0.001, arrival(5), 0), Rejection::bad_value);
+}
+
+// Commands: in pace with the vehicle's clock from the first one taken; a step ahead of the pace
+// (within 0.5 s) is taken, and orders as the step due then, so the honest steps after it are
+// taken too; rotor values more than the rotors' range outside their limits are refused.
+TEST(PeerChecks, RotorCommandStepsKeepPaceWithTheVehiclesClock) {
+  CommandCheck check;
+  check.setup({4, 0.015, 0.0, 22.0, 0.5});
+  double u[4] = {15, 15, 15, 15};
+  RejectionNote note;
+  const std::int64_t t0 = 50 * kSecond, c0 = 7 * kSecond;  // vehicle's and controller's clocks
+  const auto command = [&](std::int64_t k, double at_s) {
+    const CommandFields f{k, c0 + std::int64_t(double(k) * 0.015 * 1e9), 4, u};
+    return check.check(f, t0 + std::int64_t(at_s * 1e9), note);
+  };
+  EXPECT_EQ(command(40, 0.0), Rejection::stale);  // a flight starts near step 0
+  EXPECT_EQ(command(0, 0.0), Rejection::none);
+  EXPECT_EQ(command(6, 0.1), Rejection::none);
+  EXPECT_EQ(command(1000, 0.1), Rejection::stale);  // 14.9 s ahead of the pace
+  EXPECT_EQ(command(30, 0.1), Rejection::none);     // 0.35 s ahead: taken...
+  EXPECT_EQ(command(7, 0.105), Rejection::none);    // ...without staling the next honest one
+  EXPECT_EQ(command(7, 0.106), Rejection::stale);   // a repeat
+  u[2] = 44.5;
+  EXPECT_EQ(command(8, 0.12), Rejection::bad_value);  // beyond 22 + 22
+  u[2] = 43.0;
+  EXPECT_EQ(command(8, 0.12), Rejection::none);  // saturates at 22
+  const CommandFields late{9, c0 + 10 * kSecond, 4, u};  // stamped 10 s after command 0
+  EXPECT_EQ(check.check(late, t0 + 135'000'000, note), Rejection::stale);
 }
 
 // ROS 2's names: rt/<topic>, <pkg>::msg::dds_::<Type>_.
@@ -142,6 +237,67 @@ TEST_F(Net, MalformedSamplesAndASecondPublisherAreRejectedAndCounted) {
   peer.stop();
 }
 
+// A stamp ahead of this machine's clock by more than the tolerance (50 ms) is stale, as the
+// docs say; one within it is taken. And a sample from the future cannot make the honest
+// samples after it stale: the order is kept against when it arrived, not what it claims.
+TEST_F(Net, JoySamplesFromTheFutureAreStaleAndCannotPoisonLaterOnes) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_future"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_future", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const auto send = [&](float x, std::int64_t ahead_ns) {
+    ASSERT_TRUE(w.write({x, 0, 0, 0}, {}, system_ns() + ahead_ns, "pad", error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+  };
+  send(0.1f, 300'000'000);  // 0.3 s ahead
+  send(0.2f, 450'000'000);  // 0.45 s ahead
+  send(0.3f, 40'000'000);   // within the tolerance
+  for (int i = 0; i < 20; ++i) send(0.4f, 0);  // honest, within 0.45 s of the one above
+  ASSERT_TRUE(eventually([&] { return peer.stats().accepted + peer.stats().stale >= 23; }));
+  const JoyPeerStats s = peer.stats();
+  std::printf("%llu taken, %llu stale; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.stale,
+              s.last_rejection.c_str());
+  EXPECT_EQ(s.stale, 2u);
+  EXPECT_EQ(s.accepted, 21u);
+  EXPECT_NE(s.last_rejection.find("stale: stamped 0.45 s ahead of this machine's clock"),
+            std::string::npos) << s.last_rejection;
+  EXPECT_FLOAT_EQ(float(peer.latest().sticks.left_x), 0.4f);
+  peer.stop();
+}
+
+// Buttons are 0 or 1 (sensor_msgs/Joy, and the recording's /joy); a stamp's nanoseconds are
+// below a second; a frame id is a name, not a payload.
+TEST_F(Net, JoyButtonsStampsAndFrameIdsOutsideTheirMeaningAreRejected) {
+  JoyPeer peer;
+  std::string error;
+  ASSERT_TRUE(peer.start({domain_, "rt/joy_fields"}, error)) << error;
+  JoyWriter w;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_fields", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const auto send = [&](std::vector<std::int32_t> buttons, std::int64_t stamp,
+                        const std::string& frame) {
+    ASSERT_TRUE(w.write({0, 0, 0, 0}, buttons, stamp, frame, error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  };
+  send({0, 1}, system_ns(), "pad");                       // good
+  send({0, 2}, system_ns(), "pad");                       // a button of 2
+  send({-1, 0}, system_ns(), "pad");                      // a button of -1
+  send({}, -1, "pad");                                    // nanoseconds 4294967295
+  send({}, system_ns(), std::string(100000, 'f'));        // a 100 kB frame id
+  ASSERT_TRUE(eventually([&] {
+    const JoyPeerStats s = peer.stats();
+    return s.accepted + s.rejected() >= 5;
+  }));
+  const JoyPeerStats s = peer.stats();
+  EXPECT_EQ(s.accepted, 1u);
+  EXPECT_EQ(s.bad_value, 3u);
+  EXPECT_EQ(s.bad_size, 1u);
+  peer.stop();
+}
+
 // A peer that stops publishing is an input loss: the planner gets the authority at once.
 TEST_F(Net, ASilentPeerIsAnInputLoss) {
   JoyPeer peer;
@@ -205,6 +361,36 @@ TEST_F(Net, TwoProcessesFlyARecordingsSticksOverDds) {
   // the stream lines up: close, not equal.
   EXPECT_NEAR(b.at("skill"), a.at("skill"), 5.0);
   EXPECT_NEAR(b.at("mean_lambda"), a.at("mean_lambda"), 0.05);
+}
+
+// A publisher whose samples all arrive and are all rejected is not told to start the publisher:
+// the flight that gives up says how many arrived, why they were rejected, and the newest's
+// reason in numbers.
+TEST_F(Net, APilotWhoseSamplesAreAllRejectedIsToldWhy) {
+  const fs::path dir = test::fresh_path("net", "joy_rejected");
+  fs::create_directories(dir);
+  const std::string d = std::to_string(domain_);
+  start("fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot dds:joy_rejected --domain " +
+            d + " --headless --realtime --duration 2",
+        dir, "fly.txt");
+  JoyWriter w;
+  std::string error;
+  ASSERT_TRUE(w.open(domain_, "rt/joy_rejected", error)) << error;
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }, 10));
+  int rc = -1;
+  for (int i = 0; i < 1500 && rc < 0; ++i) {  // stamped 2 s ahead, until the flight gives up
+    ASSERT_TRUE(w.write({0, 0, 0, 0}, {}, system_ns() + 2'000'000'000, "pad", error)) << error;
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+    rc = exit_status(dir, "fly.txt");
+  }
+  const std::string out = read_file(dir / "fly.txt");
+  std::printf("%s", out.c_str());
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(out.find("start the publisher"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(
+      R"(\d+ sensor_msgs/msg/Joy samples arrived on rt/joy_rejected .* none was taken \(\d+ stale; )"
+      R"(the newest as stale: stamped [12][.0-9]* s ahead of this machine's clock)")))
+      << out;
 }
 
 // fly --publish in one process; an independent subscriber (tests/net/dds_echo.c: C, its own

@@ -21,6 +21,7 @@
 #include "core/recording/recording.hpp"
 #include "input/net/remote_vehicle.hpp"
 #include "input/net/vehicle_endpoint.hpp"
+#include "models/crazyflie.hpp"
 #include "net_test.hpp"
 #include "temp_files.hpp"
 #include "vehicle_msgs.h"
@@ -100,8 +101,7 @@ TEST_F(Net, VehicleStatesThatAreMalformedStaleOrForeignAreRejectedAndCounted) {
   w.write(state(0, 1000, 0.01, 0));   // empty
   w.write(state(5, 1000, 0.01, 13));  // echoes a command never sent
   w.write(state(0, 999, 0.01, 13));   // echoes command 0 with another stamp
-  stamp = 1;
-  w.write(state(0, 1000, 0.02, 13));  // measured before the last one taken
+  w.write(state(0, 1000, 0.0, 13));   // measured no later than the last one taken
   stamp = 100;
   w.write(state(-1, 0, 0.0, 13));     // a command older than the one in effect
   other.write(state(0, 1000, 0.03, 13));  // a second vehicle
@@ -172,6 +172,113 @@ TEST_F(Net, RotorCommandsThatAreMalformedStaleOrForeignAreRejectedAndCounted) {
   EXPECT_EQ(taken[0].step, 0);
   EXPECT_EQ(taken[1].step, 1);
   EXPECT_TRUE(taken[2].end);
+}
+
+// Times and values a vehicle cannot mean are rejected, and none of them can make the honest
+// states after it stale: an age longer than the time since its command left; a value no
+// vehicle state has (1e300, finite); an unknown status; a stamp far ahead of what its other
+// states say of the vehicle's clock (order is kept by the echoed command and its age, which
+// the controller can check).
+TEST_F(Net, VehicleStatesWithImpossibleTimesOrValuesAreRejectedAndPoisonNothing) {
+  RemoteVehicle vehicle;
+  std::string error;
+  ASSERT_TRUE(vehicle.start({domain_, 13, 0.25}, error)) << error;
+  RawWriter<StateMsg> w(domain_, &mixpilot_msgs_msg_dds__VehicleState__desc,
+                        "rt/mixpilot/vehicle/state");
+  ASSERT_TRUE(w.ok());
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  const double u[4] = {15, 15, 15, 15};
+  double x[13] = {0, 0, 0.4, 1};
+  const std::int64_t vehicle_clock = 5'000'000'000'000;  // the vehicle's own clock, elsewhere
+  std::int64_t sent_stamp = 0;
+  const auto send = [&](std::int64_t k) {
+    sent_stamp = vehicle_clock_ns();
+    vehicle.send(k, sent_stamp, u, 4);
+  };
+  const auto state = [&](std::int64_t command, double age, std::int64_t stamp = 0) {
+    StateMsg m{};
+    m.stamp_ns = stamp != 0 ? stamp : vehicle_clock + vehicle_clock_ns();
+    m.command_step = command;
+    m.command_stamp_ns = sent_stamp;
+    m.command_age_s = age;
+    m.x._length = m.x._maximum = 13;
+    m.x._buffer = x;
+    return m;
+  };
+  for (std::int64_t k = 0; k < 5; ++k) {  // good: five commands acknowledged
+    send(k);
+    w.write(state(k, 0.0));
+  }
+  ASSERT_TRUE(eventually([&] { return vehicle.stats().accepted == 5; }));
+  w.write(state(4, 10.0));  // command 4 acted 10 s, yet it left 0.1 s ago
+  x[0] = 1e300;
+  w.write(state(4, 0.001));  // a position of 1e300 m
+  x[0] = 0;
+  StateMsg odd = state(4, 0.002);
+  odd.status = 7;
+  w.write(odd);  // no such status
+  send(5);
+  w.write(state(5, 0.0, INT64_MAX / 2));  // stamped centuries ahead of the vehicle's clock
+  w.write(state(5, 0.001));               // honest again
+  send(6);
+  w.write(state(6, 0.0));
+  ASSERT_TRUE(eventually([&] {
+    const RemoteVehicleStats s = vehicle.stats();
+    return s.accepted + s.bad_value + s.stale >= 11;
+  }));
+  const RemoteVehicleStats s = vehicle.stats();
+  std::printf("%llu taken, %llu bad values, %llu stale; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.bad_value,
+              (unsigned long long)s.stale, s.last_rejection.c_str());
+  EXPECT_EQ(s.accepted, 7u);
+  EXPECT_EQ(s.bad_value, 2u);
+  EXPECT_EQ(s.stale, 2u);
+  EXPECT_NE(s.last_rejection.find("stale: stamped 4.61e+09 s off the vehicle's clock"),
+            std::string::npos) << s.last_rejection;
+  const VehicleSample& v = vehicle.latest();
+  EXPECT_EQ(v.command, 6);
+  EXPECT_EQ(v.x(0), 0.0);
+  vehicle.stop();
+}
+
+// At the vehicle: one command whose step is far ahead of the controller's pace (INT64_MAX) is
+// rejected and cannot make the honest commands after it stale; a rotor value farther outside
+// the rotors' limits than their range is not a rotor command.
+TEST_F(Net, RotorCommandsFarAheadOrNotRotorCommandsAreRejectedAndPoisonNothing) {
+  VehicleEndpoint vehicle;
+  std::string error;
+  ASSERT_TRUE(vehicle.open(domain_, 4, error)) << error;
+  RawWriter<CommandMsg> w(domain_, &mixpilot_msgs_msg_dds__RotorCommand__desc,
+                          "rt/mixpilot/vehicle/command");
+  ASSERT_TRUE(w.ok());
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }));
+  double u[4] = {15, 15, 15, 15};
+  const auto command = [&](std::int64_t step) {
+    CommandMsg m{};
+    m.step = step;
+    m.stamp_ns = vehicle_clock_ns();
+    m.u._length = m.u._maximum = 4;
+    m.u._buffer = u;
+    return m;
+  };
+  std::vector<VehicleCommand> taken;
+  for (std::int64_t k : {0, 1}) w.write(command(k));
+  w.write(command(INT64_MAX));
+  for (std::int64_t k : {2, 3, 4}) w.write(command(k));
+  u[1] = 1e300;
+  w.write(command(5));
+  u[1] = 15;
+  w.write(command(6));
+  for (int i = 0; i < 20; ++i) vehicle.wait(DDS_MSECS(5), taken);
+  const VehicleEndpointStats s = vehicle.stats();
+  std::printf("%llu taken, %llu stale, %llu bad values; the newest rejected: %s\n",
+              (unsigned long long)s.accepted, (unsigned long long)s.stale,
+              (unsigned long long)s.bad_value, s.last_rejection.c_str());
+  ASSERT_EQ(taken.size(), 6u);
+  const std::int64_t want[] = {0, 1, 2, 3, 4, 6};
+  for (std::size_t i = 0; i < taken.size(); ++i) EXPECT_EQ(taken[i].step, want[i]);
+  EXPECT_EQ(s.stale, 1u);
+  EXPECT_EQ(s.bad_value, 1u);
 }
 
 // --- Two processes ----------------------------------------------------------------------
@@ -300,6 +407,155 @@ TEST_F(Net, APeerThatGoesSilentEndsTheFlightOnTheOtherSide) {
   std::printf("%s", vout.c_str());
   EXPECT_NE(vout.find("the controller went silent for 0.50 s"), std::string::npos) << vout;
   EXPECT_EQ(finished(dir, "fly2.txt", 5), 137);  // SIGKILL
+}
+
+// mixpilot vehicle commanded rotor speed 0 (a legal command: the rotors stop) falls. Through the
+// floor it has left its world: the plant stops there, every later state says so (status 1)
+// with the last state inside, and the vehicle says so when the flight ends.
+TEST_F(Net, AVehicleThatFallsThroughTheFloorSaysSo) {
+  const fs::path dir = test::fresh_path("net", "vehicle_floor");
+  fs::create_directories(dir);
+  start("vehicle --scenario " + kStep + " --domain " + std::to_string(domain_) + " --wait 30",
+        dir, "vehicle.txt");
+  RemoteVehicle controller;
+  std::string error;
+  ASSERT_TRUE(controller.start({domain_, 13, 5.0}, error)) << error;
+  ASSERT_TRUE(controller.wait_for_vehicle(30));
+  const double stopped[4] = {0, 0, 0, 0};
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::int64_t k = 0; k < 100; ++k) {  // 1.5 s: free fall from 0.4 m would reach -10.6 m
+    std::this_thread::sleep_until(t0 + std::chrono::milliseconds(15 * k));
+    controller.send(k, vehicle_clock_ns(), stopped, 4);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const VehicleSample v = controller.latest();
+  controller.finish();
+  EXPECT_EQ(finished(dir, "vehicle.txt", 10), 0) << read_file(dir / "vehicle.txt");
+  const std::string out = read_file(dir / "vehicle.txt");
+  std::printf("%sthe newest state: z = %.3f m, left its world %d\n", out.c_str(), v.x(2),
+              int(v.left_world));
+  EXPECT_TRUE(v.left_world);
+  EXPECT_GT(v.x(2), -1.0);
+  EXPECT_LT(v.x(2), -0.9);
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(the vehicle left its world at t = 0\.[56]\d s \(it fell below the floor\))")))
+      << out;
+}
+
+// The controller's side of a vehicle whose states arrive and are all rejected: before the
+// flight (16 state values for a 13-state scenario: another scenario's vehicle) it is not told
+// to start a vehicle, and in flight (echoes of commands it never sent) the vehicle is not "silent":
+// both say how many states arrived and why the newest was rejected.
+TEST_F(Net, AControllerWhoseVehicleStatesAreAllRejectedIsToldWhy) {
+  const fs::path dir = test::fresh_path("net", "vehicle_rejected");
+  fs::create_directories(dir);
+  const std::string d = std::to_string(domain_);
+  {
+    start("fly --scenario " + kStep + " --vehicle dds --vehicle-wait 1.5 --domain " + d +
+              " --headless --realtime",
+          dir, "fly.txt");
+    RawWriter<StateMsg> w(domain_, &mixpilot_msgs_msg_dds__VehicleState__desc,
+                          "rt/mixpilot/vehicle/state");
+    ASSERT_TRUE(w.ok());
+    double x[16] = {0, 0, 0.4};
+    int rc = -1;
+    for (std::int64_t i = 1; i < 500 && rc < 0; ++i) {
+      StateMsg m{};
+      m.stamp_ns = i;
+      m.command_step = -1;
+      m.x._length = m.x._maximum = 16;
+      m.x._buffer = x;
+      w.write(m);
+      rc = exit_status(dir, "fly.txt");
+    }
+    const std::string out = read_file(dir / "fly.txt");
+    std::printf("%s", out.c_str());
+    EXPECT_EQ(rc, 1);
+    EXPECT_EQ(out.find("start `mixpilot vehicle"), std::string::npos) << out;
+    EXPECT_TRUE(std::regex_search(out, std::regex(
+        R"(\d+ states arrived on rt/mixpilot/vehicle/state .* none was taken \(the newest as bad )"
+        R"(size: 16 state values, this scenario's model has 13)")))
+        << out;
+  }
+  {
+    start("fly --scenario " + kStep + " --vehicle dds --domain " + d +
+              " --headless --realtime --duration 3 --report " + (dir / "r.json").string(),
+          dir, "fly2.txt");
+    // A vehicle that echoes the commands for 0.3 s, then echoes stamps never sent.
+    VehicleEndpoint fake;
+    std::string error;
+    ASSERT_TRUE(fake.open(domain_, 4, error)) << error;
+    const models::Crazyflie model;
+    models::Crazyflie::State x = model.hover_state({0.0, 0.0, 0.4});
+    std::vector<VehicleCommand> taken;
+    std::int64_t first = 0, last_rest = 0;
+    int rc = -1;
+    for (int i = 0; i < 3000 && rc < 0; ++i) {
+      taken.clear();
+      fake.wait(DDS_MSECS(5), taken);
+      const std::int64_t now = vehicle_clock_ns();
+      if (first == 0 && now - last_rest > 15'000'000) {  // at rest until the first command
+        fake.publish({now, -1, 0, 0.0, 0, x.data(), 13});
+        last_rest = now;
+      }
+      for (const VehicleCommand& c : taken) {
+        if (c.end) continue;
+        if (first == 0) first = now;
+        x(0) += 1e-6;  // it moves, a little
+        const bool lying = now - first > 300'000'000;
+        fake.publish({now, c.step, c.stamp_ns + (lying ? 1 : 0), 0.0, 0, x.data(), 13});
+      }
+      rc = exit_status(dir, "fly2.txt");
+    }
+    if (rc < 0) rc = finished(dir, "fly2.txt", 10);
+    const std::string out = read_file(dir / "fly2.txt");
+    std::printf("%s", out.c_str());
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_EQ(out.find("it went silent"), std::string::npos) << out;
+    EXPECT_TRUE(std::regex_search(out, std::regex(
+        R"(the vehicle was lost: no state taken for 0\.2\d s: \d+ arrived and were rejected )"
+        R"(\(the newest as unknown command: echoes step \d+ stamped)")))
+        << out;
+  }
+}
+
+// The vehicle's side of a controller whose commands arrive and are all rejected (the same step
+// again and again): the flight ends as with a silent controller, and the vehicle says how many
+// commands arrived and why the newest was rejected.
+TEST_F(Net, AVehicleWhoseCommandsAreAllRejectedSaysWhy) {
+  const fs::path dir = test::fresh_path("net", "vehicle_commands_rejected");
+  fs::create_directories(dir);
+  start("vehicle --scenario " + kStep + " --domain " + std::to_string(domain_) +
+            " --timeout 0.5 --wait 30",
+        dir, "vehicle.txt");
+  RawWriter<CommandMsg> w(domain_, &mixpilot_msgs_msg_dds__RotorCommand__desc,
+                          "rt/mixpilot/vehicle/command");
+  ASSERT_TRUE(w.ok());
+  ASSERT_TRUE(eventually([&] { return w.matched() > 0; }, 30));
+  double u[4] = {15.8, 15.8, 15.8, 15.8};
+  const auto command = [&](std::int64_t step) {
+    CommandMsg m{};
+    m.step = step;
+    m.stamp_ns = vehicle_clock_ns();
+    m.u._length = m.u._maximum = 4;
+    m.u._buffer = u;
+    return m;
+  };
+  for (std::int64_t k = 0; k < 10; ++k) w.write(command(k));
+  int rc = -1;
+  for (int i = 0; i < 200 && rc < 0; ++i) {
+    w.write(command(5));
+    rc = exit_status(dir, "vehicle.txt");
+  }
+  if (rc < 0) rc = finished(dir, "vehicle.txt", 5);
+  const std::string out = read_file(dir / "vehicle.txt");
+  std::printf("%s", out.c_str());
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(out.find("went silent"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(
+      R"(no command taken for 0\.50 s: \d+ commands arrived and were rejected \(the )"
+      R"(newest as stale: step 5 is not after the last one taken \(9\)\))")))
+      << out;
 }
 
 // Refused before anything flies: a mode without a remote vehicle, no vehicle at all, a replay.

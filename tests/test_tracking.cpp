@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 
 #include "core/control/crazyflie_tracking.hpp"
@@ -622,10 +623,147 @@ TEST(TrackingRemote, ASilentVehicleIsLost) {
   while (mode.step()) {
   }
   EXPECT_TRUE(mode.lost());
-  EXPECT_STREQ(mode.lost_reason(), "it went silent");
+  EXPECT_STREQ(mode.lost_reason(), "it went silent (no state for 1.01 s)");
   EXPECT_NEAR(mode.lost_at(), 1.0, 0.0151);
   EXPECT_TRUE(mode.telemetry().events & kEventLost);
   EXPECT_TRUE(link.finished());
+}
+
+
+// Every line a user reads is short: no number grows with a hostile value.
+void expect_bounded_lines(const std::string& text) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    EXPECT_LT(end - start, 200u) << text.substr(start, end - start);
+    start = end + 1;
+  }
+}
+
+// A vehicle that keeps talking but is of no use ends the flight as lost, with its reason,
+// within the link's timeout (plus the longest round trip when it stops acknowledging), instead
+// of flying to the end on fallbacks; the summary stays bounded and scores no state from
+// outside the world. The vehicle flies the smooth step with 30 ms each way, timeout 0.25 s.
+TEST(TrackingRemote, AVehicleOfNoUseIsLostWithItsReason) {
+  TrackingScenario sc = load(kStep);
+  sc.duration = 4.0;
+  const models::Crazyflie model;
+  const models::Crazyflie::State x0 = model.hover_state(sc.plant.start);
+  const Eigen::Vector3d start = sc.plant.start;
+  std::int64_t stamp59 = 0;
+  struct Case {
+    const char* name;
+    std::function<void(std::int64_t, VehicleSample&)> mutate;
+    const char* reason;  // how the lost reason starts
+    double lost_by;      // [s]
+  };
+  const Case cases[] = {
+      {"never acknowledges",
+       [](std::int64_t, VehicleSample& v) {
+         v.command = -1;
+         v.command_stamp_ns = 0;
+       },
+       "it never acknowledged a command", 0.8},
+      {"sits still", [&](std::int64_t, VehicleSample& v) { v.x = x0; }, "it does not move", 0.35},
+      {"stops acknowledging at step 60",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k == 59) stamp59 = v.command_stamp_ns;
+         if (k < 60) return;
+         v.command = 59;
+         v.command_stamp_ns = stamp59;
+         v.command_age_s = double(k - 59) * sc.controller.dt;
+       },
+       "it stopped acknowledging commands", 60 * 0.015 + 0.8},
+      {"jumps to exactly the loss radius",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 60) v.x.head<3>() = start + Eigen::Vector3d(100.0, 0.0, 0.0);
+       },
+       "it left the world", 60 * 0.015 + 0.1},
+      {"jumps 50 m",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 60) v.x(0) += 50.0;
+       },
+       "its position jumped", 60 * 0.015 + 0.1},
+      {"reports a state of 1e300",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 60) v.x.setConstant(1e300);
+       },
+       "it left the world", 60 * 0.015 + 0.1},
+      {"echoes a step never sent",
+       [&](std::int64_t k, VehicleSample& v) {
+         if (k >= 60) v.command = INT64_MAX;
+       },
+       "it echoes step 9223372036854775807, which was never sent", 60 * 0.015 + 0.1},
+      {"ends its flight",
+       [&](std::int64_t k, VehicleSample& v) { v.ended = k >= 60; },
+       "it ended its flight", 60 * 0.015 + 0.1},
+  };
+  for (const Case& c : cases) {
+    TrackingMode mode;
+    ASSERT_TRUE(mode.setup(sc).ok());
+    test::DelayedPlantLink<models::Crazyflie> link(model, x0, sc.controller.dt, 15, 0.03, 0.03,
+                                                   1000);
+    link.timeout = 0.25;
+    link.mutate = c.mutate;
+    ASSERT_TRUE(mode.set_vehicle(&link));
+    while (mode.step()) {
+    }
+    const std::string summary = mode.summary();
+    std::printf("%s:\n%s", c.name, summary.c_str());
+    EXPECT_TRUE(mode.lost()) << c.name;
+    EXPECT_EQ(std::string(mode.lost_reason()).rfind(c.reason, 0), 0u)
+        << c.name << ": " << mode.lost_reason();
+    EXPECT_LE(mode.lost_at(), c.lost_by) << c.name;
+    EXPECT_TRUE(link.finished()) << c.name;
+    const TrackingResult r = mode.result();
+    EXPECT_LE(r.max_error_m, 101.0) << c.name;
+    EXPECT_LE(r.settle_time_s, sc.duration) << c.name;
+    EXPECT_EQ(summary.find("tracking RMS 0.0000"), std::string::npos) << c.name;
+    expect_bounded_lines(summary);
+  }
+}
+
+// A controller that pauses (0.9 s without a step, less than the link's 1 s timeout) asks
+// nothing of its vehicle meanwhile: the vehicle, which acknowledged every command sent, flies on.
+TEST(TrackingRemote, APauseOfTheControllerIsNotTheVehiclesFault) {
+  TrackingScenario sc = load(kStep);
+  sc.duration = 2.0;
+  const models::Crazyflie model;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state(sc.plant.start),
+                                                 sc.controller.dt, 15, 0.03, 0.03, 1000);
+  ASSERT_TRUE(mode.set_vehicle(&link));
+  for (int k = 0; k < 60; ++k) ASSERT_TRUE(mode.step());
+  link.paused_ns = 900'000'000;
+  while (mode.step()) {
+  }
+  EXPECT_FALSE(mode.lost()) << mode.lost_reason();
+  EXPECT_EQ(mode.steps_done(), mode.steps_total());
+}
+
+// States claiming their command had acted 10 s, in a 4 s flight, are impossible: the vehicle is
+// lost at the first, and the settle time stays within the flight (the feed never places a
+// state after the step that reads it).
+TEST(TrackingRemote, AnAgeLongerThanTheFlightCannotMoveTheSettleTime) {
+  TrackingScenario sc = load(kStep);
+  sc.duration = 4.0;
+  const models::Crazyflie model;
+  TrackingMode mode;
+  ASSERT_TRUE(mode.setup(sc).ok());
+  test::DelayedPlantLink<models::Crazyflie> link(model, model.hover_state(sc.plant.start),
+                                                 sc.controller.dt, 15, 0.03, 0.03, 1000);
+  link.timeout = 0.25;
+  link.mutate = [](std::int64_t, VehicleSample& v) { v.command_age_s = 10.0; };
+  ASSERT_TRUE(mode.set_vehicle(&link));
+  while (mode.step()) {
+  }
+  const TrackingResult r = mode.result();
+  std::printf("%s", mode.summary().c_str());
+  EXPECT_TRUE(mode.lost());
+  EXPECT_EQ(std::string(mode.lost_reason()).rfind("its state claims step 0 had acted 10 s", 0), 0u)
+      << mode.lost_reason();
+  EXPECT_LE(r.settle_time_s, sc.duration + sc.controller.dt);
 }
 
 }  // namespace

@@ -138,11 +138,14 @@ void MiMode::measure_remote(double t) {
     const VehicleSample& v = *r.sample;
     for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
   }
-  if (left_the_world() || (r.heard && r.sample->left_world)) {
+  const VehicleWorld world = VehicleWorld::box(scenario_.arena.min, scenario_.arena.max,
+                                               mi_defaults::kLostMargin);
+  const char* outside = r.heard ? world.outside(x_.head<3>()) : nullptr;
+  if (left_the_world() || outside || (r.heard && r.sample->left_world)) {
     x_ = s.x;  // the last state known inside it
-    lost_reason_ = "it left the arena";
-  } else if (r.silent_s > link_->timeout_s()) {
-    lost_reason_ = "it went silent";
+    lost_reason_ = outside ? outside : "it left the arena";
+  } else if (r.lost) {
+    lost_reason_ = feed_.lost_reason();
   }
   // What is known of the vehicle now: the state predicted to t_k, which the pilot sees, the
   // controller starts from and the score takes.
@@ -229,7 +232,7 @@ bool MiMode::step() {
     s.u = command_;
     const models::MikroKopter::Input u = s.u;
     predictor_.record_sent(u);
-    link_->send(step_, now_ns_, u.data(), models::MikroKopter::nu);
+    feed_.send(*link_, step_, now_ns_, u.data(), models::MikroKopter::nu);
   } else {
     // The command enters the delay line; the rotors get the one sent input_delay ago.
     const std::size_t n = u_delay_.size();
@@ -308,7 +311,9 @@ std::string MiMode::summary() const {
                   lost_at_, mi_defaults::kLostMargin);
     out += buf;
   }
-  if (link_) {
+  if (link_ && feed_.sample_count() == 0) {
+    out += "  remote vehicle: no round trip measured\n";
+  } else if (link_) {
     std::snprintf(buf, sizeof buf, "  remote vehicle: RTT %.1f ms measured, %.1f ms estimated\n",
                   1e3 * feed_.measured_median(), 1e3 * feed_.rtt().estimate());
     out += buf;

@@ -297,15 +297,18 @@ bool TrackingMode::step_remote() {
   const std::int64_t now = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
   const VehicleSample& v = *r.sample;
-  if (r.fresh) sample_at(r.sigma, State(v.x));
   const double t = double(k) * scenario_.controller.dt;
   y_ = r.heard ? State(v.x) : x_init_;
-  if (r.heard && (v.left_world || !y_.allFinite() ||
-                  (y_.head<3>() - scenario_.plant.start).norm() > tracking_defaults::kLostRadius)) {
-    lose(t, "it left the world");
+  const VehicleWorld world =
+      VehicleWorld::ball(scenario_.plant.start, tracking_defaults::kLostRadius);
+  const char* outside = r.heard ? world.outside(y_.head<3>()) : nullptr;
+  if (r.heard && (v.left_world || !y_.allFinite() || outside)) {
+    lose(t, outside ? outside : "it left the world");
     y_ = x_init_;
-  } else if (r.silent_s > link_->timeout_s()) {
-    lose(t, "it went silent");
+  } else if (r.lost) {
+    lose(t, feed_.lost_reason());
+  } else if (r.fresh) {
+    sample_at(r.sigma, State(v.x));  // only states inside the world are scored
   }
   if (lost_) {
     finished_ = true;
@@ -326,7 +329,7 @@ bool TrackingMode::step_remote() {
   control();
   compute_us_ = microseconds_since(t0);
   send();
-  link_->send(k, now, u_.data(), int(u_.size()));
+  feed_.send(*link_, k, now, u_.data(), int(u_.size()));
 
   set_telemetry();
   telemetry_.events |= deadline_event(step_, compute_us_, telemetry_.solved && telemetry_.stats.overrun);
@@ -438,7 +441,9 @@ std::string TrackingMode::summary() const {
   const bool rti = nmpc();
   const bool step = scenario_.reference.kind == TrackingReferenceKind::smooth_step;
   char buf[512];
-  if (r.remote) {
+  if (r.remote && r.rtt_samples == 0) {
+    std::snprintf(buf, sizeof buf, "remote vehicle, no round trip measured");
+  } else if (r.remote) {
     std::snprintf(buf, sizeof buf, "remote vehicle, RTT %.1f ms measured, %.1f ms estimated",
                   1e3 * r.rtt_measured_s, 1e3 * r.rtt_estimated_s);
   } else {
@@ -452,7 +457,15 @@ std::string TrackingMode::summary() const {
                 rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off",
                 r.steps, r.tracking_rms_m, r.max_error_m, r.final_error_m);
   std::string out = buf;
-  if (step) {
+  if (err2_.empty()) {
+    // A remote vehicle whose states never acknowledged a command gave no error to measure.
+    std::snprintf(buf, sizeof buf,
+                  "mixpilot fly: %s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
+                  "  %d steps; tracking not measured: no state of the vehicle followed a command",
+                  scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
+                  rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off", r.steps);
+    out = buf;
+  } else if (step) {
     std::snprintf(buf, sizeof buf, "; overshoot %.4f m, settled at %.2f s", r.overshoot_m,
                   r.settle_time_s);
     out += buf;

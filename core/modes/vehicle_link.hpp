@@ -8,6 +8,7 @@
 //
 // Its calls are made on the control thread, never wait and allocate nothing.
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -32,6 +33,7 @@ struct VehicleSample {
   double command_age_s = 0.0;   // how long that command had acted when the state was measured
   std::int64_t received_ns = 0; // when the sample arrived (VehicleLink::now_ns())
   bool left_world = false;      // the vehicle says it left its world (its state is the last inside)
+  bool ended = false;           // the vehicle says its flight is over
 };
 
 class VehicleLink {
@@ -45,6 +47,13 @@ class VehicleLink {
   virtual void finish() = 0;
   // How long the vehicle may stay silent before it counts as lost [s].
   virtual double timeout_s() const = 0;
+  // States that arrived and were rejected so far (they never reach latest()), and the newest
+  // rejection in words into `text` (at most `size` bytes, "" when none): what a lost vehicle's
+  // reason quotes when its states arrived but none was taken.
+  virtual std::uint64_t rejected() const { return 0; }
+  virtual void describe_rejection(char* text, std::size_t size) const {
+    if (size > 0) text[0] = '\0';
+  }
   // The controller's clock, on which commands are stamped and states received [ns]: the steady
   // clock (a simulated one in tests).
   virtual std::int64_t now_ns() const { return vehicle_clock_ns(); }

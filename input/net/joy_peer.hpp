@@ -4,13 +4,16 @@
 // left x, left y down, right x, right y down, then triggers), so the input settings apply
 // unchanged.
 //
-// A sample reaches the controller only when it is sane: 4 to JoyInput::kMaxAxes axes, each
-// finite and in [-1, 1]; at most JoyInput::kMaxButtons buttons; a stamp neither older than
-// `max_age_s` nor in the future by as much, and not older than the last one taken. Others are
-// rejected and counted by reason. The first writer heard is the pilot; samples of another
-// writer are rejected and counted (the trainer reports a second publisher instead of mixing
-// two), until the pilot's writer has been silent for `handover_s`. A silent peer is an input
-// loss (DevicePilot's timeout).
+// A sample reaches the controller only when it is sane (input/net/peer_checks.hpp): 4 to
+// JoyInput::kMaxAxes axes, each finite and in [-1, 1]; at most JoyInput::kMaxButtons buttons,
+// each 0 or 1; a stamp no older than `max_age_s`, no more than `clock_tolerance_s` ahead of this
+// machine's clock, and not older than the last one taken (whose stamp counts as no later than
+// its arrival, so one sample from the future cannot make later ones stale). Others are
+// rejected and counted by reason, the newest kept in words. The first writer heard is the
+// pilot; samples of another writer are rejected and counted (the trainer reports a second
+// publisher instead of mixing two), until the pilot's writer has been silent for `handover_s`.
+// A silent peer, or one whose samples are all rejected, is an input loss (DevicePilot's
+// timeout).
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -19,6 +22,7 @@
 
 #include "input/latest.hpp"
 #include "input/net/dds.hpp"
+#include "input/net/peer_checks.hpp"
 #include "input/source.hpp"
 
 namespace mixpilot::net {
@@ -30,6 +34,8 @@ struct JoyPeerStats {
   std::uint64_t stale = 0;             // a stamp too old, in the future, or going back
   std::uint64_t other_publisher = 0;   // samples of a second writer
   std::uint32_t publishers = 0;        // writers heard
+  std::string last_rejection;          // the newest rejection in words, "" when none
+  std::uint64_t rejected() const { return bad_value + bad_size + stale + other_publisher; }
   // Publisher stamp → the control step's read of the sample, over the samples the controller
   // used [ms]; 0 when none.
   double latency_p50_ms = 0, latency_p99_ms = 0;
@@ -42,6 +48,7 @@ class JoyPeer final : public input::StickSource {
     std::uint32_t domain = 0;
     std::string topic = "rt/joy";
     double max_age_s = 0.5;
+    double clock_tolerance_s = 0.05;  // a stamp ahead of this machine's clock by more is stale
     double handover_s = 1.0;
   };
 
@@ -74,10 +81,12 @@ class JoyPeer final : public input::StickSource {
   // Reader thread.
   input::StickReading reading_;
   std::uint64_t pilot_writer_ = 0;
-  std::int64_t last_stamp_ns_ = 0, last_taken_ns_ = 0;
+  std::int64_t last_taken_ns_ = 0;
+  JoyCheck check_;
   WritersHeard writers_;
 
-  std::atomic<std::uint64_t> accepted_{0}, bad_value_{0}, bad_size_{0}, stale_{0}, other_{0};
+  std::atomic<std::uint64_t> accepted_{0};
+  RejectionLog rejections_;
   std::atomic<std::uint32_t> publishers_{0};
 
   // Control thread: the latency histogram (0.1 ms bins up to 100 ms, sized once).

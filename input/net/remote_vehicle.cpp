@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/modes/vehicle_feed.hpp"
 #include "input/net/vehicle_topics.hpp"
 #include "input/realtime_priority.hpp"
 
@@ -14,7 +15,6 @@ namespace mixpilot::net {
 namespace {
 
 constexpr int kTake = 16;
-constexpr double kMaxCommandAge = 10.0;  // [s]
 
 }  // namespace
 
@@ -35,7 +35,12 @@ bool RemoteVehicle::start(const Options& options, std::string& error) {
   waitset_ = t.waitset;
   sample_ = VehicleSample{};
   sample_.x.setZero(options.nx);
-  sent_.store(0);
+  sent_.reset();
+  StateCheck::Limits limits;
+  limits.nx = options.nx;
+  limits.max_abs = options.max_abs;
+  limits.max_delay_s = VehicleFeed::kMaxRtt;
+  check_.setup(limits);
   running_ = true;
   thread_ = std::thread([this] { run(); });
   return true;
@@ -56,8 +61,7 @@ bool RemoteVehicle::wait_for_vehicle(double seconds) const {
 }
 
 void RemoteVehicle::send(std::int64_t k, std::int64_t stamp_ns, const double* u, int nu) {
-  sent_stamps_[std::size_t(k % kEchoRing)].store(stamp_ns, std::memory_order_relaxed);
-  sent_.store(k + 1, std::memory_order_release);
+  sent_.note(k, stamp_ns);
   mixpilot_msgs_msg_dds__RotorCommand_ m{};
   m.step = k;
   m.stamp_ns = stamp_ns;
@@ -70,24 +74,25 @@ void RemoteVehicle::send(std::int64_t k, std::int64_t stamp_ns, const double* u,
 void RemoteVehicle::finish() {
   if (finished_.exchange(true) || writer_ <= 0) return;
   mixpilot_msgs_msg_dds__RotorCommand_ m{};
-  m.step = sent_.load();
+  m.step = sent_.sent();
   m.stamp_ns = vehicle_clock_ns();
   m.end = true;
   // Best effort: said three times, so one lost datagram does not leave the vehicle waiting.
   for (int i = 0; i < 3; ++i) dds_write(writer_, &m);
 }
 
-bool RemoteVehicle::echo_known(std::int64_t step, std::int64_t stamp) const {
-  const std::int64_t sent = sent_.load(std::memory_order_acquire);
-  if (step < 0) return step == -1;
-  if (step >= sent || step < sent - kEchoRing) return false;
-  return sent_stamps_[std::size_t(step % kEchoRing)].load(std::memory_order_relaxed) == stamp;
+void RemoteVehicle::describe_rejection(char* text, std::size_t size) const {
+  if (RejectionNote note; rejections_.last(note)) {
+    describe(note, text, size);
+  } else if (size > 0) {
+    text[0] = '\0';
+  }
 }
 
 void RemoteVehicle::run() {
   void* samples[kTake] = {};
   dds_sample_info_t infos[kTake];
-  const auto nx = std::uint32_t(options_.nx);
+  RejectionNote note;
   while (running_.load(std::memory_order_relaxed)) {
     dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(20));
     const int n = dds_take(reader_, samples, infos, kTake, kTake);
@@ -99,37 +104,26 @@ void RemoteVehicle::run() {
       const std::uint64_t writer = infos[i].publication_handle;
       publishers_.store(writers_.note(writer), std::memory_order_relaxed);
       if (vehicle_writer_ != 0 && writer != vehicle_writer_) {
-        other_.fetch_add(1, std::memory_order_relaxed);
+        rejections_.add({Rejection::other_publisher,
+                         "a state of a second vehicle (the first one heard flies)"});
         continue;
       }
-      if (m.x._length != nx) {
-        bad_size_.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      bool sane = std::isfinite(m.command_age_s) && m.command_age_s >= 0.0 &&
-                  m.command_age_s <= kMaxCommandAge;
-      for (std::uint32_t j = 0; j < nx; ++j) sane = sane && std::isfinite(m.x._buffer[j]);
-      if (!sane) {
-        bad_value_.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      if (!echo_known(m.command_step, m.command_stamp_ns)) {
-        unknown_.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      if (sample_.serial != 0 &&
-          (m.stamp_ns <= last_stamp_ns_ || m.command_step < sample_.command)) {
-        stale_.fetch_add(1, std::memory_order_relaxed);
+      const std::int64_t received = vehicle_clock_ns();
+      const StateFields fields{m.stamp_ns,      m.command_step, m.command_stamp_ns,
+                               m.command_age_s, m.status,       m.x._length,
+                               m.x._buffer};
+      if (check_.check(fields, received, sent_, note) != Rejection::none) {
+        rejections_.add(note);
         continue;
       }
       vehicle_writer_ = writer;
-      last_stamp_ns_ = m.stamp_ns;
-      std::copy_n(m.x._buffer, nx, sample_.x.data());
+      std::copy_n(m.x._buffer, m.x._length, sample_.x.data());
       sample_.command = m.command_step;
       sample_.command_stamp_ns = m.command_step >= 0 ? m.command_stamp_ns : 0;
       sample_.command_age_s = m.command_age_s;
       sample_.left_world = m.status == 1;
-      sample_.received_ns = vehicle_clock_ns();
+      sample_.ended = m.status == 2;
+      sample_.received_ns = received;
       ++sample_.serial;
       accepted_.fetch_add(1, std::memory_order_relaxed);
       changed = true;
@@ -145,13 +139,16 @@ void RemoteVehicle::run() {
 RemoteVehicleStats RemoteVehicle::stats() const {
   RemoteVehicleStats s;
   s.accepted = accepted_.load();
-  s.bad_value = bad_value_.load();
-  s.bad_size = bad_size_.load();
-  s.unknown_command = unknown_.load();
-  s.stale = stale_.load();
-  s.other_publisher = other_.load();
+  s.bad_value = rejections_.count(Rejection::bad_value);
+  s.bad_size = rejections_.count(Rejection::bad_size);
+  s.unknown_command = rejections_.count(Rejection::unknown_command);
+  s.stale = rejections_.count(Rejection::stale);
+  s.other_publisher = rejections_.count(Rejection::other_publisher);
   s.publishers = publishers_.load();
-  s.commands_sent = std::uint64_t(sent_.load());
+  s.commands_sent = std::uint64_t(sent_.sent());
+  char text[256];
+  describe_rejection(text, sizeof text);
+  s.last_rejection = text;
   return s;
 }
 

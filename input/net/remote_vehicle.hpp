@@ -5,11 +5,13 @@
 //
 // A reader thread takes the states and hands the newest sane one to the control thread through
 // a triple buffer; the control thread never waits. A state reaches the controller only when it
-// has nx finite values, a finite command age in [0, 10] s, echoes a command this controller sent
-// (step and stamp both match one of the last kEchoRing commands, or −1 before the first), and is
-// newer than the last one taken (measured later on the vehicle's clock, and no earlier command
-// in effect). The first
-// writer heard is the vehicle; states of another writer are rejected and counted. Commands are
+// passes input/net/peer_checks.hpp's StateCheck: nx values, each within what the vehicle can
+// physically have; a known status; an echo of a command this controller sent (step and stamp
+// both match one of the last SentCommands::kRing commands, or step −1, stamp 0, age 0 before
+// the first); a command age no longer than the time since that command left; a stamp in line
+// with the vehicle's other states; newer than the last one taken (a later command, or the same
+// one measured later). The first writer heard is the vehicle; states of another writer are
+// rejected. Every rejection is counted by reason and the newest kept in words. Commands are
 // written best effort on the control thread: one non-blocking send, no queue to wait on.
 #include <array>
 #include <atomic>
@@ -21,28 +23,41 @@
 #include "core/modes/vehicle_link.hpp"
 #include "input/latest.hpp"
 #include "input/net/dds.hpp"
+#include "input/net/peer_checks.hpp"
 
 namespace mixpilot::net {
 
 struct RemoteVehicleStats {
   std::uint64_t accepted = 0;
-  std::uint64_t bad_value = 0;        // a non-finite state value, a command age outside [0, 10] s
+  std::uint64_t bad_value = 0;        // not finite, not a physical state, an unknown status
   std::uint64_t bad_size = 0;         // not nx state values
   std::uint64_t unknown_command = 0;  // echoes a command this controller did not send
-  std::uint64_t stale = 0;            // not measured after the last state taken
+  std::uint64_t stale = 0;            // an impossible age or stamp, not after the last taken
   std::uint64_t other_publisher = 0;  // states of a second writer
   std::uint32_t publishers = 0;       // writers heard
   std::uint64_t commands_sent = 0;
+  std::string last_rejection;         // the newest rejection in words, "" when none
+  std::uint64_t rejected() const {
+    return bad_value + bad_size + unknown_command + stale + other_publisher;
+  }
 };
 
 class RemoteVehicle final : public VehicleLink {
  public:
-  static constexpr int kEchoRing = 128;  // sent commands an echo is checked against
+  static constexpr int kEchoRing = SentCommands::kRing;  // sent commands an echo is checked against
+  using StateBounds = std::array<double, StateCheck::kMaxState>;
+  // |x_i| ≤ 1e6 for every i: only what no vehicle state can be.
+  static StateBounds any_state() {
+    StateBounds b;
+    b.fill(1e6);
+    return b;
+  }
 
   struct Options {
     std::uint32_t domain = 0;
     int nx = 13;              // the model's state size
     double timeout_s = 0.25;  // silent this long: the vehicle is lost
+    StateBounds max_abs = any_state();  // beyond these a state value is not physical
   };
 
   RemoteVehicle() = default;
@@ -59,13 +74,14 @@ class RemoteVehicle final : public VehicleLink {
   void send(std::int64_t k, std::int64_t stamp_ns, const double* u, int nu) override;
   void finish() override;
   double timeout_s() const override { return options_.timeout_s; }
+  std::uint64_t rejected() const override { return rejections_.total(); }
+  void describe_rejection(char* text, std::size_t size) const override;
 
   bool heard() const { return heard_.load(std::memory_order_acquire); }
   RemoteVehicleStats stats() const;
 
  private:
   void run();
-  bool echo_known(std::int64_t step, std::int64_t stamp) const;
 
   Options options_;
   Participant participant_;
@@ -73,18 +89,16 @@ class RemoteVehicle final : public VehicleLink {
   std::thread thread_;
   std::atomic<bool> running_{false}, heard_{false}, finished_{false};
   input::Latest<VehicleSample> for_control_;
-  // Sent commands, for the echo check: stamp of step k at k mod kEchoRing, written before sent_.
-  std::array<std::atomic<std::int64_t>, kEchoRing> sent_stamps_{};
-  std::atomic<std::int64_t> sent_{0};
+  SentCommands sent_;  // for the echo check
 
   // Reader thread.
   VehicleSample sample_;
   std::uint64_t vehicle_writer_ = 0;
-  std::int64_t last_stamp_ns_ = 0;  // the vehicle's clock at the last state taken
+  StateCheck check_;
   WritersHeard writers_;
 
-  std::atomic<std::uint64_t> accepted_{0}, bad_value_{0}, bad_size_{0}, unknown_{0}, stale_{0},
-      other_{0};
+  std::atomic<std::uint64_t> accepted_{0};
+  RejectionLog rejections_;
   std::atomic<std::uint32_t> publishers_{0};
 };
 

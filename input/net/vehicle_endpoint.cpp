@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/modes/vehicle_link.hpp"
 #include "input/net/vehicle_topics.hpp"
 
 namespace mixpilot::net {
@@ -11,12 +12,19 @@ namespace {
 constexpr int kTake = 32;
 }  // namespace
 
-bool VehicleEndpoint::open(std::uint32_t domain, int nu, std::string& error) {
+bool VehicleEndpoint::open(std::uint32_t domain, const CommandCheck::Limits& limits,
+                           std::string& error) {
+  const int nu = limits.nu;
   if (nu < 1 || nu > VehicleCommand::kMaxInputs) {
     error = "a vehicle of " + std::to_string(nu) + " inputs is not supported";
     return false;
   }
+  if (!(limits.dt > 0.0) || !(limits.u_max > limits.u_min)) {
+    error = "a vehicle needs a positive control period and rotor limits";
+    return false;
+  }
   nu_ = nu;
+  check_.setup(limits);
   // Cyclone's threads inherit the vehicle loop's real-time priority (app/vehicle.cpp).
   if (!participant_.open(domain, error)) return false;
   VehicleTopics t;
@@ -31,6 +39,7 @@ void VehicleEndpoint::wait(std::int64_t timeout_ns, std::vector<VehicleCommand>&
   if (timeout_ns > 0) dds_waitset_wait(waitset_, nullptr, 0, timeout_ns);
   void* samples[kTake] = {};
   dds_sample_info_t infos[kTake];
+  RejectionNote note;
   const int n = dds_take(reader_, samples, infos, kTake, kTake);
   for (int i = 0; i < n; ++i) {
     if (!infos[i].valid_data) continue;
@@ -38,7 +47,8 @@ void VehicleEndpoint::wait(std::int64_t timeout_ns, std::vector<VehicleCommand>&
     const std::uint64_t writer = infos[i].publication_handle;
     stats_.publishers = writers_.note(writer);
     if (controller_ != 0 && writer != controller_) {
-      ++stats_.other_publisher;
+      rejections_.add({Rejection::other_publisher,
+                       "a command of a second controller (the first one heard flies)"});
       continue;
     }
     if (m.end) {
@@ -46,20 +56,12 @@ void VehicleEndpoint::wait(std::int64_t timeout_ns, std::vector<VehicleCommand>&
       out.push_back(VehicleCommand{m.step, m.stamp_ns, true, {}});
       continue;
     }
-    if (m.u._length != std::uint32_t(nu_)) {
-      ++stats_.bad_size;
-      continue;
-    }
-    if (!std::all_of(m.u._buffer, m.u._buffer + nu_, [](double v) { return std::isfinite(v); })) {
-      ++stats_.bad_value;
-      continue;
-    }
-    if (m.step <= last_step_) {
-      ++stats_.stale;
+    const CommandFields fields{m.step, m.stamp_ns, m.u._length, m.u._buffer};
+    if (check_.check(fields, vehicle_clock_ns(), note) != Rejection::none) {
+      rejections_.add(note);
       continue;
     }
     controller_ = writer;
-    last_step_ = m.step;
     ++stats_.accepted;
     VehicleCommand c{m.step, m.stamp_ns, false, {}};
     std::copy_n(m.u._buffer, nu_, c.u.begin());
@@ -78,6 +80,20 @@ void VehicleEndpoint::publish(const VehicleStateOut& s) {
   m.x._length = m.x._maximum = std::uint32_t(s.nx);
   m.x._buffer = const_cast<double*>(s.x);
   if (dds_write(writer_, &m) >= 0) ++stats_.states_sent;
+}
+
+VehicleEndpointStats VehicleEndpoint::stats() const {
+  VehicleEndpointStats s = stats_;
+  s.bad_value = rejections_.count(Rejection::bad_value);
+  s.bad_size = rejections_.count(Rejection::bad_size);
+  s.stale = rejections_.count(Rejection::stale);
+  s.other_publisher = rejections_.count(Rejection::other_publisher);
+  if (RejectionNote note; rejections_.last(note)) {
+    char text[256];
+    describe(note, text, sizeof text);
+    s.last_rejection = text;
+  }
+  return s;
 }
 
 std::uint32_t VehicleEndpoint::controllers() const {
