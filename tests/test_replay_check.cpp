@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -87,6 +88,13 @@ TEST(ReplayCheck, AnEarlierCommandChangesTheStates) {
     if (!same && first_different == 0) first_different = std::size_t(s.step);
   }
   EXPECT_EQ(first_different, 41u);  // the state after the changed command acted
+}
+
+// λ is compared too: a recording whose λ alone was changed (by the last bit) does not replay.
+TEST(ReplayCheck, ARecordedLambdaIsCovered) {
+  RecordingContents rec = record(kMi, 1.5, "novice");
+  rec.lambda[60].lambda = std::nextafter(rec.lambda[60].lambda, 2.0);
+  EXPECT_EQ(replay(rec, kMi), "the lambda of step 60 differs from the recorded one");
 }
 
 TEST(ReplayCheck, AMissingStepIsCaught) {

@@ -4,6 +4,7 @@
 // the input lost and under the safe controller.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -94,6 +95,31 @@ TEST(ScoreFormula, EveryFieldAsWorkedOutByHand) {
   // 100 · progress · (0.4 time_in_ball + 0.4 mean_lambda + 0.2 exp(−override / 0.1)) /
   // (1 + collisions) = 100 · 0.5 · (0.24 + 0.2 + 0.2 · exp(−0.894427)) / 3.
   EXPECT_NEAR(s.skill, 8.69613906599268, 1e-9);
+}
+
+// Progress counts a waypoint as flown when the vehicle came within r of it at most 1 s before
+// or after (README): a vehicle that trails the reference by exactly 1 s flies every waypoint
+// but the last one's second, one that trails by 1.5 s none but the first.
+TEST(ScoreFormula, ProgressForgivesALagOfOneSecondAndNoMore) {
+  Scenario sc = scenario();
+  sc.arena.obstacles.clear();
+  sc.duration = 5.0;  // 10 steps of 0.5 s
+  const auto progress_with_lag = [&](int lag_steps) {
+    ScoreAccumulator acc(sc);
+    for (int k = 0; k < 10; ++k) {
+      Telemetry s;
+      s.x = Eigen::VectorXd::Zero(16);
+      s.reference = Eigen::Vector3d(1 + k, 1, 1);
+      s.x.head<3>() = Eigen::Vector3d(1 + std::max(0, k - lag_steps), 1, 1);
+      s.stats.total_us = 1.0;
+      (void)acc.add(s);
+    }
+    return acc.finish().progress;
+  };
+  // Lag 2 steps (1 s): waypoints 0..7 are reached within the window (8 of 10).
+  EXPECT_DOUBLE_EQ(progress_with_lag(2), 0.8);
+  // Lag 3 steps (1.5 s): only waypoint 0, where the vehicle waits, is reached.
+  EXPECT_DOUBLE_EQ(progress_with_lag(3), 0.1);
 }
 
 // The skill's weights one at a time, on a flight that is perfect but for one quantity.
