@@ -254,9 +254,12 @@ TEST(Scenario, OutOfRange) {
             "-3.0, 0.0] .. [3.0, 3.0, 3.0], got [0.0, 0.0, 9.0]");
   EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.0\n"),
             "t.toml:7:10: arena.obstacles[0].radius: value outside (0, 100], got 0.0");
+  // The ball B around the reference and the vehicle in it keep clear of the ceiling: r + r_v
+  // = 0.175 + 0.3 m below z = 3, which the climb reaches at t = (2.525 − 0.5) / 0.2 s.
   EXPECT_EQ(error_of("[reference]\nclimb_rate = 0.2\n"),
-            "t.toml:5:1: reference: expected a helix inside the arena over [0, duration], but "
-            "it leaves it at t = 12.500 s, at (-0.331, -0.944, 3.000)");
+            "t.toml:5:1: reference: expected a helix at least 0.475 m (controller.ph.r + "
+            "controller.vehicle_radius) inside the arena over [0, duration], but it comes closer "
+            "to the arena's ceiling at t = 10.125 s, at (-0.920, -0.391, 2.525)");
 }
 
 TEST(Scenario, MissingRequiredKey) {
