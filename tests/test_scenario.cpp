@@ -208,6 +208,30 @@ TEST(Scenario, WrongType) {
             "got 1");
 }
 
+// Text from the file reaches a terminal only escaped: a string value, a key or a pilot name
+// holding an escape sequence shows as \x1B, never as the sequence itself. Names (which end up
+// in summaries and file names) may not hold control characters at all.
+TEST(Scenario, ControlCharactersNeverReachTheTerminal) {
+  std::string error;
+  EXPECT_FALSE(parse_scenario("name = \"a\\u001b[2Jb\"\nmode = \"mixed_initiative\"\n"
+                              "model = \"mikrokopter\"\npilot = \"reckless\"\n",
+                              "t.toml", error));
+  EXPECT_EQ(error, "t.toml:1:8: name: expected a string without control characters, got the "
+                   "string \"a\\x1B[2Jb\"");
+  EXPECT_EQ(error_of("[controller]\nobstacle_form = \"\\u001b[31mlcl\\u0007\"\n"),
+            "t.toml:6:17: controller.obstacle_form: expected one of \"lcl\", \"squared\", "
+            "got the string \"\\x1B[31mlcl\\x07\"");
+  EXPECT_EQ(error_of("\"\\u009b2J\" = 1\n").rfind("t.toml:5:1: \\xC2\\x9B2J: unknown key", 0), 0u)
+      << error_of("\"\\u009b2J\" = 1\n");
+  for (const std::string body : {"[pilots.\"\\u001b]0;x\\u0007\"]\nq5 = \"x\"\n",
+                                 "x = \"\\u001b\"\n", "[reference]\nradius = \"\\u001b\"\n"}) {
+    const std::string e = error_of(body);
+    EXPECT_FALSE(e.empty());
+    EXPECT_EQ(e.find('\x1b'), std::string::npos) << e;
+    EXPECT_EQ(e.find('\x07'), std::string::npos) << e;
+  }
+}
+
 TEST(Scenario, UnknownKey) {
   EXPECT_EQ(error_of("[controller.ph]\nthetta2 = 50.0\n"),
             "t.toml:6:1: controller.ph.thetta2: unknown key (did you mean \"theta2\"?)");
