@@ -41,10 +41,7 @@ int gamepad_script_command(int argc, char** argv) {
   bool force = false;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("gamepad-script", a + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value("gamepad-script", argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return kExitOk;
@@ -57,13 +54,15 @@ int gamepad_script_command(int argc, char** argv) {
     } else if (!a.empty() && a[0] == '-') {
       usage_error("gamepad-script", "unknown option '" + a + "'");
     } else if (in.empty()) {
-      in = a;
+      in = file_argument("gamepad-script", "a recording", a);
     } else {
       usage_error("gamepad-script", "one recording at a time, got '" + in + "' and '" + a + "'");
     }
   }
   if (in.empty()) usage_error("gamepad-script", "which recording? (mixpilot gamepad-script REC.mcap -o OUT.csv)");
   if (out.empty()) usage_error("gamepad-script", "-o OUT.csv is required");
+  check_not_an_input("gamepad-script", "-o", out,
+                     {{"the recording", in}, {"--input-settings", settings_path}});
   std::string error;
   const auto settings = command_input_settings("gamepad-script", settings_path, error);
   const auto pr = settings ? read_pilot_recording(in, error) : std::nullopt;

@@ -155,7 +155,8 @@ bool save_user_file(const std::string& path, const std::string& text, std::strin
     return false;
   }
   OutputFile f;
-  if (!f.open(path, /*overwrite=*/true, error)) return false;
+  // Read-modify-write of the user's own file: replacing what was read is the point.
+  if (!f.open(path, /*overwrite=*/true, error, InputReplacement::allowed)) return false;
   if (std::fwrite(text.data(), 1, text.size(), f.stream()) != text.size()) {
     error = path + ": cannot write (" + std::strerror(errno) + ")";
     f.discard();
