@@ -9,6 +9,7 @@
 #include "app/commands.hpp"
 #include "app/flight.hpp"
 #include "app/replay.hpp"
+#include "core/numerics/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
@@ -78,8 +79,9 @@ int gamepad_script_command(int argc, char** argv) {
     std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
     return kExitError;
   }
-  std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n", in.c_str(),
-               settings->mode);
+  // The name on one comment line, whatever characters it holds.
+  std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n",
+               escape_controls(in).c_str(), settings->mode);
   std::fprintf(f.stream(), "t,left_x,left_y,right_x,right_y\n");
   for (std::size_t k = 0; k < rec->pilot.size(); ++k) {
     const PilotCommandMsg& m = rec->pilot[k];

@@ -233,7 +233,10 @@ bool McapWriter::close(std::string& error) {
   }
   auto give_up = [&] {
     file_ = nullptr;
-    error = error_ + out_.keep_partial();
+    const std::string note = out_.keep_partial();
+    error = error_ + note;
+    if (!out_.temp_path().empty())  // something was kept
+      error += " (`mixpilot recover " + out_.temp_path() + "` makes a recording of its whole steps)";
     return false;
   };
   if (!error_.empty()) return give_up();

@@ -264,18 +264,20 @@ bool OutputFile::commit(std::string& error, bool keep_partial) {
   }
   // Durable before visible: the data reaches the disk before the name points at it. A write
   // that failed earlier (the caller may not have checked) fails the whole output.
-  errno = 0;
-  if (std::ferror(file_) || std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
-    const int err = errno != 0 ? errno : EIO;
+  const bool failed_before = std::ferror(file_) != 0;
+  if (failed_before || std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
+    const std::string why = failed_before ? std::string("an earlier write failed") : reason(errno);
     abandon();
-    error = temp_path_ + ": write failed: " + reason(err) + partial_note(keep_partial);
+    const std::string note = partial_note(keep_partial);
+    error = path_ + ": write failed: " + why + note;
     return false;
   }
   const int rc = std::fclose(file_);
   file_ = nullptr;
   if (rc != 0) {
     const int err = errno;
-    error = temp_path_ + ": close failed: " + reason(err) + partial_note(keep_partial);
+    const std::string note = partial_note(keep_partial);
+    error = path_ + ": close failed: " + reason(err) + note;
     return false;
   }
   if (overwrite_) {
@@ -288,7 +290,8 @@ bool OutputFile::commit(std::string& error, bool keep_partial) {
       return false;
     }
     if (std::rename(temp_path_.c_str(), target_.c_str()) != 0) {
-      error = path_ + ": cannot move the output into place: " + reason(errno) + complete_note();
+      const std::string why = reason(errno);
+      error = path_ + ": cannot move the output into place: " + why + complete_note();
       return false;
     }
   } else if (::renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, target_.c_str(),

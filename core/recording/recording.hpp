@@ -198,8 +198,6 @@ class SessionRecorder {
   // Writes the "mixpilot_end" Metadata record (steps = the /vehicle/state messages recorded),
   // completes the file and moves it to its path.
   bool close(std::string& error, bool interrupted = false, uint64_t dropped_steps = 0);
-  // Removes the file being written: the session it was for never flew (McapWriter::discard).
-  void discard() { writer_.discard(); }
 
   uint64_t log_time_ns(uint64_t step) const { return step * period_ns_; }
   const McapWriter& writer() const { return writer_; }

@@ -153,15 +153,6 @@ bool RecordingSink::close(std::string& error, bool interrupted) {
   return recorder_.close(error, interrupted, std::uint64_t(dropped_.load()));
 }
 
-void RecordingSink::discard() {
-  if (!open_) return;
-  closing_.store(true, std::memory_order_release);
-  wake_.notify_one();
-  writer_.join();
-  open_ = false;
-  recorder_.discard();
-}
-
 bool ReplayPilot::command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) {
   if (step < 0 || step >= std::int64_t(commands_.size())) return false;
   const PilotCommandMsg& m = commands_[std::size_t(step)];

@@ -53,9 +53,6 @@ class RecordingSink final : public TelemetrySink {
   // "mixpilot_end" record (RecordingEnd: `interrupted` for a flight stopped before its end, the
   // steps recorded and dropped); false with a message if anything failed on the way.
   bool close(std::string& error, bool interrupted = false);
-  // Stops the writer and removes the temporary: for a session that ended before its first
-  // step (a failure while setting up the rest of the run), whose recording is not wanted.
-  void discard();
   // The temporary being written (where a failed or crashed run's data is).
   const std::string& temp_path() const { return recorder_.writer().tmp_path(); }
 

@@ -311,7 +311,11 @@ std::optional<std::string> scenario_mode(std::string_view text, const std::strin
   }
   Section s(d, &root, "", Pos{1, 1});
   std::string mode;
-  if (!s.string("mode", mode, true)) {
+  // Every mode a scenario can name (core/modes/mode.hpp's ModeKind), so an unknown one is
+  // reported where it is written.
+  if (!s.choice("mode", mode,
+                {"mixed_initiative", "pendubot_swingup", "crazyflie_tracking", "obstacle_avoidance"},
+                true)) {
     error = d.str();
     return std::nullopt;
   }

@@ -31,7 +31,8 @@ inline constexpr long long kMaxTextFileBytes = 16ll << 20;
 // "<path>: N bytes, more than ..." otherwise.
 bool read_text_file(const std::string& path, std::string& text, std::string& error);
 
-// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader.
+// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader; an
+// unknown one is an error at its line and column.
 std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
                                          std::string& error);
 
