@@ -21,6 +21,29 @@ void usage_error(const char* command, const std::string& message) {
   std::exit(kExitUsage);
 }
 
+std::string option_value(const char* command, int argc, char** argv, int& i) {
+  const std::string option = argv[i];
+  if (i + 1 >= argc) usage_error(command, option + " needs a value");
+  const std::string value = argv[++i];
+  if (value.empty()) usage_error(command, option + " needs a value, got an empty string");
+  return value;
+}
+
+std::string file_argument(const char* command, const char* what, std::string_view arg) {
+  if (arg.empty()) usage_error(command, std::string("an empty string where ") + what + " is expected");
+  return std::string(arg);
+}
+
+void check_not_an_input(const char* command, const std::string& option, const std::string& output,
+                        const std::vector<std::pair<std::string, std::string>>& inputs) {
+  for (const auto& [input_option, input] : inputs) {
+    if (input.empty() || !same_file(output, input)) continue;
+    const std::string what = input_option.empty() ? std::string("the input") : input_option;
+    usage_error(command, option + " " + output + " is the same file as " + what + " " + input +
+                             ": an output never replaces what the command reads");
+  }
+}
+
 std::optional<double> parse_seconds(std::string_view text, double max) {
   const std::string v(text);
   char* end = nullptr;
@@ -35,11 +58,13 @@ bool write_file(const std::string& path, const std::string& text, bool overwrite
   OutputFile out;
   if (!out.open(path, overwrite, error)) return false;
   if (std::fwrite(text.data(), 1, text.size(), out.stream()) != text.size()) {
-    error = out.temp_path() + ": write failed: " + std::strerror(errno);
+    error = path + ": write failed: " + std::strerror(errno) + "; nothing written";
     out.discard();
     return false;
   }
-  return out.commit(error);
+  // A part of a report or an image is of no use: only a complete file is kept when it cannot
+  // be moved into place.
+  return out.commit(error, /*keep_partial=*/false);
 }
 
 namespace {

@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace mixpilot::cli {
 
@@ -16,14 +18,31 @@ enum ExitCode : int {
   kExitInterrupted = 130,   // SIGINT or SIGTERM ended the flight (what shells report for ^C)
 };
 
+// Prints "mixpilot COMMAND: MESSAGE (see 'mixpilot COMMAND --help')" and exits with kExitUsage.
+// Every command checks its whole command line before it opens any output, so nothing is left
+// behind by this exit.
 [[noreturn]] void usage_error(const char* command, const std::string& message);
+
+// The value of the option argv[i] (i moves past it). A missing value, or an empty one, is a
+// usage error naming the option: an empty file name would otherwise read as "none", the
+// defaults, or the current folder.
+std::string option_value(const char* command, int argc, char** argv, int& i);
+// A positional argument (a file the command reads): an empty one is a usage error.
+std::string file_argument(const char* command, const char* what, std::string_view arg);
+
+// Outputs never replace an input of the same run: a usage error when `output` (given as
+// option `option`) is, by device and inode, the same file as one of `inputs` (option, path),
+// whatever names, links or folders lead to them.
+void check_not_an_input(const char* command, const std::string& option, const std::string& output,
+                        const std::vector<std::pair<std::string, std::string>>& inputs);
 
 // A positive, finite number of seconds no larger than `max`, or nullopt.
 std::optional<double> parse_seconds(std::string_view text, double max);
 
 // Writes `text` to `path` through a unique temporary in the same directory, moved into place
-// (core/recording/output_file.hpp: never over a special file, over an existing file only with
-// `overwrite`).
+// (core/recording/output_file.hpp: never over a special file or an input, over an existing file
+// only with `overwrite`). A failed write leaves nothing; a complete file that cannot be moved
+// into place stays in its temporary, and the message says where.
 bool write_file(const std::string& path, const std::string& text, bool overwrite,
                 std::string& error);
 

@@ -185,7 +185,13 @@ bool is_device_pilot(const std::string& pilot) {
 }
 
 input::InputSettings load_input_settings(const std::string& path, std::string& note) {
-  const std::string file = path.empty() ? input::default_settings_path() : path;
+  std::string why;
+  const std::string file = path.empty() ? input::default_settings_path(&why) : path;
+  if (file.empty()) {
+    note = "no folder for the user's input settings (" + why +
+           "): the default input settings are used";
+    return {};
+  }
   bool exists = false;
   std::string error;
   if (const auto s = input::load_settings(file, exists, error)) return *s;
@@ -302,6 +308,15 @@ Labels report_labels(const Flight& f, bool was_interrupted) {
 }
 
 bool check_outputs(const FlyOptions& o, std::string& error) {
+  const std::vector<std::pair<std::string, std::string>> inputs = {
+      {"--scenario", o.scenario_path},
+      {o.replay ? "the recording" : "--pilot", o.pilot.ends_with(".mcap") ? o.pilot : ""},
+      {"--gamepad-script", o.gamepad_script},
+      {"--input-settings", o.input_settings}};
+  if (!o.record.empty()) check_not_an_input(o.command, "--record", o.record, inputs);
+  if (!o.report.empty()) check_not_an_input(o.command, "--report", o.report, inputs);
+  for (const ScreenshotRequest& shot : o.screenshots)
+    check_not_an_input(o.command, "--screenshot", shot.path, inputs);
   if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
     usage_error(o.command, "--record and --report name the same file '" + o.record + "'");
   for (const std::string* path : {&o.record, &o.report})

@@ -1,4 +1,5 @@
 // mixpilot fly / demo: one session of any mode, as fast as possible.
+#include <algorithm>
 #include <chrono>
 #include <thread>
 #include <cstdio>
@@ -112,6 +113,13 @@ int run_in_window(const FlyOptions& o) {
   if (!shown) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     if (status == kExitOk) status = kExitError;
+  } else {
+    for (const ScreenshotRequest& r : o.screenshots) {
+      if (std::find(shots.begin(), shots.end(), r.path) != shots.end()) continue;
+      std::fprintf(stderr, "mixpilot %s: --screenshot %s: not written, the window closed before "
+                   "t = %s s\n", o.command, r.path.c_str(), seconds_text(r.t).c_str());
+      if (status == kExitOk) status = kExitError;
+    }
   }
   return interrupted() ? kExitInterrupted : status;
 }
@@ -137,11 +145,12 @@ int run_replay_headless(const FlyOptions& o) {
   app.load_replay();
   if (interrupted()) return kExitInterrupted;
   const double end = double(app.replay()->steps()) * app.replay()->dt();
-  int status = kExitOk;
-  for (const ScreenshotRequest& r : o.screenshots) {
+  for (const ScreenshotRequest& r : o.screenshots)  // all checked before the first is written
     if (r.t >= end)
       usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
                                  " s is beyond the recording's end (" + seconds_text(end) + " s)");
+  int status = kExitOk;
+  for (const ScreenshotRequest& r : o.screenshots) {
     app.seek(r.t);
     for (int f = 0; f < 2; ++f) screen->frame([&] { app.build_frame(0.0); });
     if (!write_file(r.path, screen->png(), o.force, error)) {
@@ -173,19 +182,14 @@ int run_fly(const FlyOptions& o) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return status;
   }
+  // Every check that can fail comes before the recording opens: a run that never flies leaves
+  // no file behind.
+  if (!check_outputs(o, error)) {  // again: the flight's own inputs (reference files) are known
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
   Mode& mode = *flight->mode;
   Session session(mode);
-  RecordingSink recorder;
-  if (!o.record.empty()) {
-    // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
-    RecordingSink::Settings rs;
-    if (!o.headless || o.realtime) rs.when_full = RecordingSink::FullRing::drop;
-    if (!recorder.open(o.record, mode, session_info(*flight), error, rs, o.force)) {
-      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-      return kExitError;
-    }
-    session.add_sink(&recorder);
-  }
   for (const ScreenshotRequest& r : o.screenshots)
     if (r.t >= double(mode.steps_total()) * mode.dt())
       usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
@@ -200,16 +204,7 @@ int run_fly(const FlyOptions& o) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
-    // Rendered on this thread (its GL context's): a real-time flight hands the telemetry over
-    // through the runner's ring, so the control thread never renders.
-    if (!o.realtime) session.add_sink(&*screenshots);
   }
-  std::optional<ReplayCheck> check;
-  if (flight->recording) {
-    check.emplace(*flight->recording);
-    session.add_sink(&*check);
-  }
-
   std::optional<net::TelemetryPublisher> publisher;
   if (o.publish) {
     net::use_loopback_unless_configured();
@@ -218,8 +213,27 @@ int run_fly(const FlyOptions& o) {
       std::fprintf(stderr, "mixpilot %s: --publish: %s\n", o.command, error.c_str());
       return kExitError;
     }
-    session.add_sink(&*publisher);
   }
+  RecordingSink recorder;
+  if (!o.record.empty()) {
+    // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
+    RecordingSink::Settings rs;
+    if (!o.headless || o.realtime) rs.when_full = RecordingSink::FullRing::drop;
+    if (!recorder.open(o.record, mode, session_info(*flight), error, rs, o.force)) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+    session.add_sink(&recorder);
+  }
+  // Rendered on this thread (its GL context's): a real-time flight hands the telemetry over
+  // through the runner's ring, so the control thread never renders.
+  if (screenshots && !o.realtime) session.add_sink(&*screenshots);
+  std::optional<ReplayCheck> check;
+  if (flight->recording) {
+    check.emplace(*flight->recording);
+    session.add_sink(&*check);
+  }
+  if (publisher) session.add_sink(&*publisher);
 
   std::optional<HapticSink> haptic;
   if (flight->devices) {
@@ -259,7 +273,7 @@ int run_fly(const FlyOptions& o) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     status = kExitError;
   }
-  std::fputs(mode.summary().c_str(), stdout);
+  std::printf("mixpilot %s: %s", o.command, mode.summary().c_str());
   const double flown = double(mode.steps_done()) * mode.dt();
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
@@ -347,10 +361,7 @@ int fly_command(int argc, char** argv) {
   FlyOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(o.command, std::string(a) + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value(o.command, argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kFlyUsage, stdout);
       return kExitOk;
@@ -443,10 +454,7 @@ int replay_command(int argc, char** argv) {
   o.command = "replay";
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("replay", std::string(a) + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value("replay", argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kReplayUsage, stdout);
       return kExitOk;
@@ -458,7 +466,7 @@ int replay_command(int argc, char** argv) {
     } else if (!a.empty() && a[0] == '-') {
       usage_error("replay", "unknown option '" + std::string(a) + "'");
     } else if (o.pilot.empty()) {
-      o.pilot = std::string(a);
+      o.pilot = file_argument("replay", "a recording", a);
     } else {
       usage_error("replay", "one recording at a time (got '" + o.pilot + "' and '" +
                                 std::string(a) + "')");
@@ -482,6 +490,7 @@ int demo_command() {
   o.scenario_path = dir + "/scenarios/mi_helix.toml";
   o.pilot = "novice";
   o.headless = true;
+  o.command = "demo";
   return run_fly(o);
 }
 

@@ -9,6 +9,7 @@
 #include "app/commands.hpp"
 #include "app/flight.hpp"
 #include "app/replay.hpp"
+#include "core/numerics/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
@@ -41,10 +42,7 @@ int gamepad_script_command(int argc, char** argv) {
   bool force = false;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("gamepad-script", a + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value("gamepad-script", argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return kExitOk;
@@ -57,13 +55,15 @@ int gamepad_script_command(int argc, char** argv) {
     } else if (!a.empty() && a[0] == '-') {
       usage_error("gamepad-script", "unknown option '" + a + "'");
     } else if (in.empty()) {
-      in = a;
+      in = file_argument("gamepad-script", "a recording", a);
     } else {
       usage_error("gamepad-script", "one recording at a time, got '" + in + "' and '" + a + "'");
     }
   }
   if (in.empty()) usage_error("gamepad-script", "which recording? (mixpilot gamepad-script REC.mcap -o OUT.csv)");
   if (out.empty()) usage_error("gamepad-script", "-o OUT.csv is required");
+  check_not_an_input("gamepad-script", "-o", out,
+                     {{"the recording", in}, {"--input-settings", settings_path}});
   std::string error;
   const auto settings = command_input_settings("gamepad-script", settings_path, error);
   const auto pr = settings ? read_pilot_recording(in, error) : std::nullopt;
@@ -79,8 +79,9 @@ int gamepad_script_command(int argc, char** argv) {
     std::fprintf(stderr, "mixpilot gamepad-script: %s\n", error.c_str());
     return kExitError;
   }
-  std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n", in.c_str(),
-               settings->mode);
+  // The name on one comment line, whatever characters it holds.
+  std::fprintf(f.stream(), "# mixpilot gamepad-script of %s (stick mode %d)\n",
+               escape_controls(in).c_str(), settings->mode);
   std::fprintf(f.stream(), "t,left_x,left_y,right_x,right_y\n");
   for (std::size_t k = 0; k < rec->pilot.size(); ++k) {
     const PilotCommandMsg& m = rec->pilot[k];

@@ -49,10 +49,7 @@ int joy_publish_command(int argc, char** argv) {
   double wait_s = 30;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("joy-publish", a + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value("joy-publish", argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return kExitOk;

@@ -45,6 +45,30 @@ constexpr const char* kUsage =
     "exit status: 0 done, 1 bad input or failure, 2 usage, 3 a replay differs from its\n"
     "recording, 130 interrupted\n";
 
+constexpr const char* kDemoUsage =
+    "usage: mixpilot demo\n"
+    "\n"
+    "Flies the shipped scenarios/mi_helix.toml headless with the emulated novice pilot, as fast\n"
+    "as possible, and prints its summary and score: what `mixpilot fly --scenario\n"
+    "<data>/scenarios/mi_helix.toml --pilot novice --headless` does. Nothing is written.\n"
+    "\n"
+    "  -h, --help  show this help\n"
+    "\n"
+    "environment: MIXPILOT_DATA_DIR, the folder holding scenarios/ (see 'mixpilot --help')\n"
+    "\n"
+    "exit status: 0 done, 1 no data folder or a failure, 2 usage, 130 interrupted\n";
+
+constexpr const char* kModelsUsage =
+    "usage: mixpilot models\n"
+    "\n"
+    "Simulates each dynamic model open loop with ERK4 (the Pendubot swinging freely, the\n"
+    "Crazyflie and the MikroKopter at hover for 10 s) and prints its energy or position drift:\n"
+    "a check of the models and the integrator. Nothing is read or written.\n"
+    "\n"
+    "  -h, --help  show this help\n"
+    "\n"
+    "exit status: 0 done, 2 usage\n";
+
 // Open-loop simulation of `seconds` of the model from x0 under constant u with ERK4 at dt.
 template <class M>
 typename M::State simulate(const M& model, typename M::State x, const typename M::Input& u,
@@ -117,7 +141,7 @@ int main(int argc, char** argv) {
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {
-        std::fputs(kUsage, stdout);
+        std::fputs(cmd == "demo" ? kDemoUsage : kModelsUsage, stdout);
         return 0;
       }
       std::fprintf(stderr, "mixpilot %s: unexpected argument '%s'\n", argv[1], argv[2]);

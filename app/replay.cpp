@@ -6,6 +6,7 @@
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
+#include "core/numerics/input_file.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
@@ -21,7 +22,10 @@ const std::string* embedded_scenario(const RecordingContents& rec, const std::st
 
 std::string embedded_scenario_source(const RecordingContents& rec, const std::string& path) {
   const auto it = rec.metadata.find("scenario_path");
-  if (it != rec.metadata.end() && !it->second.empty() && it->second.front() == '/')
+  // A path with control characters is no file anyone saved a scenario in; it would only carry
+  // them into messages.
+  if (it != rec.metadata.end() && !it->second.empty() && it->second.front() == '/' &&
+      escape_controls(it->second) == it->second)
     return it->second;
   return path + " (embedded scenario)";
 }
@@ -88,7 +92,7 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
                                   const std::string& text, const std::string& source,
                                   std::optional<double> duration, std::string& error) {
   if (const auto v = rec.metadata.find("vehicle"); v != rec.metadata.end() && !v->second.empty()) {
-    error = path + " was flown with a remote vehicle (--vehicle " + v->second +
+    error = path + " was flown with a remote vehicle (--vehicle " + printable(v->second) +
             "): its plant ran in another process, so the flight cannot be flown again here";
     return nullptr;
   }

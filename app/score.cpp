@@ -13,6 +13,7 @@
 #include "app/replay.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/score.hpp"
+#include "core/numerics/input_file.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
@@ -71,7 +72,8 @@ ScoreRow score_recording(const std::string& path) {
     return row;
   }
   const auto pilot_meta = rec->metadata.find("pilot");
-  row.pilot = pilot_meta != rec->metadata.end() ? pilot_meta->second : "";
+  // Printed in the table: as the recording says it, made printable.
+  row.pilot = pilot_meta != rec->metadata.end() ? escape_controls(pilot_meta->second) : "";
   row.mode = to_string(mode->kind());
   row.scenario = mode->scenario_name();
   Session session(*mode);
@@ -104,16 +106,14 @@ int score_command(int argc, char** argv) {
       std::fputs(kScoreUsage, stdout);
       return kExitOk;
     } else if (a == "--jobs") {
-      if (i + 1 >= argc) usage_error("score", "--jobs needs a value");
-      const std::string v = argv[++i];
+      const std::string v = option_value("score", argc, argv, i);
       char* end = nullptr;
       const long n = std::strtol(v.c_str(), &end, 10);
       if (end == v.c_str() || *end != '\0' || n < 1 || n > 256)
         usage_error("score", "--jobs expects a whole number from 1 to 256, got '" + v + "'");
       jobs = int(n);
     } else if (a == "--json") {
-      if (i + 1 >= argc) usage_error("score", "--json needs a value");
-      json_path = argv[++i];
+      json_path = option_value("score", argc, argv, i);
     } else if (a == "--allow-mismatch") {
       allow_mismatch = true;
     } else if (a == "--force") {
@@ -121,10 +121,15 @@ int score_command(int argc, char** argv) {
     } else if (a.size() > 1 && a[0] == '-') {
       usage_error("score", "unknown option '" + std::string(a) + "'");
     } else {
-      files.emplace_back(a);
+      files.push_back(file_argument("score", "a recording", a));
     }
   }
   if (files.empty()) usage_error("score", "no recordings given");
+  if (!json_path.empty()) {
+    std::vector<std::pair<std::string, std::string>> inputs;
+    for (const std::string& f : files) inputs.emplace_back("the recording", f);
+    check_not_an_input("score", "--json", json_path, inputs);
+  }
   if (!json_path.empty()) {
     std::string error;
     if (!check_output_path(json_path, force, error)) {

@@ -41,13 +41,18 @@ std::vector<std::string> shipped_scenarios() {
   return out;
 }
 
-// Where the app's recordings go: $XDG_DATA_HOME/mixpilot/recordings (~/.local/share/...).
-fs::path recordings_folder() {
-  if (const char* x = std::getenv("XDG_DATA_HOME"); x && *x == '/')
-    return fs::path(x) / "mixpilot" / "recordings";
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return fs::path(home) / ".local" / "share" / "mixpilot" / "recordings";
-  return fs::current_path() / "mixpilot-recordings";
+// Where the app's recordings go: $XDG_DATA_HOME/mixpilot/recordings (~/.local/share/...);
+// "" with `why` when the user has no home folder.
+fs::path recordings_folder(std::string* why = nullptr) {
+  const std::string base = xdg_dir("XDG_DATA_HOME", ".local/share", why);
+  return base.empty() ? fs::path() : fs::path(base) / "mixpilot" / "recordings";
+}
+
+// A scenario or pilot name as part of a file name: one name, never a path.
+std::string file_name_part(std::string name) {
+  for (char& c : name)
+    if (c == '/' || c == '\0') c = '_';
+  return name == "." || name == ".." ? "_" : name;
 }
 
 bool is_flying(const LiveFlight& f) { return f.started && f.runner->running(); }
@@ -59,7 +64,9 @@ Trainer::Trainer(FlyOptions o) : options_(std::move(o)) {
       options_.input_settings.empty() ? input::default_settings_path() : options_.input_settings;
   input_settings_ = load_input_settings(input_settings_path_, input_.note);
   if (!input_.note.empty())
-    say(input_settings_path_ + " has errors: the default input settings are used (I shows them)",
+    say(input_settings_path_.empty()  // no home folder: the note says so
+            ? input_.note
+            : input_settings_path_ + " has errors: the default input settings are used (I shows them)",
         true);
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
@@ -91,7 +98,9 @@ std::string Trainer::next_record_path() const {
   std::string name = live_ ? live_->flight.mode->scenario_name() : "flight";
   if (live_ && !live_->flight.pilot.empty() && !live_->flight.recording)
     name += "-" + live_->flight.pilot;
-  return (recordings_folder() / (name + "-" + stamp + ".mcap")).string();
+  const fs::path folder = recordings_folder();
+  if (folder.empty()) return "";
+  return (folder / file_name_part(name + "-" + stamp + ".mcap")).string();
 }
 
 std::shared_ptr<input::Gamepad> Trainer::gamepad(std::string& error) {
@@ -208,6 +217,13 @@ void Trainer::start() {
   live_->waiting = false;
   if (choices_.record) {
     const std::string path = next_record_path();
+    if (path.empty()) {
+      std::string why;
+      recordings_folder(&why);
+      say("cannot record: no folder for recordings (" + why + "); set XDG_DATA_HOME or fly "
+          "without recording", true);
+      return;
+    }
     std::error_code ec;
     if (path != options_.record) fs::create_directories(fs::path(path).parent_path(), ec);
     RecordingSink::Settings rs;
@@ -566,7 +582,7 @@ int Trainer::finish() {
   int status = status_;
   if (replay_) {
     replay_->stop();
-    std::fputs(replay_->mode().summary().c_str(), stdout);
+    std::printf("mixpilot %s: %s", options_.command, replay_->mode().summary().c_str());
     const std::string& diff = replay_->mismatch();
     if (diff.empty()) {
       std::printf("  replay exact: every recorded step reproduced bit for bit\n");
@@ -582,7 +598,15 @@ int Trainer::finish() {
   if (!f.closed) close_live(f);
   while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
   const Mode& mode = *f.flight.mode;
-  std::fputs(mode.summary().c_str(), stdout);
+  if (!f.started || mode.steps_done() == 0) {
+    // The window closed before Start: no flight, so no score (a 0.0 s flight is not one).
+    std::printf("mixpilot %s: %s: not flown (the window was closed before Start)%s\n",
+                options_.command, mode.scenario_name().c_str(),
+                options_.report.empty() ? "" : "; no report written");
+    for (const std::string& path : recorded_) std::printf("  recorded %s\n", path.c_str());
+    return status;
+  }
+  std::printf("mixpilot %s: %s", options_.command, mode.summary().c_str());
   const RealtimeStats st = f.runner->stats();
   std::printf("  %.1f s flown in the window\n", double(mode.steps_done()) * mode.dt());
   print_realtime(st, mode.dt());

@@ -292,10 +292,7 @@ int vehicle_command(int argc, char** argv) {
   Options o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error("vehicle", a + " needs a value");
-      return argv[++i];
-    };
+    const auto value = [&] { return option_value("vehicle", argc, argv, i); };
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return kExitOk;

@@ -1,9 +1,13 @@
 #include "input/mapping_wizard.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <sstream>
 
+#include "core/numerics/input_file.hpp"
+#include "core/scenario/scenario_toml.hpp"
 #include "input/mapping.hpp"
 #include "input/settings.hpp"
 
@@ -189,13 +193,17 @@ std::string MappingWizard::mapping() const {
 
 bool save_mapping(const std::string& path, const std::string& line, std::string& error) {
   const std::string guid = line.substr(0, line.find(','));
+  // The mappings already there are kept; the file is read as every input is (a FIFO or a
+  // device put there must not block the window).
+  std::string text;
+  struct stat st {};
+  if (!path.empty() && ::lstat(path.c_str(), &st) == 0 &&
+      !read_input_file(path, kMaxTextFileBytes, text, error))
+    return false;
   std::string kept;
-  {
-    std::ifstream in(path);
-    std::string l;
-    while (std::getline(in, l))
-      if (!l.starts_with(guid + ",")) kept += l + "\n";
-  }
+  std::istringstream in(normalize_text(text));
+  for (std::string l; std::getline(in, l);)
+    if (!l.starts_with(guid + ",")) kept += l + "\n";
   return save_user_file(path, kept + line + "\n", error);
 }
 

@@ -1,11 +1,14 @@
 #include "input/settings.hpp"
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
 #include "core/recording/output_file.hpp"
+#include "core/scenario/data_files.hpp"
 #include "core/scenario/toml_read.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
@@ -57,8 +60,13 @@ std::optional<InputSettings> parse_settings(std::string_view text, const std::st
   top.num("return_time_s", s.return_time_s, kReturnTime);
   top.num("keyboard_ramp_s", s.keyboard_ramp_s, kKeyboardRamp);
   if (const toml::node* n = top.take("gamepad", false, "a string")) {
-    if (n->is_string()) s.gamepad = n->as_string()->get();
-    else d.add(pos_of(n->source()), "gamepad", "expected a string, got " + describe(*n));
+    if (!n->is_string())
+      d.add(pos_of(n->source()), "gamepad", "expected a string, got " + describe(*n));
+    else if (escape_controls(n->as_string()->get()) != n->as_string()->get())
+      d.add(pos_of(n->source()), "gamepad",
+            "expected a name without control characters, got " + describe(*n));
+    else
+      s.gamepad = n->as_string()->get();
   }
   Section axes = top.sub("axes");
   read_axis(axes.sub("roll"), s.roll);
@@ -81,8 +89,11 @@ std::optional<InputSettings> parse_settings(std::string_view text, const std::st
 
 std::optional<InputSettings> load_settings(const std::string& path, bool& exists,
                                            std::string& error) {
-  std::error_code ec;
-  exists = std::filesystem::exists(path, ec);
+  // Only a name that is not there at all is "no file": a symbolic-link loop, a dangling link or
+  // an unreadable folder is an error the reader names.
+  struct stat st {};
+  exists = !(::lstat(path.c_str(), &st) != 0 && (errno == ENOENT || errno == ENOTDIR) &&
+             !path.empty());
   if (!exists) return InputSettings{};
   std::string text;
   if (!read_text_file(path, text, error)) return std::nullopt;
@@ -131,6 +142,12 @@ std::string to_toml(const InputSettings& s) {
 }
 
 bool save_user_file(const std::string& path, const std::string& text, std::string& error) {
+  if (path.empty()) {  // the user's config folder is unknown (no home folder)
+    std::string why;
+    config_dir(&why);
+    error = "nowhere to save: " + why;
+    return false;
+  }
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (ec) {
@@ -138,7 +155,8 @@ bool save_user_file(const std::string& path, const std::string& text, std::strin
     return false;
   }
   OutputFile f;
-  if (!f.open(path, /*overwrite=*/true, error)) return false;
+  // Read-modify-write of the user's own file: replacing what was read is the point.
+  if (!f.open(path, /*overwrite=*/true, error, InputReplacement::allowed)) return false;
   if (std::fwrite(text.data(), 1, text.size(), f.stream()) != text.size()) {
     error = path + ": cannot write (" + std::strerror(errno) + ")";
     f.discard();
@@ -151,13 +169,17 @@ bool save_settings(const std::string& path, const InputSettings& s, std::string&
   return save_user_file(path, to_toml(s), error);
 }
 
-std::string config_dir() {
-  if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x == '/')
-    return std::string(x) + "/mixpilot";
-  const char* home = std::getenv("HOME");
-  return std::string(home && *home ? home : ".") + "/.config/mixpilot";
+std::string config_dir(std::string* why) {
+  const std::string base = xdg_dir("XDG_CONFIG_HOME", ".config", why);
+  return base.empty() ? base : base + "/mixpilot";
 }
-std::string default_settings_path() { return config_dir() + "/input.toml"; }
-std::string user_mappings_path() { return config_dir() + "/gamecontrollerdb.txt"; }
+std::string default_settings_path(std::string* why) {
+  const std::string dir = config_dir(why);
+  return dir.empty() ? dir : dir + "/input.toml";
+}
+std::string user_mappings_path(std::string* why) {
+  const std::string dir = config_dir(why);
+  return dir.empty() ? dir : dir + "/gamecontrollerdb.txt";
+}
 
 }  // namespace mixpilot::input

@@ -56,8 +56,10 @@ std::string to_toml(const InputSettings& s);
                                  std::string& error);
 
 // $XDG_CONFIG_HOME/mixpilot (default ~/.config/mixpilot): input.toml, gamecontrollerdb.txt.
-std::string config_dir();
-std::string default_settings_path();
-std::string user_mappings_path();
+// "" with `why` when the user has no home folder (core/scenario/data_files.hpp: never the
+// current folder); the paths below are "" then too.
+std::string config_dir(std::string* why = nullptr);
+std::string default_settings_path(std::string* why = nullptr);
+std::string user_mappings_path(std::string* why = nullptr);
 
 }  // namespace mixpilot::input

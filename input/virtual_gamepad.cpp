@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "core/numerics/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/source.hpp"
 
@@ -36,7 +37,8 @@ std::optional<std::vector<ScriptRow>> parse_script(const std::string& text,
                                                    const std::string& name,
                                                    std::string& error) {
   std::vector<ScriptRow> rows;
-  std::istringstream in(text);
+  // Any editor's line ends and byte-order mark read as written.
+  std::istringstream in(normalize_text(text));
   std::string line;
   int n = 0;
   const auto fail = [&](const std::string& what) {
@@ -57,9 +59,9 @@ std::optional<std::vector<ScriptRow>> parse_script(const std::string& text,
     // flies longer than a day.
     if (!number(cells[0], r.t) || r.t < 0 || r.t > kMaxScriptSeconds)
       return fail("expected a time in seconds from 0 to " + std::to_string(int(kMaxScriptSeconds)) +
-                  " first, got \"" + cells[0] + "\"");
+                  " first, got \"" + printable(cells[0]) + "\"");
     if (!rows.empty() && r.t < rows.back().t)
-      return fail("time " + cells[0] + " is earlier than the row before");
+      return fail("time " + printable(cells[0]) + " is earlier than the row before");
     if (cells.size() == 2 && (cells[1] == "unplug" || cells[1] == "plug")) {
       r.kind = cells[1] == "unplug" ? ScriptRow::unplug : ScriptRow::plug;
     } else if (cells.size() == 5 || cells.size() == 7) {
@@ -68,7 +70,7 @@ std::optional<std::vector<ScriptRow>> parse_script(const std::string& text,
         const bool trigger = i >= 5;
         if (!number(cells[i], v) || v < (trigger ? 0.0 : -1.0) || v > 1.0)
           return fail("column " + std::to_string(i + 1) + ": expected a number in " +
-                      (trigger ? "[0, 1]" : "[-1, 1]") + ", got \"" + cells[i] + "\"");
+                      (trigger ? "[0, 1]" : "[-1, 1]") + ", got \"" + printable(cells[i]) + "\"");
         r.values[i - 1] = float(v);
       }
     } else {

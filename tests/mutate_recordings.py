@@ -11,10 +11,12 @@ and 8-byte overwrites with boundary values. Each variant goes through `mixpilot 
 replay, check) and `mixpilot recover` under a timeout and a memory limit, classified as:
 
   clean error  exit 1 or 3 with a message naming the file (and a byte offset for a read error)
-  accepted     exit 0, and the JSON report holds only finite numbers
+  accepted     exit 0, and the JSON report holds only finite numbers (recover: and `score`
+               reads the recording it wrote)
   crash        a signal, abort or exit >= 128
   hang         the timeout was reached
-  nonsense     exit 0 with inf/nan in the report, or an error exit without a proper message
+  nonsense     exit 0 with inf/nan in the report, a recovered file `score` refuses, or an error
+               exit without a proper message
 
 Prints `tried / clean error / accepted / crash / hang / nonsense`; exits 1 if any run crashed,
 hung or gave nonsense. --sample K runs a seeded random sample of K variants (the CTest).
@@ -201,6 +203,14 @@ def main():
             for stale in (report, recovered):
                 stale.unlink(missing_ok=True)
             kind, why = run(cmd, args.timeout, memory, path, rep)
+            if cmd_name == "recover" and kind == "accepted":
+                # What recover writes is a recording: `score` reads and replays it.
+                p = subprocess.run([str(binary), "score", str(recovered), "--jobs", "1"],
+                                   capture_output=True, text=True, errors="replace",
+                                   timeout=args.timeout, preexec_fn=limit_memory(memory))
+                if p.returncode not in (0, 3):
+                    kind, why = "nonsense", ("recover wrote a file score refuses: " +
+                                             p.stderr.strip().split("\n")[-1][:200])
             tally.add(kind, f"{cmd_name} {label}", why)
     shutil.rmtree(work, ignore_errors=True)
     return tally.report()

@@ -7,7 +7,8 @@ for an array, its first element mutated too -- and, for each reference CSV, vari
 cells (the same values), rows, header and time grid; it flies each one headless for a short
 time under a timeout and a memory limit. Each run is classified:
 
-  clean error  exit 1 or 2 with a message (`file:line:col: key: ...` or another clear line)
+  clean error  exit 1 or 2 with a message that points into the file (`file:line:col: key: ...`;
+               a reference CSV's error comes through the scenario key that names it)
   accepted     exit 0, and the JSON report holds only finite numbers
   crash        a signal, abort or exit >= 128
   hang         the timeout was reached
@@ -44,7 +45,7 @@ VALUES = [
 ]
 HEADER = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?")
 KEYVAL = re.compile(r"^(\s*)([A-Za-z0-9_\-]+)(\s*=\s*)(.*)$")
-LOCATED = re.compile(r":\d+:\d+: \S+: ")
+LOCATED = re.compile(r":\d+:\d+: (?:TOML syntax|\S+): ")  # file:line:col: key path:
 
 
 def split_value(rest):
@@ -179,7 +180,8 @@ def finite_json(path, allowed_nulls=frozenset()):
     return walk(data)
 
 
-def fly(binary, scenario, workdir, duration, timeout, memory, allowed_nulls=frozenset()):
+def fly(binary, scenario, workdir, duration, timeout, memory, allowed_nulls=frozenset(),
+        located=True):
     report = workdir / "report.json"
     if report.exists():
         report.unlink()
@@ -198,6 +200,8 @@ def fly(binary, scenario, workdir, duration, timeout, memory, allowed_nulls=froz
             return "accepted", ""
         return "nonsense", f"non-finite report (null: {sorted(null_keys(report))})"
     if p.returncode in (1, 2, 3) and err:
+        if located and not LOCATED.search(err):
+            return "nonsense", f"an error that does not point into the file: {err[:200]!r}"
         return "clean error", err.split("\n")[0]
     return "nonsense", f"exit {p.returncode} with message {err[:200]!r}"
 

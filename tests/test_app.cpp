@@ -188,6 +188,30 @@ TEST_F(App, ClickStartThenSpacePausesAndResumes) {
   save_shot(screen_, "finished");
 }
 
+// The window closed before Start: no flight was flown, so the summary says so instead of a
+// 0.0 s flight with a skill of 0; a --report asked for is said not written (there is nothing
+// to score), and none appears.
+TEST_F(App, ClosingBeforeAnyFlightSaysNothingWasFlown) {
+  cli::FlyOptions o = live_options("mi_helix.toml", 3.0);
+  o.report = test::fresh_path("app", "never.json").string();
+  cli::Trainer app(o);
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  frame(app);
+  frame(app);
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(app.finish(), 0);
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("mixpilot fly: mi_helix: not flown (the window was closed before Start); "
+                     "no report written"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("skill"), std::string::npos) << out;
+  EXPECT_EQ(out.find("0.0 s"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(o.report));
+}
+
 // R flies the same scenario again from its start: a new flight, the old one's telemetry gone.
 TEST_F(App, RestartFliesANewFlight) {
   cli::Trainer app(live_options("mi_helix.toml", 2.0));

@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <SDL2/SDL.h>
+#include <pwd.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +35,7 @@
 namespace mixpilot::input {
 namespace {
 
+namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 TEST(Shape, DeadzoneExpoRateAndInversion) {
@@ -245,6 +250,55 @@ TEST(Settings, AMissingFileGivesTheDefaultsAndSavedFilesLoad) {
   EXPECT_EQ(back->max_tilt_deg, 20.0);
 }
 
+// Only a name with nothing behind it is a missing settings file (the defaults); a symbolic-link
+// loop or a dangling link is an error that says what it is.
+TEST(Settings, LinksThatLeadNowhereAreErrorsNotMissingFiles) {
+  const fs::path dir = test::fresh_path("input", "links");
+  fs::create_directories(dir);
+  const fs::path loop = dir / "loop.toml", dangling = dir / "dangling.toml";
+  fs::create_symlink(loop, loop);
+  fs::create_symlink(dir / "nothing.toml", dangling);
+  bool exists = false;
+  std::string error;
+  EXPECT_FALSE(load_settings(loop.string(), exists, error));
+  EXPECT_EQ(error, loop.string() + ": cannot open file (" + std::strerror(ELOOP) + ")");
+  EXPECT_FALSE(load_settings(dangling.string(), exists, error));
+  EXPECT_EQ(error, dangling.string() + ": cannot open file (a symbolic link to a missing file)");
+}
+
+// The user's folders never default to the current folder: HOME unset, empty or relative gives
+// the account's home (or no folder at all, said as such); a relative or empty XDG_CONFIG_HOME
+// is ignored, as the XDG base directory specification says.
+TEST(Settings, TheConfigFolderIsNeverTheCurrentFolder) {
+  const auto restore = [](const char* name, const char* old) {
+    if (old) ::setenv(name, old, 1);
+    else ::unsetenv(name);
+  };
+  const std::string home = std::getenv("HOME") ? std::getenv("HOME") : "";
+  const std::string xdg = std::getenv("XDG_CONFIG_HOME") ? std::getenv("XDG_CONFIG_HOME") : "";
+  const bool had_home = std::getenv("HOME"), had_xdg = std::getenv("XDG_CONFIG_HOME");
+  struct passwd* pw = ::getpwuid(::getuid());
+  ASSERT_TRUE(pw && pw->pw_dir && pw->pw_dir[0] == '/') << "this account has no home folder";
+  const std::string account = pw->pw_dir;
+  for (const char* h : {static_cast<const char*>(nullptr), "", "relative/home", "."}) {
+    for (const char* x : {static_cast<const char*>(nullptr), "", "relative/config"}) {
+      h ? ::setenv("HOME", h, 1) : ::unsetenv("HOME");
+      x ? ::setenv("XDG_CONFIG_HOME", x, 1) : ::unsetenv("XDG_CONFIG_HOME");
+      std::string why;
+      EXPECT_EQ(config_dir(&why), account + "/.config/mixpilot")
+          << "HOME=" << (h ? h : "(unset)") << " XDG_CONFIG_HOME=" << (x ? x : "(unset)");
+      EXPECT_EQ(default_settings_path(), account + "/.config/mixpilot/input.toml");
+    }
+  }
+  ::setenv("HOME", "/home/someone", 1);
+  ::setenv("XDG_CONFIG_HOME", "/etc/xdg-test", 1);
+  EXPECT_EQ(config_dir(), "/etc/xdg-test/mixpilot");
+  ::unsetenv("XDG_CONFIG_HOME");
+  EXPECT_EQ(user_mappings_path(), "/home/someone/.config/mixpilot/gamecontrollerdb.txt");
+  restore("HOME", had_home ? home.c_str() : nullptr);
+  restore("XDG_CONFIG_HOME", had_xdg ? xdg.c_str() : nullptr);
+}
+
 TEST(Latest, TheReaderAlwaysSeesAWholeAndNewerValue) {
   struct Pair {
     std::uint64_t a = 0, b = 0;
@@ -394,6 +448,26 @@ TEST(Script, RowsAndTheirErrors) {
     EXPECT_EQ(error, std::string("s.csv:2: expected a time in seconds from 0 to 86400 first, got \"") +
                          t + "\"");
   }
+}
+
+// A script as any editor writes it (byte-order mark, CR LF, old Mac CR), and errors that never
+// pass a cell's terminal escape sequences on.
+TEST(Script, EditorsLineEndsAndNoEscapesInErrors) {
+  std::string error;
+  for (const std::string nl : {"\n", "\r\n", "\r"}) {
+    const auto rows = parse_script("\xEF\xBB\xBFt,left_x,left_y,right_x,right_y" + nl +
+                                       "0,0,0,0,0" + nl + "0.5,0,-1,0.25,0" + nl + "1,unplug" + nl,
+                                   "s.csv", error);
+    ASSERT_TRUE(rows) << error;
+    ASSERT_EQ(rows->size(), 3u);
+    EXPECT_EQ((*rows)[1].values[1], -1.0f);
+    EXPECT_EQ((*rows)[2].kind, ScriptRow::unplug);
+  }
+  EXPECT_FALSE(parse_script("0,0,0,0,0\n0.1,\x1b[2J,0,0,0\n", "s.csv", error));
+  EXPECT_EQ(error, "s.csv:2: column 2: expected a number in [-1, 1], got \"\\x1B[2J\"");
+  EXPECT_FALSE(parse_script("\x1b]0;owned\x07,0,0,0,0\n", "s.csv", error));
+  EXPECT_EQ(error, "s.csv:1: expected a time in seconds from 0 to 86400 first, got "
+                   "\"\\x1B]0;owned\\x07\"");
 }
 
 // Waits (up to 2 s) for `done`.

@@ -280,20 +280,37 @@ TEST_P(EveryMode, OverrunsInARowHandTheVehicleToTheSafeControllerAndBack) {
 }
 
 // A session length given apart from the file (fly --duration) obeys the file's own rule: the
-// helix reference climbs out of mi_helix_slow's 2.5 m arena at 113.998 s (z = 0.6 + 0.016667 t).
-TEST(MakeMode, ASessionLengthThatTakesTheReferenceOutOfTheArenaIsRefused) {
-  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix_slow.toml";
-  for (const double seconds : {113.9, 300.0}) {
+// helix reference keeps the ball B and the vehicle in it (r + r_v = 0.175 + 0.3 m) clear of the
+// walls, floor and ceiling. mi_helix_slow climbs at 0.016667 m/s from 0.6 m towards its 2.5 m
+// ceiling: it comes within 0.475 m of it at t = (2.025 − 0.6) / 0.016667 ≈ 85.498 s (and would
+// leave the arena at 114 s). mi_helix (1 m in 30 s) allows 42.75 s: a novice flying 57 s of it
+// scraped the ceiling from 36.6 s.
+TEST(MakeMode, ASessionLengthThatTakesTheReferenceNearTheWallsIsRefused) {
+  const std::string dir = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/";
+  struct Case {
+    const char* file;
+    double seconds;
+    const char* refused;  // nullptr: accepted
+  };
+  for (const Case& c : {Case{"mi_helix_slow.toml", 85.4, nullptr},
+                        Case{"mi_helix_slow.toml", 85.6, "ceiling at t = 85.498 s"},
+                        Case{"mi_helix_slow.toml", 300.0, "ceiling at t = 85.498 s"},
+                        Case{"mi_helix.toml", 42.7, nullptr},
+                        Case{"mi_helix.toml", 57.0, "ceiling at t = 42.754 s"}}) {
     ModeRequest request;
-    request.duration = seconds;
+    request.duration = c.seconds;
     std::string error;
-    const auto mode = load_mode(path, std::move(request), error);
-    if (seconds < 114.0) {
-      EXPECT_TRUE(mode) << error;
+    const auto mode = load_mode(dir + c.file, std::move(request), error);
+    if (!c.refused) {
+      EXPECT_TRUE(mode) << c.file << " " << c.seconds << ": " << error;
     } else {
-      EXPECT_FALSE(mode);
-      EXPECT_NE(error.find("flies the reference out of the arena at t = 113.997 s"), std::string::npos)
+      EXPECT_FALSE(mode) << c.file << " " << c.seconds;
+      EXPECT_NE(error.find(std::string("flies the reference closer than 0.475 m (the ball's "
+                                       "radius 0.175 m and the vehicle's 0.300 m) to the "
+                                       "arena's ") + c.refused),
+                std::string::npos)
           << error;
+      EXPECT_NE(error.find("this scenario allows at most"), std::string::npos) << error;
     }
   }
 }

@@ -439,5 +439,30 @@ TEST(TrajectoryCsv, ErrorsNameFileAndLine) {
   for (const auto& p : {short_row, not_number, bad_header, no_last, good}) std::remove(p.c_str());
 }
 
+// A CSV read as any editor or spreadsheet writes it: a UTF-8 byte-order mark, CR LF or old
+// Mac CR line ends; and a cell echoed in an error never carries a terminal escape sequence.
+TEST(TrajectoryCsv, EditorsLineEndsAndNoEscapesInErrors) {
+  std::string error;
+  for (const std::string nl : {"\n", "\r\n", "\r"}) {
+    const std::string path = temp_path("line_ends.csv");
+    write_text(path, "\xEF\xBB\xBFt,x0,x1,u0" + nl + "0,1,2,3" + nl + "0.1,1,2," + nl);
+    const auto ok = read_trajectory_csv(path, error);
+    ASSERT_TRUE(ok) << error;
+    EXPECT_EQ(ok->trajectory.x.size(), 2u);
+    EXPECT_EQ(ok->dt, 0.1);
+    std::remove(path.c_str());
+  }
+  const std::string path = temp_path("escape.csv");
+  write_text(path, "t,x0,x1,u0\n0,1,\x1b[2J\x1b]0;owned\x07,3\n0.1,1,2,\n");
+  EXPECT_FALSE(read_trajectory_csv(path, error));
+  EXPECT_EQ(error.find('\x1b'), std::string::npos) << error;
+  EXPECT_EQ(error.find('\x07'), std::string::npos) << error;
+  EXPECT_NE(error.find("found \"\\x1B[2J\\x1B]0;owned\\x07\""), std::string::npos) << error;
+  write_text(path, "t,x0,\x1b[31mx1,u0\n");
+  EXPECT_FALSE(read_trajectory_csv(path, error));
+  EXPECT_NE(error.find("found \"\\x1B[31mx1\""), std::string::npos) << error;
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace mixpilot

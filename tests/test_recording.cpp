@@ -6,6 +6,7 @@
 // (core/recording/output_file.hpp).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,6 +21,7 @@
 
 #include "core/modes/make_mode.hpp"
 #include "core/modes/session.hpp"
+#include "core/numerics/input_file.hpp"
 #include "core/numerics/version.hpp"
 #include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
@@ -497,7 +499,8 @@ std::vector<MessageKey> message_keys(const McapFile& f) {
 // A recording cut at any byte — every record boundary and points inside records, header to
 // footer — is recovered as a valid recording whose messages are a prefix of the original's:
 // every message whose step was followed by another, all of them when the cut fell after the
-// closing record.
+// closing record. A cut that leaves no whole control step is refused: such a file holds no
+// flight, and `score` could not replay it.
 TEST(Recovery, CutAnywhereRecoversAPrefix) {
   const fs::path src = temp_path("original.mcap");
   {
@@ -534,19 +537,40 @@ TEST(Recovery, CutAnywhereRecoversAPrefix) {
   if (::access("/dev/shm", W_OK) == 0) dir = "/dev/shm";
   const fs::path cut = dir / ("mixpilot_cut_" + std::to_string(::getpid()) + ".mcap.Abc123.tmp");
   const fs::path out = dir / ("mixpilot_recovered_" + std::to_string(::getpid()) + ".mcap");
-  int recovered = 0, refused = 0;
+  int recovered = 0, refused = 0, stepless = 0;
   std::size_t last_kept = 0;
   for (const std::size_t n : cuts) {
     if (n >= bytes.size()) continue;
     std::ofstream(cut, std::ios::binary | std::ios::trunc)
         .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(n));
+    // The whole steps the cut leaves: every message of a step that another step follows
+    // within the cut (all of them after the closing record).
+    std::size_t whole_messages = 0;
+    for (const auto& m : original->messages)
+      if (m.data_offset + m.data_size <= n) ++whole_messages;
+    std::size_t kept_messages = whole_messages;
+    if (n < end_record_end)
+      while (kept_messages > 0 && original->messages[kept_messages - 1].log_time ==
+                                      original->messages[whole_messages - 1].log_time)
+        --kept_messages;
+    std::size_t steps = 0;
+    for (std::size_t i = 0; i < kept_messages; ++i)
+      steps += original->channels.at(original->messages[i].channel_id).topic == "/vehicle/state";
+    fs::remove(out);
     const auto result = recover_recording(cut.string(), out.string(), true, err);
-    if (!result) {  // only a cut inside the magic or Header leaves nothing to recover
+    if (!result) {
       ++refused;
-      ASSERT_LT(n, original->schemas.begin()->second.record_offset) << err;
-      ASSERT_NE(err.find(" at byte "), std::string::npos) << err;
+      EXPECT_FALSE(fs::exists(out)) << "a refused recovery writes nothing";
+      if (n < original->schemas.begin()->second.record_offset) {  // inside the magic or Header
+        ASSERT_NE(err.find(" at byte "), std::string::npos) << err;
+      } else {
+        ++stepless;
+        ASSERT_EQ(steps, 0u) << "cut at " << n << ": " << err;
+        ASSERT_NE(err.find("cut before its first whole control step"), std::string::npos) << err;
+      }
       continue;
     }
+    ASSERT_GT(steps, 0u) << "cut at " << n;
     ++recovered;
     const auto f = read_mcap(out.string(), err);  // strict: a complete file
     ASSERT_TRUE(f) << n << ": " << err;
@@ -586,6 +610,7 @@ TEST(Recovery, CutAnywhereRecoversAPrefix) {
   EXPECT_EQ(last_kept, all.size());
   EXPECT_GT(recovered, 200);
   EXPECT_GT(refused, 0);
+  EXPECT_GT(stepless, 0);
 }
 
 TEST(Recovery, RefusesCompleteFilesAndExistingOutputs) {
@@ -603,18 +628,59 @@ TEST(Recovery, RefusesCompleteFilesAndExistingOutputs) {
   const fs::path cut = temp_path("half.mcap");
   std::ofstream(cut, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
                                              std::streamsize(bytes.size()));
-  // In place only with permission to overwrite.
-  EXPECT_FALSE(recover_recording(cut.string(), cut.string(), false, err));
-  EXPECT_EQ(err, cut.string() + ": " + std::strerror(EEXIST) + " (refusing to overwrite it)");
+  // Never in place, whatever name leads to the file: the cut one stays as evidence, and a
+  // failed rewrite could not lose it.
+  const fs::path alias = temp_path("alias.mcap");
+  fs::create_symlink(cut, alias);
+  for (const fs::path& target : {cut, alias}) {
+    for (const bool overwrite : {false, true}) {
+      EXPECT_FALSE(recover_recording(cut.string(), target.string(), overwrite, err));
+      EXPECT_EQ(err, target.string() + ": the file being recovered; the recovered recording goes "
+                                       "to another file (the cut one stays as it is)");
+    }
+  }
   EXPECT_EQ(slurp(cut), bytes);
-  const auto result = recover_recording(cut.string(), cut.string(), true, err);
+  const fs::path beside = temp_path("half.recovered.mcap");
+  const auto result = recover_recording(cut.string(), beside.string(), false, err);
   ASSERT_TRUE(result) << err;
   EXPECT_EQ(result->steps, 1u);  // steps 0 and 1 whole, step 2 cut: step 1 could be too
-  const auto r = read_recording(cut.string(), err);
+  const auto r = read_recording(beside.string(), err);
   ASSERT_TRUE(r) << err;
   EXPECT_EQ(r->states.size(), 1u);
+  EXPECT_EQ(slurp(cut), bytes);
   EXPECT_FALSE(recover_recording("/dev/zero", temp_path("y.mcap").string(), false, err));
   EXPECT_EQ(err, "/dev/zero: not a regular file (a character device)");
+}
+
+// A second ^C can stop a run after its recording is complete but before the move into place:
+// the temporary then is the whole recording, and `recover` puts it in place as it is.
+TEST(Recovery, ACompleteTemporaryIsPutInPlace) {
+  const fs::path whole = temp_path("finished.mcap");
+  {
+    SessionRecorder rec;
+    std::string err;
+    ASSERT_TRUE(rec.open(whole.string(), kPeriodNs, test_info(), err)) << err;
+    record_session(rec, 4);
+    ASSERT_TRUE(rec.close(err)) << err;
+  }
+  const auto bytes = slurp(whole);
+  const fs::path target = temp_path("stopped.mcap");
+  const fs::path temp = target.string() + ".Qw12Er.tmp";
+  fs::copy_file(whole, temp);
+  std::string err;
+  ASSERT_EQ(default_recovery_path(temp.string()), target.string());
+  const auto result = recover_recording(temp.string(), target.string(), false, err);
+  ASSERT_TRUE(result) << err;
+  EXPECT_TRUE(result->was_complete);
+  EXPECT_EQ(result->steps, 4u);
+  EXPECT_EQ(slurp(target), bytes);          // as it was, byte for byte
+  EXPECT_FALSE(fs::exists(temp));           // its bytes are at the target now
+  // Never over an existing file without permission; the temporary then stays.
+  fs::copy_file(whole, temp);
+  EXPECT_FALSE(recover_recording(temp.string(), target.string(), false, err));
+  EXPECT_NE(err.find("refusing to overwrite"), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(temp));
+  fs::remove(temp);
 }
 
 TEST(Recovery, DefaultOutputPath) {
@@ -871,6 +937,118 @@ TEST(OutputFile, DiscardAndAbandon) {
   EXPECT_FALSE(f.is_open());
   EXPECT_FALSE(f.commit(err));
   EXPECT_FALSE(fs::exists(p));
+}
+
+// An output never replaces a file this process read as an input, by any name: the --force
+// that would turn the recording being scored into its own score is refused. A file read in order
+// to be rewritten (the user's settings) says so.
+TEST(OutputFile, NeverReplacesAnInputOfTheRun) {
+  const fs::path dir = temp_path("inputs");
+  fs::create_directories(dir);
+  const fs::path in = dir / "in.toml";
+  std::ofstream(in) << "x = 1\n";
+  fs::create_symlink(in, dir / "alias.toml");
+  fs::create_hard_link(in, dir / "hard.toml");
+  std::string text, err;
+  ASSERT_TRUE(read_input_file(in.string(), 1000, text, err)) << err;
+  for (const char* name : {"in.toml", "alias.toml", "hard.toml"}) {
+    const std::string path = (dir / name).string();
+    EXPECT_FALSE(check_output_path(path, true, err)) << name;
+    EXPECT_EQ(err, path + ": this run read it as an input (" + in.string() +
+                       "); an output never replaces an input");
+    OutputFile f;
+    EXPECT_FALSE(f.open(path, true, err)) << name;
+  }
+  OutputFile f;
+  ASSERT_TRUE(f.open(in.string(), true, err, InputReplacement::allowed)) << err;
+  ASSERT_TRUE(write_output(f, "x = 2\n"));
+  ASSERT_TRUE(f.commit(err)) << err;
+  EXPECT_EQ(read_all(in), "x = 2\n");
+  // The file at that name now is another one (new inode and change time): no longer an input.
+  OutputFile g;
+  EXPECT_TRUE(g.open(in.string(), true, err)) << err;
+  g.discard();
+}
+
+// A legal name of NAME_MAX bytes leaves no room for ".XXXXXX.tmp": the temporary is named
+// after the name's first part, and the output lands under its full name.
+TEST(OutputFile, NamesAtNameMax) {
+  const fs::path dir = temp_path("long_names");
+  fs::create_directories(dir);
+  const long max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  ASSERT_GT(max, 20);
+  for (const std::size_t length : {std::size_t(max), std::size_t(max) - 6, std::size_t(max) - 11}) {
+    const fs::path p = dir / (std::string(length - 5, 'n') + ".mcap");
+    std::string err;
+    EXPECT_TRUE(check_output_path(p.string(), false, err)) << length << ": " << err;
+    OutputFile f;
+    ASSERT_TRUE(f.open(p.string(), false, err)) << length << ": " << err;
+    EXPECT_LE(fs::path(f.temp_path()).filename().string().size(), std::size_t(max));
+    ASSERT_TRUE(write_output(f, "whole"));
+    ASSERT_TRUE(f.commit(err)) << err;
+    EXPECT_EQ(read_all(p), "whole");
+    EXPECT_TRUE(temporaries_of(p).empty());
+  }
+  // A multi-byte character is never cut in half.
+  const fs::path u =
+      dir / (std::string(std::size_t(max) - 12, 'a') + "\xC3\xA9" + std::string(10, 'b'));
+  OutputFile f;
+  std::string err;
+  ASSERT_TRUE(f.open(u.string(), false, err)) << err;
+  EXPECT_EQ(escape_controls(fs::path(f.temp_path()).filename().string()),
+            fs::path(f.temp_path()).filename().string());
+  f.discard();
+}
+
+// A failure says what became of the output, and only what is true: a temporary whose folder
+// was removed is not "kept", and one that nothing reached (a full disk, here a file-size limit
+// of 0 bytes) is removed instead of being left empty.
+TEST(OutputFile, FailuresSayWhatIsLeft) {
+  const fs::path dir = temp_path("vanishing");
+  fs::create_directories(dir);
+  {
+    OutputFile f;
+    std::string err;
+    ASSERT_TRUE(f.open((dir / "out.mcap").string(), false, err)) << err;
+    const std::string tmp = f.temp_path();
+    ASSERT_TRUE(write_output(f, "data"));
+    fs::remove_all(dir);
+    EXPECT_FALSE(f.commit(err));
+    EXPECT_EQ(err.find("kept in"), std::string::npos) << err;
+    EXPECT_NE(err.find("the output is lost: its temporary " + tmp + " is gone"), std::string::npos)
+        << err;
+  }
+  fs::create_directories(dir);
+  // A full disk: writes fail with EFBIG beyond the limit (SIGXFSZ ignored, as a full disk
+  // sends no signal).
+  struct rlimit old {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  const auto old_handler = ::signal(SIGXFSZ, SIG_IGN);
+  const auto with_limit = [&](rlim_t bytes, std::size_t size, std::string& err, std::string& tmp) {
+    struct rlimit lim = old;
+    lim.rlim_cur = bytes;
+    EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &lim), 0);
+    OutputFile f;
+    EXPECT_TRUE(f.open((dir / "full.mcap").string(), false, err)) << err;
+    tmp = f.temp_path();
+    const std::string big(size, 'x');
+    (void)std::fwrite(big.data(), 1, big.size(), f.stream());
+    const bool ok = f.commit(err);
+    EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &old), 0);
+    return ok;
+  };
+  std::string err, tmp;
+  EXPECT_FALSE(with_limit(0, 1000, err, tmp));
+  EXPECT_EQ(err, (dir / "full.mcap").string() + ": write failed: " + std::strerror(EFBIG) +
+                     "; nothing had reached the disk, so no file is kept");
+  EXPECT_NE(err.find("nothing had reached the disk, so no file is kept"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_FALSE(with_limit(100000, 300000, err, tmp));  // a part reached it: kept for recover
+  EXPECT_NE(err.find("what was written is kept in " + tmp), std::string::npos) << err;
+  EXPECT_GT(fs::file_size(tmp), 0u);
+  fs::remove(tmp);
+  ::signal(SIGXFSZ, old_handler);
+  EXPECT_TRUE(temporaries_of(dir / "full.mcap").empty());
 }
 
 TEST(OutputFile, SameOutputPath) {

@@ -208,6 +208,30 @@ TEST(Scenario, WrongType) {
             "got 1");
 }
 
+// Text from the file reaches a terminal only escaped: a string value, a key or a pilot name
+// holding an escape sequence shows as \x1B, never as the sequence itself. Names (which end up
+// in summaries and file names) may not hold control characters at all.
+TEST(Scenario, ControlCharactersNeverReachTheTerminal) {
+  std::string error;
+  EXPECT_FALSE(parse_scenario("name = \"a\\u001b[2Jb\"\nmode = \"mixed_initiative\"\n"
+                              "model = \"mikrokopter\"\npilot = \"reckless\"\n",
+                              "t.toml", error));
+  EXPECT_EQ(error, "t.toml:1:8: name: expected a string without control characters, got the "
+                   "string \"a\\x1B[2Jb\"");
+  EXPECT_EQ(error_of("[controller]\nobstacle_form = \"\\u001b[31mlcl\\u0007\"\n"),
+            "t.toml:6:17: controller.obstacle_form: expected one of \"lcl\", \"squared\", "
+            "got the string \"\\x1B[31mlcl\\x07\"");
+  EXPECT_EQ(error_of("\"\\u009b2J\" = 1\n").rfind("t.toml:5:1: \\xC2\\x9B2J: unknown key", 0), 0u)
+      << error_of("\"\\u009b2J\" = 1\n");
+  for (const std::string body : {"[pilots.\"\\u001b]0;x\\u0007\"]\nq5 = \"x\"\n",
+                                 "x = \"\\u001b\"\n", "[reference]\nradius = \"\\u001b\"\n"}) {
+    const std::string e = error_of(body);
+    EXPECT_FALSE(e.empty());
+    EXPECT_EQ(e.find('\x1b'), std::string::npos) << e;
+    EXPECT_EQ(e.find('\x07'), std::string::npos) << e;
+  }
+}
+
 TEST(Scenario, UnknownKey) {
   EXPECT_EQ(error_of("[controller.ph]\nthetta2 = 50.0\n"),
             "t.toml:6:1: controller.ph.thetta2: unknown key (did you mean \"theta2\"?)");
@@ -254,9 +278,12 @@ TEST(Scenario, OutOfRange) {
             "-3.0, 0.0] .. [3.0, 3.0, 3.0], got [0.0, 0.0, 9.0]");
   EXPECT_EQ(error_of("[[arena.obstacles]]\ncenter = [0.0, 0.0, 1.0]\nradius = 0.0\n"),
             "t.toml:7:10: arena.obstacles[0].radius: value outside (0, 100], got 0.0");
+  // The ball B around the reference and the vehicle in it keep clear of the ceiling: r + r_v
+  // = 0.175 + 0.3 m below z = 3, which the climb reaches at t = (2.525 − 0.5) / 0.2 s.
   EXPECT_EQ(error_of("[reference]\nclimb_rate = 0.2\n"),
-            "t.toml:5:1: reference: expected a helix inside the arena over [0, duration], but "
-            "it leaves it at t = 12.500 s, at (-0.331, -0.944, 3.000)");
+            "t.toml:5:1: reference: expected a helix at least 0.475 m (controller.ph.r + "
+            "controller.vehicle_radius) inside the arena over [0, duration], but it comes closer "
+            "to the arena's ceiling at t = 10.125 s, at (-0.920, -0.391, 2.525)");
 }
 
 TEST(Scenario, MissingRequiredKey) {

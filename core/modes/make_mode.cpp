@@ -32,11 +32,17 @@ std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& sou
   std::optional<Scenario> scenario = parse_scenario(text, source_name, error);
   if (!scenario) return nullptr;
   if (request.duration) {
-    // The same rule as the file's own duration: the reference stays inside the arena.
-    if (const auto t = reference_leaves_arena(*scenario, *request.duration)) {
+    // The same rule as the file's own duration: the reference keeps the ball and the vehicle
+    // clear of the arena's walls, floor and ceiling.
+    if (const auto b = reference_too_close_to_walls(*scenario, *request.duration)) {
+      char margin[96];
+      std::snprintf(margin, sizeof margin,
+                    "%.3f m (the ball's radius %.3f m and the vehicle's %.3f m)", b->margin,
+                    scenario->controller.ph.r, scenario->controller.vehicle_radius);
       error = source_name + ": a session of " + seconds_text(*request.duration) +
-              " s flies the reference out of the arena at t = " + seconds_text(*t) +
-              " s; this scenario allows at most " + seconds_text(*t) + " s";
+              " s flies the reference closer than " + margin + " to the arena's " + b->face +
+              " at t = " + seconds_text(b->t) + " s; this scenario allows at most " +
+              seconds_text(b->t) + " s";
       return nullptr;
     }
     scenario->duration = *request.duration;

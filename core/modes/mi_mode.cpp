@@ -281,7 +281,7 @@ std::string MiMode::summary() const {
   const Score s = score();
   char buf[768];
   std::snprintf(buf, sizeof buf,
-                "mixpilot fly: %s, pilot %s\n"
+                "%s, pilot %s\n"
                 "  flew %.1f s; RTI median %.0f us, p99 %.0f us, %d deadline misses, %lld "
                 "fallbacks\n"
                 "  lambda mean %.3f (min %.3f); deviation max %.3f m, rms %.3f m; in ball %.1f%%; "

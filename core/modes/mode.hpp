@@ -114,7 +114,9 @@ class Mode {
   virtual const Telemetry& telemetry() const = 0;
   // The mode's metrics so far (the score in mixed initiative). Allocates: not for the loop.
   virtual Metrics metrics() const = 0;
-  // A few human-readable lines about the run so far, for the terminal.
+  // A few human-readable lines about the run so far, for the terminal. The first names the
+  // scenario and mode; the front end that prints it puts its own label before it
+  // ("mixpilot replay: ...").
   virtual std::string summary() const = 0;
 
   // Real-time runs (SPEC §4): a control step whose RTI solve takes longer than `deadline_us`

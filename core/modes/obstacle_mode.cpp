@@ -301,7 +301,7 @@ std::string ObstacleMode::summary() const {
   const ObstacleRunResult r = result();
   char buf[768];
   std::snprintf(buf, sizeof buf,
-                "%s: obstacle avoidance (SPEC 5.3), form %s, %zu spheres, %zu balls, %d steps "
+                "%s (obstacle_avoidance, SPEC 5.3), form %s, %zu spheres, %zu balls, %d steps "
                 "of %.0f ms\n"
                 "  min distance %.4f m (d_C %.3f m, margin %+.4f m) at t = %.3f s (obstacle %d), "
                 "%.4f m at the control instants; violations %d\n"

@@ -396,7 +396,7 @@ std::string PendubotMode::summary() const {
   const double swingup = run.swingup_time.value_or(-1.0);
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "pendubot_swingup %s: %.2f s, %s, NMPC N = %d at dt = %.0f ms%s\n", sc.name.c_str(),
+                "%s (pendubot_swingup): %.2f s, %s, NMPC N = %d at dt = %.0f ms%s\n", sc.name.c_str(),
                 sc.duration, sc.sensor.quantization ? "encoders (quantized)" : "exact state",
                 sc.controller.N, 1e3 * sc.controller.dt, sc.lqr.enabled ? " + LQR" : "");
   std::string out = buf;

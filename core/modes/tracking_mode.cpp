@@ -451,7 +451,7 @@ std::string TrackingMode::summary() const {
   }
   const std::string rtt_text = buf;
   std::snprintf(buf, sizeof buf,
-                "mixpilot fly: %s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
+                "%s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
                 "  %d steps; tracking RMS %.4f m, max %.4f m, final %.4f m",
                 scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
                 rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off",
@@ -460,7 +460,7 @@ std::string TrackingMode::summary() const {
   if (err2_.empty()) {
     // A remote vehicle whose states never acknowledged a command gave no error to measure.
     std::snprintf(buf, sizeof buf,
-                  "mixpilot fly: %s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
+                  "%s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
                   "  %d steps; tracking not measured: no state of the vehicle followed a command",
                   scenario_.name.c_str(), rti ? "NMPC" : "LQR", step ? "smooth step" : "helix",
                   rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off", r.steps);

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
@@ -94,12 +93,11 @@ bool write_trajectory_csv(const std::string& path, const OcpTrajectory& traj, do
 }
 
 std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::string& error) {
-  if (!check_input_file(path, kMaxTrajectoryBytes, error)) return std::nullopt;
-  std::ifstream in(path);
-  if (!in) {
-    error = path + ": cannot open: " + std::strerror(errno);
-    return std::nullopt;
-  }
+  std::string text;
+  if (!read_input_file(path, kMaxTrajectoryBytes, text, error)) return std::nullopt;
+  // Any editor's or spreadsheet's line ends and byte-order mark read as written.
+  std::istringstream in(normalize_text(text));
+  text = std::string();
   std::string line;
   int lineno = 1;
   if (!std::getline(in, line)) {
@@ -132,7 +130,7 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
       std::string expected = "\"" + want_u + "\"";
       if (nu == 0) expected = "\"" + want_x + "\" or " + expected;
       error = where(path, 1) + "column " + std::to_string(c + 1) + ": expected " + expected +
-              ", found \"" + name + "\"";
+              ", found \"" + printable(name) + "\"";
       return std::nullopt;
     }
   }
@@ -177,7 +175,7 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
     for (int c = 0; c < 1 + nx; ++c) {
       if (!parse_number(cells[c], v)) {
         error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" + trim(header[c]) +
-                "): expected a number in [-1e6, 1e6], found \"" + trim(cells[c]) + "\"";
+                "): expected a number in [-1e6, 1e6], found \"" + printable(trim(cells[c])) + "\"";
         return std::nullopt;
       }
       if (c == 0) {
@@ -196,7 +194,7 @@ std::optional<TrajectoryFile> read_trajectory_csv(const std::string& path, std::
         const int c = 1 + nx + j;
         if (!parse_number(cells[c], v)) {
           error = where(path, lineno) + "column " + std::to_string(c + 1) + " (" + trim(header[c]) +
-                  "): expected a number in [-1e6, 1e6], found \"" + trim(cells[c]) + "\"";
+                  "): expected a number in [-1e6, 1e6], found \"" + printable(trim(cells[c])) + "\"";
           return std::nullopt;
         }
         u(j) = v;

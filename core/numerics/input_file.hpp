@@ -11,8 +11,11 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace mixpilot {
 
@@ -31,7 +34,57 @@ inline std::string too_big(const std::string& path, long long size, long long ma
          std::to_string(max_bytes) + " such a file may have";
 }
 
+// Why stat() failed on `path`, said plainly: a symbolic link whose target is missing reads as
+// such, not as "no such file" of the link the user can see.
+inline std::string open_error(const std::string& path, int err) {
+  struct stat l {};
+  if (err == ENOENT && ::lstat(path.c_str(), &l) == 0 && S_ISLNK(l.st_mode))
+    return path + ": cannot open file (a symbolic link to a missing file)";
+  return path + ": cannot open file (" + std::strerror(err) + ")";
+}
+
+// A file as it was read: its change time tells it from a later file that reuses the inode
+// number, and from the same file rewritten since.
+struct ReadFile {
+  dev_t dev;
+  ino_t ino;
+  struct timespec ctime;
+  std::string path;
+
+  bool is(const struct stat& st) const {
+    return dev == st.st_dev && ino == st.st_ino && ctime.tv_sec == st.st_ctim.tv_sec &&
+           ctime.tv_nsec == st.st_ctim.tv_nsec;
+  }
+};
+
+// The files this process has read as inputs (read_input_file(), recordings): an output never
+// replaces one of them (core/recording/output_file.hpp), whatever name it is given by.
+inline std::vector<ReadFile>& files_read(std::unique_lock<std::mutex>& lock) {
+  static std::mutex mutex;
+  static std::vector<ReadFile> files;
+  lock = std::unique_lock<std::mutex>(mutex);
+  return files;
+}
+
 }  // namespace input_file_detail
+
+// Notes that the file `st` describes was read as `path` (see input_read_as()).
+inline void note_input_read(const struct stat& st, const std::string& path) {
+  std::unique_lock<std::mutex> lock;
+  auto& files = input_file_detail::files_read(lock);
+  for (const auto& f : files)
+    if (f.is(st)) return;
+  files.push_back({st.st_dev, st.st_ino, st.st_ctim, path});
+}
+
+// The name under which this process read the file `st` describes as an input, if it did and
+// the file has not changed since.
+inline std::optional<std::string> input_read_as(const struct stat& st) {
+  std::unique_lock<std::mutex> lock;
+  for (const auto& f : input_file_detail::files_read(lock))
+    if (f.is(st)) return f.path;
+  return std::nullopt;
+}
 
 // True when `path` names a regular file of at most max_bytes; otherwise false with
 // "<path>: cannot open file (<system's reason>)", "<path>: expected a regular file, got a
@@ -44,7 +97,7 @@ inline bool check_input_file(const std::string& path, long long max_bytes, std::
   }
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
-    error = path + ": cannot open file (" + std::strerror(errno) + ")";
+    error = input_file_detail::open_error(path, errno);
     return false;
   }
   if (!S_ISREG(st.st_mode)) {
@@ -66,7 +119,7 @@ inline bool read_input_file(const std::string& path, long long max_bytes, std::s
   if (!check_input_file(path, max_bytes, error)) return false;
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) {
-    error = path + ": cannot open file (" + std::strerror(errno) + ")";
+    error = input_file_detail::open_error(path, errno);
     return false;
   }
   struct stat st {};
@@ -94,7 +147,10 @@ inline bool read_input_file(const std::string& path, long long max_bytes, std::s
     }
   }
   ::close(fd);
-  if (ok) text = std::move(out);
+  if (ok) {
+    note_input_read(st, path);
+    text = std::move(out);
+  }
   return ok;
 }
 
@@ -115,10 +171,11 @@ inline std::string normalize_text(std::string_view text) {
   return out;
 }
 
-// `text` safe to print inside quotes: control characters and bytes that are not UTF-8 appear
-// as \xNN (escape sequences never reach the terminal), a quote as \", and anything beyond
-// max_chars is cut with "…".
-inline std::string printable(std::string_view text, std::size_t max_chars = 60) {
+namespace input_file_detail {
+
+// `text` with control characters and bytes that are not UTF-8 as \xNN; with `quoted`, a quote
+// and a backslash escaped too (the text is shown inside quotes); cut at max_chars with "…".
+inline std::string escaped(std::string_view text, std::size_t max_chars, bool quoted) {
   std::string out;
   std::size_t chars = 0;
   const auto hex = [&](unsigned char c) {
@@ -143,7 +200,7 @@ inline std::string printable(std::string_view text, std::size_t max_chars = 60) 
     } else if (len == 1 && (c < 0x20 || c == 0x7F)) {
       hex(c);
       ++i;
-    } else if (len == 1 && (c == '"' || c == '\\')) {
+    } else if (len == 1 && quoted && (c == '"' || c == '\\')) {
       out += '\\';
       out += char(c);
       ++i;
@@ -156,6 +213,31 @@ inline std::string printable(std::string_view text, std::size_t max_chars = 60) 
       i += len;
     }
     ++chars;
+  }
+  return out;
+}
+
+}  // namespace input_file_detail
+
+// `text` safe to print inside quotes: control characters and bytes that are not UTF-8 appear
+// as \xNN (escape sequences never reach the terminal), a quote as \", and anything beyond
+// max_chars is cut with "…".
+inline std::string printable(std::string_view text, std::size_t max_chars = 60) {
+  return input_file_detail::escaped(text, max_chars, true);
+}
+
+// A whole message safe for a terminal: control characters and bytes that are not UTF-8 as
+// \xNN, the rest (quotes included) as it is; line breaks stay when `multiline` (the lines of a
+// multi-line message). For messages that carry text from a file or a recording.
+inline std::string escape_controls(std::string_view text, bool multiline = false) {
+  std::string out;
+  out.reserve(text.size());
+  while (true) {
+    const std::size_t nl = multiline ? text.find('\n') : std::string_view::npos;
+    out += input_file_detail::escaped(text.substr(0, nl), std::string_view::npos, false);
+    if (nl == std::string_view::npos) break;
+    out += '\n';
+    text.remove_prefix(nl + 1);
   }
   return out;
 }

@@ -14,6 +14,7 @@
 #include <set>
 #include <utility>
 
+#include "core/numerics/input_file.hpp"
 #include "core/numerics/version.hpp"
 
 namespace mixpilot {
@@ -214,6 +215,11 @@ bool McapWriter::write_metadata(std::string_view name, const McapStringMap& meta
   return true;
 }
 
+void McapWriter::discard() {
+  out_.discard();
+  file_ = nullptr;
+}
+
 bool McapWriter::flush() {
   if (file_ == nullptr) return false;
   if (std::fflush(file_) != 0) return fail(tmp_path() + ": flush failed: " + std::strerror(errno));
@@ -226,9 +232,11 @@ bool McapWriter::close(std::string& error) {
     return false;
   }
   auto give_up = [&] {
-    out_.abandon();
     file_ = nullptr;
-    error = error_ + " (partial recording kept in " + tmp_path() + ")";
+    const std::string note = out_.keep_partial();
+    error = error_ + note;
+    if (!out_.temp_path().empty())  // something was kept
+      error += " (`mixpilot recover " + out_.temp_path() + "` makes a recording of its whole steps)";
     return false;
   };
   if (!error_.empty()) return give_up();
@@ -818,7 +826,10 @@ std::optional<McapFile> parse_mcap(std::vector<uint8_t> bytes, std::string_view 
   McapFile f;
   f.bytes = std::move(bytes);
   Parser p(f, name, options);
-  if (!p.run(error)) return std::nullopt;
+  if (!p.run(error)) {
+    error = escape_controls(error);  // it may quote topics and names from the file
+    return std::nullopt;
+  }
   return f;
 }
 
@@ -870,6 +881,7 @@ std::optional<McapFile> read_mcap(const std::string& path, std::string& error,
             " bytes: " + (read_errno != 0 ? std::strerror(read_errno) : "the file shrank");
     return std::nullopt;
   }
+  note_input_read(st, path);  // no output of this run replaces it
   return parse_mcap(std::move(bytes), path, error, options);
 }
 

@@ -100,8 +100,12 @@ class McapWriter {
   bool flush();
 
   // Writes DataEnd, the summary, SummaryOffsets, Footer and magic, then moves the temporary to
-  // the final path. On failure the temporary stays for inspection or recovery.
+  // the final path. On failure the temporary stays for inspection or recovery (unless nothing
+  // of it reached the disk; the message says which).
   bool close(std::string& error);
+  // Closes and removes the temporary: nothing of this file is wanted (a run that ended before
+  // it began).
+  void discard();
 
   bool is_open() const { return file_ != nullptr; }
   const std::string& error() const { return error_; }

@@ -11,6 +11,8 @@
 #include <random>
 #include <system_error>
 
+#include "core/numerics/input_file.hpp"
+
 namespace mixpilot {
 
 namespace {
@@ -33,7 +35,7 @@ const char* kind_of(mode_t mode) {
 // create (a symbolic link to a regular file is followed); false with the reason when the path
 // must not be written.
 bool resolve_target(const std::string& path, bool overwrite, std::string& target,
-                    std::string& error) {
+                    std::string& error, InputReplacement inputs = InputReplacement::refused) {
   if (path.empty()) {
     error = "empty output path";
     return false;
@@ -71,6 +73,14 @@ bool resolve_target(const std::string& path, bool overwrite, std::string& target
     error = path + ": not a regular file (" + kind_of(st.st_mode) + ")";
     return false;
   }
+  struct stat file {};
+  if (inputs == InputReplacement::refused && ::stat(path.c_str(), &file) == 0) {
+    if (const auto read_as = input_read_as(file)) {
+      error = path + ": this run read it as an input (" + *read_as +
+              "); an output never replaces an input";
+      return false;
+    }
+  }
   if (!overwrite) {
     error = path + ": " + reason(EEXIST) + " (refusing to overwrite it)";
     return false;
@@ -83,17 +93,41 @@ std::string directory_of(const std::string& target) {
   return dir.empty() ? std::string(".") : dir.string();
 }
 
-// Creates "<target>.XXXXXX.tmp" with O_EXCL (mode 0666 less the umask, like any new file).
+// The longest file name the folder `dir` takes (NAME_MAX of its file system).
+std::size_t name_max(const std::string& dir) {
+  const long n = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  return n > 0 ? std::size_t(n) : 255;
+}
+
+// `name` cut to at most `bytes` bytes, not inside a UTF-8 sequence.
+std::string cut_name(const std::string& name, std::size_t bytes) {
+  if (name.size() <= bytes) return name;
+  std::size_t n = bytes;
+  while (n > 0 && (static_cast<unsigned char>(name[n]) & 0xC0) == 0x80) --n;
+  return name.substr(0, n);
+}
+
+// Creates "<target>.XXXXXX.tmp" with O_EXCL (mode 0666 less the umask, like any new file). A
+// target whose name leaves no room for the suffix gives a temporary named after its first part.
 // Returns the descriptor, or -1 with errno set.
 int create_unique(const std::string& target, std::string& temp_path) {
   static constexpr char kChars[] =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+  static constexpr std::size_t kSuffix = 11;  // ".XXXXXX.tmp"
   thread_local std::mt19937_64 rng(std::random_device{}() ^
                                    (std::uint64_t(::getpid()) << 32));
+  const fs::path t(target);
+  const std::string dir = t.parent_path().empty() ? std::string(".") : t.parent_path().string();
+  const std::size_t room = name_max(dir);
+  const std::string name = t.filename().string();
+  const std::string base =
+      name.size() + kSuffix <= room
+          ? target
+          : (t.parent_path() / cut_name(name, room > kSuffix ? room - kSuffix : 1)).string();
   for (int attempt = 0; attempt < 100; ++attempt) {
     std::string suffix(6, 'x');
     for (char& c : suffix) c = kChars[rng() % (sizeof kChars - 1)];
-    temp_path = target + "." + suffix + ".tmp";
+    temp_path = base + "." + suffix + ".tmp";
     const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0 || errno != EEXIST) return fd;
   }
@@ -137,12 +171,21 @@ bool same_output_path(const std::string& a, const std::string& b) {
          sa.st_ino == sb.st_ino;
 }
 
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa {}, sb {};
+  return !a.empty() && !b.empty() && ::stat(a.c_str(), &sa) == 0 &&
+         ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
 bool link_into_place(const std::string& from, const std::string& to, std::string& error) {
   if (::link(from.c_str(), to.c_str()) != 0) {
     const int err = errno;
+    struct stat st {};
     error = to + ": " + reason(err) +
             (err == EEXIST ? " (it appeared while this run was writing; not replaced)" : "") +
-            "; the output is kept in " + from;
+            (::stat(from.c_str(), &st) == 0
+                 ? "; the output is kept in " + from
+                 : "; the output is lost: " + from + " is gone (its folder was removed or moved)");
     return false;
   }
   ::unlink(from.c_str());  // both names refer to the finished file; the temporary one goes
@@ -151,7 +194,8 @@ bool link_into_place(const std::string& from, const std::string& to, std::string
 
 OutputFile::~OutputFile() { abandon(); }
 
-bool OutputFile::open(const std::string& path, bool overwrite, std::string& error) {
+bool OutputFile::open(const std::string& path, bool overwrite, std::string& error,
+                      InputReplacement inputs) {
   if (file_ != nullptr) {
     error = path + ": output already open on " + path_;
     return false;
@@ -159,7 +203,7 @@ bool OutputFile::open(const std::string& path, bool overwrite, std::string& erro
   path_ = path;
   overwrite_ = overwrite;
   temp_path_.clear();
-  if (!resolve_target(path, overwrite, target_, error)) return false;
+  if (!resolve_target(path, overwrite, target_, error, inputs)) return false;
   std::string temp;
   const int fd = create_unique(target_, temp);
   if (fd < 0) {
@@ -174,26 +218,66 @@ bool OutputFile::open(const std::string& path, bool overwrite, std::string& erro
     return false;
   }
   temp_path_ = std::move(temp);
+  struct stat st {};
+  if (::fstat(fd, &st) == 0) {
+    temp_dev_ = st.st_dev;
+    temp_ino_ = st.st_ino;
+  }
   std::setvbuf(file_, nullptr, _IOFBF, 1 << 16);
   return true;
 }
 
-bool OutputFile::commit(std::string& error) {
+std::string OutputFile::complete_note() const {
+  struct stat st {};
+  if (::lstat(temp_path_.c_str(), &st) == 0 && st.st_dev == temp_dev_ && st.st_ino == temp_ino_)
+    return "; the output is kept in " + temp_path_;
+  return "; the output is lost: its temporary " + temp_path_ +
+         " is gone (its folder was removed or moved while it was written)";
+}
+
+std::string OutputFile::partial_note(bool keep) {
+  struct stat st {};
+  if (::lstat(temp_path_.c_str(), &st) != 0 || st.st_dev != temp_dev_ || st.st_ino != temp_ino_) {
+    const std::string gone = temp_path_;
+    temp_path_.clear();
+    return "; nothing is kept: " + gone +
+           " is gone (its folder was removed or moved while it was written)";
+  }
+  if (st.st_size == 0 || !keep) {
+    ::unlink(temp_path_.c_str());
+    temp_path_.clear();
+    return st.st_size == 0 ? "; nothing had reached the disk, so no file is kept"
+                           : "; the incomplete file was removed";
+  }
+  return "; what was written is kept in " + temp_path_;
+}
+
+std::string OutputFile::keep_partial() {
+  abandon();
+  return temp_path_.empty() ? std::string() : partial_note(true);
+}
+
+bool OutputFile::commit(std::string& error, bool keep_partial) {
   if (file_ == nullptr) {
     error = path_.empty() ? std::string("output not open") : path_ + ": output not open";
     return false;
   }
-  const std::string kept = "; the output is kept in " + temp_path_;
-  // Durable before visible: the data reaches the disk before the name points at it.
-  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
-    error = temp_path_ + ": write failed: " + reason(errno) + kept;
+  // Durable before visible: the data reaches the disk before the name points at it. A write
+  // that failed earlier (the caller may not have checked) fails the whole output.
+  const bool failed_before = std::ferror(file_) != 0;
+  if (failed_before || std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) {
+    const std::string why = failed_before ? std::string("an earlier write failed") : reason(errno);
     abandon();
+    const std::string note = partial_note(keep_partial);
+    error = path_ + ": write failed: " + why + note;
     return false;
   }
   const int rc = std::fclose(file_);
   file_ = nullptr;
   if (rc != 0) {
-    error = temp_path_ + ": close failed: " + reason(errno) + kept;
+    const int err = errno;
+    const std::string note = partial_note(keep_partial);
+    error = path_ + ": close failed: " + reason(err) + note;
     return false;
   }
   if (overwrite_) {
@@ -201,11 +285,13 @@ bool OutputFile::commit(std::string& error) {
     // directory that appeared meanwhile is not replaced.
     struct stat st {};
     if (::lstat(target_.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-      error = path_ + ": not a regular file (" + kind_of(st.st_mode) + "); not replaced" + kept;
+      error = path_ + ": not a regular file (" + kind_of(st.st_mode) + "); not replaced" +
+              complete_note();
       return false;
     }
     if (std::rename(temp_path_.c_str(), target_.c_str()) != 0) {
-      error = path_ + ": cannot move the output into place: " + reason(errno) + kept;
+      const std::string why = reason(errno);
+      error = path_ + ": cannot move the output into place: " + why + complete_note();
       return false;
     }
   } else if (::renameat2(AT_FDCWD, temp_path_.c_str(), AT_FDCWD, target_.c_str(),
@@ -214,7 +300,7 @@ bool OutputFile::commit(std::string& error) {
     if (err != EINVAL && err != ENOSYS && err != EOPNOTSUPP) {
       error = path_ + ": " + reason(err) +
               (err == EEXIST ? " (it appeared while this run was writing; not replaced)" : "") +
-              kept;
+              complete_note();
       return false;
     }
     if (!link_into_place(temp_path_, target_, error)) return false;

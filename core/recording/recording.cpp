@@ -7,6 +7,7 @@
 #include <limits>
 #include <utility>
 
+#include "core/numerics/input_file.hpp"
 #include "core/numerics/version.hpp"
 
 namespace mixpilot {
@@ -347,7 +348,8 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                                       {"planned_steps", std::to_string(info.planned_steps)},
                                       {"control_period_ns", std::to_string(period_ns_)}});
   if (!writer_.error().empty()) {
-    error = writer_.error();
+    error = writer_.error() + "; no file is kept (no step had been recorded)";
+    writer_.discard();
     return false;
   }
   return true;
@@ -454,7 +456,8 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
   out.library = file.library;
   out.complete = file.complete;
   auto fail = [&](uint64_t at, const std::string& what) {
-    error = std::string(name) + ": " + what + " at byte " + std::to_string(at);
+    // `what` may quote a topic, a profile or a value from the file.
+    error = escape_controls(std::string(name) + ": " + what + " at byte " + std::to_string(at));
     return std::nullopt;
   };
   if (file.profile != "ros2")

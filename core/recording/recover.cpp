@@ -1,10 +1,16 @@
 #include "core/recording/recover.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 
+#include "core/recording/output_file.hpp"
 #include "core/recording/recording.hpp"
 
 namespace mixpilot {
@@ -20,6 +26,36 @@ std::size_t whole_step_messages(const McapFile& cut, bool has_end) {
   const uint64_t last = cut.messages.back().log_time;
   while (keep > 0 && cut.messages[keep - 1].log_time == last) --keep;
   return keep;
+}
+
+// A complete recording left as a temporary (its run was stopped between writing its last byte
+// and moving it into place): checked to read back as a recording, copied to `out_path` as it
+// is, and the temporary removed once the copy is in place.
+std::optional<RecoveryResult> put_in_place(const McapFile& whole, const std::string& in_path,
+                                           const std::string& out_path, bool overwrite,
+                                           std::string& error) {
+  const std::optional<RecordingContents> contents = decode_recording(whole, in_path, error);
+  if (!contents) return std::nullopt;
+  if (contents->states.empty()) {
+    error = in_path + ": a complete recording of no control step; nothing to put in place";
+    return std::nullopt;
+  }
+  OutputFile out;
+  if (!out.open(out_path, overwrite, error)) return std::nullopt;
+  if (std::fwrite(whole.bytes.data(), 1, whole.bytes.size(), out.stream()) != whole.bytes.size()) {
+    error = out_path + ": write failed: " + std::strerror(errno) + "; nothing written";
+    out.discard();
+    return std::nullopt;
+  }
+  if (!out.commit(error, /*keep_partial=*/false)) return std::nullopt;
+  ::unlink(in_path.c_str());  // its bytes are now at out_path
+  RecoveryResult result;
+  result.bytes_total = result.bytes_used = whole.bytes.size();
+  result.messages = whole.messages.size();
+  result.steps = contents->states.size();
+  result.interrupted = contents->end ? contents->end->interrupted : true;
+  result.was_complete = true;
+  return result;
 }
 
 }  // namespace
@@ -41,6 +77,17 @@ std::optional<RecoveryResult> recover_recording(const McapFile& cut, const std::
   const std::size_t keep = whole_step_messages(cut, contents->end.has_value());
   result.messages = keep;
   result.messages_left_out = cut.messages.size() - keep;
+  uint16_t state_channel = 0;
+  for (const auto& [id, c] : cut.channels)
+    if (c.topic == "/vehicle/state") state_channel = id;
+  uint64_t steps = 0;
+  for (std::size_t i = 0; i < keep; ++i) steps += cut.messages[i].channel_id == state_channel;
+  if (steps == 0) {  // a recording without a step is no flight: `score` could not replay it
+    error = name + ": cut before its first whole control step (" +
+            std::to_string(cut.parsed_bytes) + " of " + std::to_string(cut.bytes.size()) +
+            " bytes readable); nothing to recover";
+    return std::nullopt;
+  }
 
   McapWriter w;
   McapWriteOptions options;
@@ -51,11 +98,9 @@ std::optional<RecoveryResult> recover_recording(const McapFile& cut, const std::
   // The writer numbers schemas and channels 1, 2, ...: map the original ids.
   std::map<uint16_t, uint16_t> schema_id, channel_id;
   for (const auto& [id, s] : cut.schemas) schema_id[id] = w.add_schema(s.name, s.encoding, s.data);
-  uint16_t state_channel = 0;
   for (const auto& [id, c] : cut.channels) {
     const uint16_t schema = c.schema_id == 0 ? 0 : schema_id.at(c.schema_id);
     channel_id[id] = w.add_channel(schema, c.topic, c.message_encoding, c.metadata);
-    if (c.topic == "/vehicle/state") state_channel = id;
   }
   for (const auto& md : cut.metadata)
     if (md.name != kEndMetadataName) w.write_metadata(md.name, md.metadata);
@@ -79,28 +124,39 @@ std::optional<RecoveryResult> recover_recording(const McapFile& cut, const std::
 std::optional<RecoveryResult> recover_recording(const std::string& in_path,
                                                 const std::string& out_path, bool overwrite,
                                                 std::string& error) {
+  if (same_file(in_path, out_path)) {
+    error = out_path + ": the file being recovered; the recovered recording goes to another "
+            "file (the cut one stays as it is)";
+    return std::nullopt;
+  }
   McapReadOptions options;
   options.allow_truncated = true;
   const std::optional<McapFile> cut = read_mcap(in_path, error, options);
   if (!cut) return std::nullopt;
+  if (cut->complete && temporary_target(in_path)) return put_in_place(*cut, in_path, out_path,
+                                                                      overwrite, error);
   return recover_recording(*cut, in_path, out_path, overwrite, error);
 }
 
-std::string default_recovery_path(const std::string& in_path) {
+std::optional<std::string> temporary_target(const std::string& path) {
   namespace fs = std::filesystem;
   const std::string tmp = ".tmp";
-  if (in_path.size() > tmp.size() && in_path.ends_with(tmp)) {
-    std::string target = in_path.substr(0, in_path.size() - tmp.size());
-    // "<target>.XXXXXX": the writer's unique suffix (core/recording/output_file.cpp).
-    const std::size_t dot = target.rfind('.');
-    if (dot != std::string::npos && target.size() - dot == 7 &&
-        std::all_of(target.begin() + std::ptrdiff_t(dot) + 1, target.end(),
-                    [](unsigned char c) { return std::isalnum(c) != 0; }))
-      target.resize(dot);
-    const fs::path t(target);
-    if (!t.filename().empty() && t.filename() != "." && t.filename() != "..") return target;
-  }
-  const fs::path p(in_path);
+  if (path.size() <= tmp.size() || !path.ends_with(tmp)) return std::nullopt;
+  std::string target = path.substr(0, path.size() - tmp.size());
+  // "<target>.XXXXXX": the writer's unique suffix (core/recording/output_file.cpp).
+  const std::size_t dot = target.rfind('.');
+  if (dot != std::string::npos && target.size() - dot == 7 &&
+      std::all_of(target.begin() + std::ptrdiff_t(dot) + 1, target.end(),
+                  [](unsigned char c) { return std::isalnum(c) != 0; }))
+    target.resize(dot);
+  const fs::path t(target);
+  if (t.filename().empty() || t.filename() == "." || t.filename() == "..") return std::nullopt;
+  return target;
+}
+
+std::string default_recovery_path(const std::string& in_path) {
+  if (auto target = temporary_target(in_path)) return *target;
+  const std::filesystem::path p(in_path);
   return (p.parent_path() / (p.stem().string() + ".recovered.mcap")).string();
 }
 

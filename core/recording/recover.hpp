@@ -19,6 +19,9 @@ struct RecoveryResult {
   uint64_t messages_left_out = 0;  // complete messages of the last, possibly partial, step
   uint64_t steps = 0;              // control steps in the recovered file (/vehicle/state)
   bool interrupted = true;         // as written to mixpilot_end
+  // The temporary was already a complete recording (its run was stopped between finishing it
+  // and moving it into place): it was put in place as it is, and the temporary removed.
+  bool was_complete = false;
 };
 
 // Recovers `in_path` into `out_path` (an OutputFile: never over an existing file unless
@@ -28,8 +31,11 @@ struct RecoveryResult {
 // that step, and a step is kept whole or not at all (every message of step k is logged at k·Δt).
 // The messages written are therefore a prefix of the original's. The end record says
 // recovered, interrupted (unless the original's end record said otherwise) and the step count.
-// A complete file is refused ("nothing to recover"); so is one that does not decode as a
-// recording. nullopt with the reason on failure.
+// A file cut before its first whole control step is refused ("nothing to recover": such a
+// recording would hold no flight), and so is one that does not decode as a recording. A
+// complete file is refused too, unless it is a writer's temporary ("<name>.XXXXXX.tmp"), which
+// is then put in place as it is. The output never replaces the input. nullopt with the reason
+// on failure; nothing is written then.
 std::optional<RecoveryResult> recover_recording(const std::string& in_path,
                                                 const std::string& out_path, bool overwrite,
                                                 std::string& error);
@@ -42,5 +48,9 @@ std::optional<RecoveryResult> recover_recording(const McapFile& cut, const std::
 // Where `mixpilot recover FILE` writes by default: the temporary's own target
 // ("run.mcap.Ab12Cd.tmp" and "run.mcap.tmp" give "run.mcap"), else "<stem>.recovered.mcap".
 std::string default_recovery_path(const std::string& in_path);
+
+// The target of a writer's temporary ("run.mcap.Ab12Cd.tmp" or "run.mcap.tmp" → "run.mcap");
+// nullopt for any other name.
+std::optional<std::string> temporary_target(const std::string& path);
 
 }  // namespace mixpilot

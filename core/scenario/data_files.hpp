@@ -16,4 +16,13 @@ std::string data_dir(std::string* why = nullptr);
 // data_dir()/relative, or "" when there is no data folder.
 std::string data_file(const std::string& relative);
 
+// The user's home folder: $HOME when it is an absolute path, else the account's (getpwuid);
+// "" with `why` when neither is one. Never the current folder: a relative or empty HOME would
+// scatter settings and recordings over whatever folder the program was started in.
+std::string home_dir(std::string* why = nullptr);
+// A user folder of the XDG base directories: $<variable> (XDG_CONFIG_HOME, XDG_DATA_HOME) when it
+// is an absolute path (the specification ignores a relative or empty one), else
+// home_dir()/<under_home> (".config", ".local/share"); "" with `why` when there is no home.
+std::string xdg_dir(const char* variable, const char* under_home, std::string* why = nullptr);
+
 }  // namespace mixpilot

@@ -79,13 +79,15 @@ PilotProfile read_pilot(Section s, const std::string& name) {
   return p;
 }
 
-// First time in [0, duration] at which the helix leaves the box, if any. The coordinates are
-// sinusoids and a line: sampling at ≤ 1 mrad of phase misses at most ~R·5e-7 m of excursion.
-std::optional<double> helix_leaves(const HelixReference& h, double duration,
-                                   const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+// First time in [0, duration] at which the helix comes closer than `margin` to a face of the
+// box [lo, hi] (or leaves it), if any. The coordinates are sinusoids and a line: sampling at
+// ≤ 1 mrad of phase misses at most ~R·5e-7 m of excursion.
+std::optional<double> helix_breach(const HelixReference& h, double duration,
+                                   const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                   double margin) {
   const auto outside = [&](double t) {
     const Eigen::Vector3d p = h.position(t);
-    return (p.array() < lo.array()).any() || (p.array() > hi.array()).any();
+    return (p.array() < lo.array() + margin).any() || (p.array() > hi.array() - margin).any();
   };
   const int n = std::max(1000, int(std::ceil(std::abs(h.angular_rate) * duration / 1e-3)));
   for (int i = 0; i <= n; ++i) {
@@ -101,6 +103,15 @@ std::optional<double> helix_leaves(const HelixReference& h, double duration,
     return t;
   }
   return std::nullopt;
+}
+
+// The face of the box [lo, hi] nearest to `p`, for messages.
+const char* nearest_face(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                         const Eigen::Vector3d& hi) {
+  const double floor = p.z() - lo.z(), ceiling = hi.z() - p.z();
+  const double wall = std::min({p.x() - lo.x(), hi.x() - p.x(), p.y() - lo.y(), hi.y() - p.y()});
+  if (floor <= ceiling && floor <= wall) return "floor";
+  return ceiling <= wall ? "ceiling" : "walls";
 }
 
 std::string vec_text(const Eigen::Vector3d& v) {
@@ -195,14 +206,17 @@ Scenario read_scenario(const toml::table& root, Diagnostics& d) {
     }
   }
   arena.finish();
-  // The reference must stay flyable: the controller's soft walls would fight it otherwise.
+  // The reference must stay flyable: a pilot anywhere in the ball B around it, in a vehicle of
+  // its radius, must not touch the walls, floor or ceiling (the score counts that contact as a
+  // collision, and the controller's soft walls would fight the reference).
   if (box_ok && duration_ok) {
-    if (const auto t = helix_leaves(sc.reference, sc.duration, sc.arena.min, sc.arena.max)) {
-      const Eigen::Vector3d p = sc.reference.position(*t);
+    if (const auto b = reference_too_close_to_walls(sc, sc.duration)) {
       d.add(ref.pos(), "reference",
-            "expected a helix inside the arena over [0, duration], but it leaves it at t = " +
-                approx(*t) + " s, at (" + approx(p.x()) + ", " + approx(p.y()) + ", " +
-                approx(p.z()) + ")");
+            "expected a helix at least " + approx(b->margin) +
+                " m (controller.ph.r + controller.vehicle_radius) inside the arena over [0, "
+                "duration], but it comes closer to the arena's " + b->face + " at t = " +
+                approx(b->t) + " s, at (" + approx(b->at.x()) + ", " + approx(b->at.y()) + ", " +
+                approx(b->at.z()) + ")");
     }
   }
 
@@ -278,8 +292,13 @@ bool read_text_file(const std::string& path, std::string& text, std::string& err
   return read_input_file(path, kMaxTextFileBytes, text, error);
 }
 
-std::optional<double> reference_leaves_arena(const Scenario& sc, double duration) {
-  return helix_leaves(sc.reference, duration, sc.arena.min, sc.arena.max);
+std::optional<ReferenceBreach> reference_too_close_to_walls(const Scenario& sc,
+                                                           double duration) {
+  const double margin = sc.controller.ph.r + sc.controller.vehicle_radius;
+  const auto t = helix_breach(sc.reference, duration, sc.arena.min, sc.arena.max, margin);
+  if (!t) return std::nullopt;
+  const Eigen::Vector3d p = sc.reference.position(*t);
+  return ReferenceBreach{*t, p, nearest_face(p, sc.arena.min, sc.arena.max), margin};
 }
 
 std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
@@ -292,7 +311,11 @@ std::optional<std::string> scenario_mode(std::string_view text, const std::strin
   }
   Section s(d, &root, "", Pos{1, 1});
   std::string mode;
-  if (!s.string("mode", mode, true)) {
+  // Every mode a scenario can name (core/modes/mode.hpp's ModeKind), so an unknown one is
+  // reported where it is written.
+  if (!s.choice("mode", mode,
+                {"mixed_initiative", "pendubot_swingup", "crazyflie_tracking", "obstacle_avoidance"},
+                true)) {
     error = d.str();
     return std::nullopt;
   }

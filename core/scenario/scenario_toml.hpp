@@ -31,13 +31,22 @@ inline constexpr long long kMaxTextFileBytes = 16ll << 20;
 // "<path>: N bytes, more than ..." otherwise.
 bool read_text_file(const std::string& path, std::string& text, std::string& error);
 
-// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader.
+// The top-level `mode` of a scenario (any mode), so callers can dispatch to its loader; an
+// unknown one is an error at its line and column.
 std::optional<std::string> scenario_mode(std::string_view text, const std::string& source_name,
                                          std::string& error);
 
-// First time in [0, duration] at which the helix reference leaves the arena box, if any
-// (the loader refuses such a file; a session length given apart, e.g. on the command line,
-// is checked with this).
-[[nodiscard]] std::optional<double> reference_leaves_arena(const Scenario& sc, double duration);
+// Where the helix reference first comes closer to the arena's walls, floor or ceiling than
+// margin = controller.ph.r + controller.vehicle_radius: a pilot anywhere in the ball B around
+// the reference would touch them there. The loader refuses such a file; a session length
+// given apart (fly --duration) is checked with this too.
+struct ReferenceBreach {
+  double t = 0.0;           // [s] first time
+  Eigen::Vector3d at;       // the reference there [m]
+  const char* face = "";    // "walls", "floor" or "ceiling"
+  double margin = 0.0;      // [m] the clearance needed
+};
+[[nodiscard]] std::optional<ReferenceBreach> reference_too_close_to_walls(const Scenario& sc,
+                                                                         double duration);
 
 }  // namespace mixpilot

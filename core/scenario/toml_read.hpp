@@ -43,7 +43,9 @@ class Diagnostics {
   void add(Pos p, std::string_view path, std::string_view what) {
     std::string text = file_ + ':' + std::to_string(p.line) + ':' + std::to_string(p.col) + ": ";
     text.append(path).append(": ").append(what);
-    items_.push_back({p, std::move(text)});
+    // Keys, strings and file names come from the file (or a recording): a terminal must never
+    // receive their control characters.
+    items_.push_back({p, escape_controls(text)});
   }
   bool empty() const { return items_.empty(); }
   std::string str() {
@@ -76,7 +78,7 @@ inline std::string fmt(double v) {
 inline std::string describe(const toml::node& n) {
   switch (n.type()) {
     case toml::node_type::string:
-      return "the string \"" + n.as_string()->get() + '"';
+      return "the string \"" + printable(n.as_string()->get()) + '"';
     case toml::node_type::integer:
       return std::to_string(n.as_integer()->get());
     case toml::node_type::floating_point:
@@ -266,6 +268,12 @@ class Section {
     if (!n) return false;
     if (!n->is_string() || n->as_string()->get().empty()) {
       d_.add(pos_of(n->source()), path(key), "expected a non-empty string, got " + describe(*n));
+      return false;
+    }
+    // Names and file names end up in messages, summaries and file names.
+    if (escape_controls(n->as_string()->get()) != n->as_string()->get()) {
+      d_.add(pos_of(n->source()), path(key),
+             "expected a string without control characters, got " + describe(*n));
       return false;
     }
     out = n->as_string()->get();
