@@ -305,7 +305,7 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
     if (!screen.open(d.w, d.h, error, d.scale)) GTEST_SKIP() << "no EGL device: " << error;
     for (auto& entry : flights) {
       const char* const scenario = entry.first;
-      Flight& f = entry.second;
+      Flown& f = entry.second;
       ASSERT_TRUE(f.mode) << scenario;
       SCOPED_TRACE(std::string(scenario) + " at " + std::to_string(d.w) + "x" + std::to_string(d.h) +
                    ", scale " + std::to_string(d.scale));
