@@ -46,7 +46,7 @@ class Offscreen {
   float scale_ = 1.0f;
   void* display_ = nullptr;  // EGLDisplay
   void* context_ = nullptr;  // EGLContext
-  unsigned fbo_ = 0, colour_ = 0, depth_ = 0;
+  unsigned fbo_ = 0, colour_ = 0;
   bool imgui_ = false;
   std::string font_;  // the font file loaded, "" for ImGui's built-in
 };

@@ -175,10 +175,10 @@ TEST_F(Ui, KeyThreeSwitchesToTopCamera) {
   ui::UiState st;
   const auto chase = render(scene, f.history, st);
   ASSERT_EQ(st.camera, ui::Camera::chase);
-  ImGui::GetIO().KeysDown['3'] = true;
+  ImGui::GetIO().KeysDown[int('3')] = true;
   ui::RunInfo run;
   screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
-  ImGui::GetIO().KeysDown['3'] = false;
+  ImGui::GetIO().KeysDown[int('3')] = false;
   EXPECT_EQ(st.camera, ui::Camera::top);
   EXPECT_NE(render(scene, f.history, st), chase);
 }

@@ -125,9 +125,13 @@ namespace {
 
 inline int pad4(int n) { return (n + 3) & ~3; }
 
-inline double row_norm2(int m, const double* y, int ldy) {
+// ‖Y(row, :)‖² of an n x m column-major Y; Y may be null when m = 0 (no offset is formed then).
+inline double row_norm2(int m, const double* Y, int row, int ldy) {
   double s = 0.0;
-  for (int k = 0; k < m; ++k) s += y[static_cast<ptrdiff_t>(k) * ldy] * y[static_cast<ptrdiff_t>(k) * ldy];
+  for (int k = 0; k < m; ++k) {
+    const double v = Y[row + static_cast<ptrdiff_t>(k) * ldy];
+    s += v * v;
+  }
   return s;
 }
 
@@ -308,7 +312,7 @@ bool syrk_potrf_ln_padded(int n, int m, const double* Y, int ldy, double* C, int
         p -= l * l;
       }
       if (!(p > pivot_floor)) {
-        const double mag = std::abs(d0[c] + row_norm2(m, Y + j, ldy));
+        const double mag = std::abs(d0[c] + row_norm2(m, Y, j, ldy));
         if (!((j >= n_strict || mag > 0.0) && p >= -psd_tol * mag)) return false;
         p = std::max(pivot_floor, psd_tol * mag);  // no curvature: regularized (see the header)
       }
