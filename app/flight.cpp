@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "app/cli.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/recording/output_file.hpp"
@@ -281,7 +281,7 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
   }
   if (!f->mode) return std::nullopt;
-  if (const auto* mi = dynamic_cast<const MiMode*>(f->mode.get())) f->pilot = mi->pilot().name();
+  f->pilot = f->mode->identity().pilot;
   if (o.vehicle == "dds" && !open_vehicle(o, *f, error)) return std::nullopt;
   status = kExitOk;
   return f;
@@ -295,8 +295,7 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
   info.scenario_path = f.scenario_file;
   info.pilot = f.pilot;
   if (f.vehicle) info.vehicle = "dds";
-  if (const auto* mi = dynamic_cast<const MiMode*>(f.mode.get()))
-    info.seed = mi->scenario().plant.seed;
+  if (const auto seed = f.mode->identity().seed) info.seed = *seed;
   return info;
 }
 

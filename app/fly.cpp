@@ -11,7 +11,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
 #include "app/trainer.hpp"

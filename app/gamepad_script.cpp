@@ -8,7 +8,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "core/numerics/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/recording/output_file.hpp"

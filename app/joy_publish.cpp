@@ -12,7 +12,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "core/recording/recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/net/dds.hpp"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "app/flight.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "ui/scene.hpp"
 
 namespace mixpilot::cli {

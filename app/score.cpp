@@ -5,14 +5,14 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include "app/cli.hpp"
 #include "app/commands.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "core/modes/report.hpp"
-#include "core/modes/score.hpp"
 #include "core/numerics/input_file.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/output_file.hpp"
@@ -46,13 +46,19 @@ struct ScoreRow {
   std::string pilot;
   std::string scenario;
   Metrics metrics;
-  Score score;  // mixed initiative
   bool ok = false;
   std::string difference;  // what differed first; empty: every step replayed bit for bit
   std::string error;
   // The flight stopped before its planned end: "interrupted at t = 3.0 s of 30.0 s" ("" if not).
   std::string ended_early;
 };
+
+// A metric of the row by name (0 when the mode has none).
+double metric_of(const ScoreRow& row, std::string_view name) {
+  for (const auto& [key, value] : row.metrics)
+    if (key == name) return value;
+  return 0.0;
+}
 
 ScoreRow score_recording(const std::string& path) {
   ScoreRow row;
@@ -63,32 +69,19 @@ ScoreRow score_recording(const std::string& path) {
     row.error = error;
     return row;
   }
-  const std::string* text = embedded_scenario(*rec, path, row.error);
-  if (!text) return row;
-  std::unique_ptr<Mode> mode =
-      replay_mode(*rec, path, *text, embedded_scenario_source(*rec, path), {}, error);
-  if (!mode) {
+  auto replayed = replay_recording(*rec, path, error);
+  if (!replayed) {
     row.error = error;
     return row;
   }
   const auto pilot_meta = rec->metadata.find("pilot");
   // Printed in the table: as the recording says it, made printable.
   row.pilot = pilot_meta != rec->metadata.end() ? escape_controls(pilot_meta->second) : "";
-  row.mode = to_string(mode->kind());
-  row.scenario = mode->scenario_name();
-  Session session(*mode);
-  ReplayCheck check(*rec);
-  session.add_sink(&check);
-  session.run();
-  row.metrics = replay_metrics(*mode, *rec, &row.score);
-  row.difference = check.first_difference(mode->steps_done());
-  if (rec->end && rec->end->interrupted) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "interrupted at t = %.1f s of %.1f s",
-                  double(mode->steps_done()) * mode->dt(),
-                  double(mode->steps_total()) * mode->dt());
-    row.ended_early = buf;
-  }
+  row.mode = to_string(replayed->mode->kind());
+  row.scenario = replayed->mode->scenario_name();
+  row.metrics = std::move(replayed->metrics);
+  row.difference = std::move(replayed->difference);
+  row.ended_early = std::move(replayed->ended_early);
   row.ok = true;
   return row;
 }
@@ -149,7 +142,7 @@ int score_command(int argc, char** argv) {
       const std::lock_guard<std::mutex> lock(io);
       if (rows[i].ok && rows[i].mode == "mixed_initiative") {
         std::fprintf(stderr, "[%zu/%zu] %s: skill %.1f\n", d, files.size(), files[i].c_str(),
-                     rows[i].score.skill);
+                     metric_of(rows[i], "skill"));
       } else if (rows[i].ok) {
         std::fprintf(stderr, "[%zu/%zu] %s: %s\n", d, files.size(), files[i].c_str(),
                      rows[i].mode.c_str());
@@ -173,7 +166,7 @@ int score_command(int argc, char** argv) {
       std::printf("%-32s error: %s\n", r.file.c_str(), r.error.c_str());
       continue;
     }
-    const Score& s = r.score;
+    const auto m = [&r](std::string_view name) { return metric_of(r, name); };
     const bool exact = r.difference.empty();
     std::string replay = exact ? "exact" : "DIFFERS from recording";
     if (!r.ended_early.empty()) replay += " (" + r.ended_early + ")";
@@ -184,8 +177,9 @@ int score_command(int argc, char** argv) {
     }
     if (r.mode == "mixed_initiative") {
       std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
-                  r.pilot.c_str(), s.duration_s, s.mean_lambda, s.min_lambda, s.max_deviation_m,
-                  s.collisions, static_cast<long long>(s.fallbacks), s.skill, replay.c_str());
+                  r.pilot.c_str(), m("duration_s"), m("mean_lambda"), m("min_lambda"),
+                  m("max_deviation_m"), int(m("collisions")), static_cast<long long>(m("fallbacks")),
+                  m("skill"), replay.c_str());
     } else {  // the other modes' metrics are in the JSON
       std::printf("%-32s %-12.12s %8s %7s %7s %8s %5s %6s %7s %s\n", r.file.c_str(),
                   r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay.c_str());

@@ -169,8 +169,8 @@ void Trainer::refresh_choices() {
   choices_.pilots.clear();
   choices_.pilot = -1;
   if (!live_) return;
-  if (const auto* mi = dynamic_cast<const MiMode*>(live_->flight.mode.get())) {
-    for (const auto& [name, profile] : mi->scenario().pilots) choices_.pilots.push_back(name);
+  if (ModeIdentity id = live_->flight.mode->identity(); !id.pilot.empty()) {
+    choices_.pilots = std::move(id.pilots);
     choices_.pilots.push_back("gamepad");
     choices_.pilots.push_back("keyboard");
     if (options_.pilot.ends_with(".mcap")) choices_.pilots.push_back(options_.pilot);

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "app/flight.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "app/replay_tape.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/runtime/realtime_runner.hpp"

@@ -22,7 +22,7 @@
 
 #include "app/flight.hpp"
 #include "app/offscreen.hpp"
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "app/trainer.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
@@ -421,15 +421,15 @@ Metrics score_of(const std::string& path) {
   const auto rec = read_recording(path, error);
   EXPECT_TRUE(rec) << error;
   if (!rec) return {};
-  const std::string* text = cli::embedded_scenario(*rec, path, error);
+  const std::string* text = embedded_scenario(*rec, path, error);
   EXPECT_TRUE(text) << error;
-  auto mode = cli::replay_mode(*rec, path, *text, cli::embedded_scenario_source(*rec, path), {},
+  auto mode = replay_mode(*rec, path, *text, embedded_scenario_source(*rec, path), {},
                                error);
   EXPECT_TRUE(mode) << error;
   if (!mode) return {};
   Session session(*mode);
   session.run();
-  return cli::replay_metrics(*mode, *rec);
+  return replay_metrics(*mode, *rec);
 }
 
 double metric(const Metrics& m, const std::string& name) {

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"

@@ -141,6 +141,7 @@ class IdleMode final : public Mode {
   const Telemetry& telemetry() const override { return telemetry_; }
   Metrics metrics() const override { return {}; }
   std::string summary() const override { return ""; }
+  ModeView view() const override { return {}; }
   void set_deadline_us(double) override {}
 
  private:

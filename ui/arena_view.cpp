@@ -299,7 +299,7 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     const Telemetry& a = h[i - 1];
     const Telemetry& b = h[i];
     if (a.x.size() < 3) continue;
-    const ImU32 c = sc.mode == ModeKind::mixed_initiative ? authority_colour(b.lambda) : colour::kPilot;
+    const ImU32 c = sc.shared_authority ? authority_colour(b.lambda) : colour::kPilot;
     line(dl, v, a.x.head<3>(), b.x.head<3>(), c, 3.0f);
   }
   for (Eigen::Index i = 1; i < s.predicted.cols(); ++i)

@@ -14,34 +14,22 @@
 
 namespace mixpilot::ui {
 
-struct SceneSphere {
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // [m]
-  double radius = 0.1;                               // [m]
-};
+using SceneSphere = ViewSphere;
 
-// What does not change during a flight.
-struct Scene {
-  ModeKind mode = ModeKind::mixed_initiative;
+// What does not change during a flight: what the mode shows of itself (core/modes/mode_view.hpp)
+// and what the front end adds.
+struct Scene : ModeView {
+  ModeKind mode = ModeKind::mixed_initiative;  // named in the title only: the view says the rest
   std::string title;         // the scenario's name
   std::string input_source;  // the pilot source, or the controller for the other modes
   double dt = 0.01;          // [s] control period
   double duration = 0.0;     // [s] of the whole run
-  Eigen::Vector3d arena_min{-3.0, -3.0, 0.0};  // [m] quadrotor modes: the flight volume
-  Eigen::Vector3d arena_max{3.0, 3.0, 3.0};    // [m]
-  std::vector<SceneSphere> spheres;            // static obstacles
-  // Moving obstacles: their centres at time t (the obstacle mode's thrown balls).
-  std::function<void(double t, std::vector<Eigen::Vector3d>& centers)> moving;
-  double moving_radius = 0.1;   // [m]
-  Eigen::Matrix3Xd reference;   // 3 x M: the whole reference path, for drawing
-  double ball_radius = 0.0;     // [m] r of the ball B (mixed initiative), 0: none
-  double hover_rotor_speed = 1.0;  // Ω at hover (mixed initiative; the thrust stick's centre)
-  double link1 = 0.1483, link2 = 0.1804;  // [m] Pendubot links
 };
 
 // The value of the channel called `name` in `s`, or `fallback` when it has none.
 double channel_value(const Telemetry& s, std::string_view name, double fallback = 0.0);
 
-// The scene of a mode, read through its const accessors (no effect on the flight).
+// The scene of a mode, read through its interface (no effect on the flight).
 Scene scene_of(const Mode& mode, const std::string& input_source);
 
 // The telemetry the screen draws, oldest first, newest last: either a ring of the newest

@@ -178,7 +178,7 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
                (kOverlay & ~ImGuiWindowFlags_NoBackground) | ImGuiWindowFlags_AlwaysAutoResize);
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
   const float w = ImGui::GetContentRegionAvail().x;
-  if (sc.mode == ModeKind::mixed_initiative) {
+  if (sc.shared_authority) {
     // Before the first solve (the initial state) the pilot has the authority.
     const ImVec2 bar_min = ImGui::GetCursorScreenPos();
     const float bar_h = (compact ? 1.4f : 2.0f) * ImGui::GetFontSize();
@@ -197,7 +197,7 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
     ImGui::PopStyleColor();
   };
   char text[96];
-  if (sc.mode == ModeKind::mixed_initiative) {
+  if (sc.shared_authority) {
     // Over the last minute at most (a replay's history is the whole flight up to the playhead).
     std::int64_t in_ball = 0;
     const std::size_t from = h.empty() ? 0 : h.first_at_or_after(h.newest().t - 60.0 + 0.5 * sc.dt);
@@ -600,13 +600,13 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   ImGui::SetNextWindowPos(vmin);
   ImGui::SetNextWindowSize(ImVec2(view_w, vmax.y - vmin.y));
   ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
-  if (sc.mode == ModeKind::pendubot_swingup) draw_pendubot(sc, h, vmin, vmax, frame);
+  if (sc.view == ViewKind::arm_2d) draw_pendubot(sc, h, vmin, vmax, frame);
   else draw_arena(sc, h, ui, vmin, vmax, frame);
   ImGui::End();
 
   // The sticks at the bottom of the frame over the camera line, below the vehicle or, where
   // the view is short, beside it; shrunk down to a readable size.
-  if (sc.mode == ModeKind::mixed_initiative && ui.show_sticks && !h.empty()) {
+  if (sc.shared_authority && ui.show_sticks && !h.empty()) {
     const float floor = vmax.y - ImGui::GetTextLineHeightWithSpacing() - m;
     const float vehicle = kVehicleInFrame * (vmax.y - frame.y);
     const float aspect = 300.0f / 170.0f, least = scaled(80);

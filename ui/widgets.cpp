@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <span>
 #include <string>
 
 #include "ui/panels.hpp"
@@ -140,7 +141,7 @@ int channel_index(const Telemetry& s, const char* name) {
 // One rolling plot of channels over [t_end − window, t_end] in a slot `slot` pixels high: its
 // title, a legend that wraps under it (each series' value at the right edge, or under the
 // mouse), and the curves in what is left (at least `min_height`).
-void plot(const History& h, const char* title, std::initializer_list<Series> named, double window,
+void plot(const History& h, const char* title, std::span<const Series> named, double window,
           double t_end, float slot, float min_height) {
   struct Indexed {
     int channel;
@@ -254,6 +255,19 @@ void plot(const History& h, const char* title, std::initializer_list<Series> nam
 const ImU32 kCycle[] = {colour::kPilot, colour::kPlanner, colour::kMpc, colour::kCaution,
                         colour::kObstacle, colour::kCritical};
 
+// A series' colour from what it stands for (the i-th of its plot for SeriesRole::other).
+ImU32 role_colour(SeriesRole role, int i) {
+  switch (role) {
+    case SeriesRole::pilot: return colour::kPilot;
+    case SeriesRole::applied: return colour::kMpc;
+    case SeriesRole::soft_limit: return colour::kCaution;
+    case SeriesRole::hard_limit: return colour::kCritical;
+    case SeriesRole::timing: return colour::kCaution;
+    case SeriesRole::other: break;
+  }
+  return kCycle[i % 6];
+}
+
 }  // namespace
 
 void draw_plots(const Scene& sc, const History& h, UiState& ui) {
@@ -269,27 +283,23 @@ void draw_plots(const Scene& sc, const History& h, UiState& ui) {
     return std::max(0.0f, (ImGui::GetContentRegionAvail().y + st.ItemSpacing.y) / float(plots) -
                               st.ItemSpacing.y);
   };
-  if (sc.mode == ModeKind::mixed_initiative) {
-    const float s = slot(6);
-    plot(h, "authority λ", {{"lambda", colour::kPilot}}, ui.plot_window, t_end, s, min_height);
-    plot(h, "deviation |p − η_r| vs r",
-         {{"deviation", colour::kPilot}, {"ball radius r", colour::kCaution}}, ui.plot_window,
-         t_end, s, min_height);
-    plot(h, "roll φ_h vs φ*₁", {{"roll pilot", colour::kPilot}, {"roll MPC", colour::kMpc}},
-         ui.plot_window, t_end, s, min_height);
-    plot(h, "pitch θ_h vs θ*₁", {{"pitch pilot", colour::kPilot}, {"pitch MPC", colour::kMpc}},
-         ui.plot_window, t_end, s, min_height);
-    plot(h, "rotor speed Ω vs bound",
-         {{"rotor speed max", colour::kMpc}, {"rotor speed bound", colour::kCritical}},
-         ui.plot_window, t_end, s, min_height);
-    plot(h, "RTI time", {{"RTI time", colour::kCaution}}, ui.plot_window, t_end, s, min_height);
+  if (!sc.plots.empty()) {
+    const float s = slot(int(sc.plots.size()));
+    for (const PlotSpec& spec : sc.plots) {
+      Series series[4];
+      std::size_t n = 0;
+      for (std::size_t i = 0; i < spec.series.size() && n < 4; ++i)
+        series[n++] = {spec.series[i].channel, role_colour(spec.series[i].role, int(i))};
+      plot(h, spec.title, std::span<const Series>(series, n), ui.plot_window, t_end, s, min_height);
+    }
     return;
   }
   const Telemetry& n = h.newest();
   const float s = slot(std::max(1, n.num_channels));
-  for (int i = 0; i < n.num_channels; ++i)
-    plot(h, n.channels[std::size_t(i)].name, {{n.channels[std::size_t(i)].name, kCycle[i % 6]}},
-         ui.plot_window, t_end, s, min_height);
+  for (int i = 0; i < n.num_channels; ++i) {
+    const Series one[] = {{n.channels[std::size_t(i)].name, kCycle[i % 6]}};
+    plot(h, n.channels[std::size_t(i)].name, one, ui.plot_window, t_end, s, min_height);
+  }
 }
 
 }  // namespace mixpilot::ui

@@ -277,6 +277,44 @@ Metrics MiMode::metrics() const {
   return m;
 }
 
+ModeView MiMode::view() const {
+  ModeView v;
+  v.shared_authority = true;
+  v.arena_min = scenario_.arena.min;
+  v.arena_max = scenario_.arena.max;
+  for (const Obstacle& o : scenario_.arena.obstacles) v.spheres.push_back({o.center, o.radius});
+  const Scenario& sc = scenario_;
+  v.reference = sample_path(sc.duration, [&sc](double t) { return sc.reference.position(t); });
+  v.ball_radius = sc.controller.ph.r;
+  v.hover_rotor_speed = model_.hover_speed();
+  using R = SeriesRole;
+  v.plots = {{"authority λ", {{"lambda", R::pilot}}},
+             {"deviation |p − η_r| vs r", {{"deviation", R::pilot}, {"ball radius r", R::soft_limit}}},
+             {"roll φ_h vs φ*₁", {{"roll pilot", R::pilot}, {"roll MPC", R::applied}}},
+             {"pitch θ_h vs θ*₁", {{"pitch pilot", R::pilot}, {"pitch MPC", R::applied}}},
+             {"rotor speed Ω vs bound",
+              {{"rotor speed max", R::applied}, {"rotor speed bound", R::hard_limit}}},
+             {"RTI time", {{"RTI time", R::timing}}}};
+  return v;
+}
+
+ModeIdentity MiMode::identity() const {
+  ModeIdentity id;
+  id.pilot = pilot_->name();
+  for (const auto& entry : scenario_.pilots) id.pilots.push_back(entry.first);
+  id.seed = scenario_.plant.seed;
+  return id;
+}
+
+Metrics MiMode::replayed_metrics(const std::vector<double>& recorded_solve_us) const {
+  Score s = score();
+  const std::size_t n = std::min(recorded_solve_us.size(), std::size_t(steps_done()));
+  // The deadline misses are replayed as recorded (replay_timing()).
+  set_timing(s, std::vector<double>(recorded_solve_us.begin(), recorded_solve_us.begin() + std::ptrdiff_t(n)),
+             s.deadline_misses);
+  return to_metrics(s);
+}
+
 std::string MiMode::summary() const {
   const Score s = score();
   char buf[768];

@@ -57,6 +57,9 @@ class MiMode final : public Mode {
   // rtt_estimated_s (the final estimate).
   Metrics metrics() const override;
   std::string summary() const override;
+  ModeView view() const override;
+  ModeIdentity identity() const override;
+  Metrics replayed_metrics(const std::vector<double>& recorded_solve_us) const override;
 
   [[nodiscard]] bool set_vehicle(VehicleLink* link) override {
     link_ = link;

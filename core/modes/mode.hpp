@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "core/control/pilot.hpp"
+#include "core/modes/mode_view.hpp"
 #include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
 
@@ -114,6 +115,19 @@ class Mode {
   virtual const Telemetry& telemetry() const = 0;
   // The mode's metrics so far (the score in mixed initiative). Allocates: not for the loop.
   virtual Metrics metrics() const = 0;
+  // What the mode shows of itself: its world, the view and the plots (core/modes/mode_view.hpp).
+  // Allocates: not for the loop.
+  virtual ModeView view() const = 0;
+  // Who flies and what a user may pick instead (mode_view.hpp). Default: the controller flies.
+  virtual ModeIdentity identity() const { return {}; }
+  // The metrics of a replay whose RTI solves took `recorded_solve_us` [µs] per step when they
+  // were flown: where the metrics hold timing fields they describe the recorded flight, not this
+  // replay, so a flight and every replay of it agree to the bit on any machine. Default:
+  // metrics().
+  virtual Metrics replayed_metrics(const std::vector<double>& recorded_solve_us) const {
+    (void)recorded_solve_us;
+    return metrics();
+  }
   // A few human-readable lines about the run so far, for the terminal. The first names the
   // scenario and mode; the front end that prints it puts its own label before it
   // ("mixpilot replay: ...").

@@ -297,6 +297,26 @@ Metrics ObstacleMode::metrics() const {
   };
 }
 
+ModeView ObstacleMode::view() const {
+  ModeView v;
+  const ObstacleWorld& w = scenario_.world;
+  const double r = settings_.clearance;
+  for (const auto& c : w.spheres) v.spheres.push_back({c, r});
+  if (!w.balls.empty()) {
+    const int first = int(w.spheres.size());
+    v.moving = [world = w, first](double t, std::vector<Eigen::Vector3d>& centers) {
+      centers.clear();
+      for (int j = first; j < world.size(); ++j) centers.push_back(world.position(j, t));
+    };
+    v.moving_radius = r;
+  }
+  const OcpTrajectory& ref = scenario_.reference.trajectory;
+  v.reference.resize(3, Eigen::Index(ref.x.size()));
+  for (std::size_t i = 0; i < ref.x.size(); ++i) v.reference.col(Eigen::Index(i)) = ref.x[i].head<3>();
+  fit_arena(v, v.reference, 1.0);
+  return v;
+}
+
 std::string ObstacleMode::summary() const {
   const ObstacleRunResult r = result();
   char buf[768];

@@ -85,6 +85,7 @@ class ObstacleMode final : public Mode {
   // 1 squared), steps.
   Metrics metrics() const override;
   std::string summary() const override;
+  ModeView view() const override;
 
   // The scenario flown; its world at telemetry().t is where the obstacles are.
   const ObstacleScenario& scenario() const { return scenario_; }

@@ -390,6 +390,15 @@ Metrics PendubotMode::metrics() const {
   };
 }
 
+ModeView PendubotMode::view() const {
+  ModeView v;
+  v.view = ViewKind::arm_2d;
+  const models::PendubotParams p;
+  v.link1 = p.l1;
+  v.link2 = p.l2;
+  return v;
+}
+
 std::string PendubotMode::summary() const {
   const PendubotRun run = result();
   const PendubotScenario& sc = scenario_;

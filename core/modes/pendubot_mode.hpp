@@ -117,6 +117,7 @@ class PendubotMode final : public Mode {
   // fallbacks, lqr_entry_time_s, lqr_time_s, lqr_entries, quantization.
   Metrics metrics() const override;
   std::string summary() const override;
+  ModeView view() const override;
 
   // The results so far, without the per-step log.
   PendubotRun result() const;

@@ -109,6 +109,7 @@ class TrackingMode final : public Mode {
   // predictor_median_us, max_input_violation, rtt_s, compensation, steps, lost.
   Metrics metrics() const override;
   std::string summary() const override;
+  ModeView view() const override;
 
   // Flies the vehicle behind `link` instead of the simulated plant (after setup(), before the
   // first step; nullptr: the simulated plant). The link outlives the flight.

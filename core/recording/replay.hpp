@@ -1,17 +1,18 @@
 #pragma once
 // Flying a recording again: the same mode from its embedded scenario, checked step by step
-// against what was recorded (`mixpilot fly --pilot REC.mcap`, `mixpilot score`).
+// against what was recorded. Every front end replays through here: `mixpilot score`
+// (replay_recording), `mixpilot fly --pilot REC.mcap` and the window's replay (replay_mode,
+// ReplayCheck and replay_metrics around their own paced or taped session).
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "core/modes/mode.hpp"
-#include "core/modes/score.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/recording.hpp"
 
-namespace mixpilot::cli {
+namespace mixpilot {
 
 // The scenario text a recording embeds; nullptr with "<path>: no embedded scenario ..." when
 // it has none.
@@ -24,10 +25,9 @@ std::string embedded_scenario_source(const RecordingContents& rec, const std::st
 
 // The metrics of a replay of `rec`: the mode's own, except that mixed initiative's timing fields
 // (RTI median and p99, deadline misses) describe the recorded flight's first steps_done() steps,
-// not this replay, so `fly --pilot REC` and `score REC` agree to the bit on any machine.
-// `score`, when given, receives the mixed-initiative score with those fields.
-[[nodiscard]] Metrics replay_metrics(const Mode& mode, const RecordingContents& rec,
-                                     Score* score = nullptr);
+// not this replay, so `fly --pilot REC` and `score REC` agree to the bit on any machine
+// (Mode::replayed_metrics).
+[[nodiscard]] Metrics replay_metrics(const Mode& mode, const RecordingContents& rec);
 
 // An error found in the scenario embedded in the recording at `path`, said as such: its
 // file:line:col name the file it was recorded from, which may have changed since.
@@ -58,4 +58,19 @@ class ReplayCheck final : public TelemetrySink {
   const char* what_ = "";
 };
 
-}  // namespace mixpilot::cli
+// A whole recording flown again and checked: what `mixpilot score` reports of it.
+struct ReplayResult {
+  std::unique_ptr<Mode> mode;  // after the run: its telemetry, summary and metrics
+  Metrics metrics;             // replay_metrics()
+  std::string difference;      // what differed first; "": every step replayed bit for bit
+  // The flight stopped before its planned end: "interrupted at t = 3.0 s of 30.0 s" ("" if not).
+  std::string ended_early;
+};
+
+// Flies `rec` (read from `path`, named in messages) again from its embedded scenario, checking
+// every step, with `extra` (when given) also watching. nullopt with the reason when its
+// scenario is missing or no longer valid, or it was flown with a remote vehicle.
+std::optional<ReplayResult> replay_recording(const RecordingContents& rec, const std::string& path,
+                                             std::string& error, TelemetrySink* extra = nullptr);
+
+}  // namespace mixpilot

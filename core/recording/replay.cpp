@@ -1,16 +1,16 @@
-#include "app/replay.hpp"
+#include "core/recording/replay.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 #include "core/modes/make_mode.hpp"
-#include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
 #include "core/numerics/input_file.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
-namespace mixpilot::cli {
+namespace mixpilot {
 
 const std::string* embedded_scenario(const RecordingContents& rec, const std::string& path,
                                      std::string& error) {
@@ -30,16 +30,10 @@ std::string embedded_scenario_source(const RecordingContents& rec, const std::st
   return path + " (embedded scenario)";
 }
 
-Metrics replay_metrics(const Mode& mode, const RecordingContents& rec, Score* score) {
-  const auto* mi = dynamic_cast<const MiMode*>(&mode);
-  if (!mi) return with_lost_fields(mode.metrics(), mode);
-  Score s = mi->score();
-  const std::size_t n = std::min(rec.solver.size(), std::size_t(mode.steps_done()));
-  std::vector<double> recorded_us(n);
-  for (std::size_t k = 0; k < n; ++k) recorded_us[k] = rec.solver[k].total_us;
-  set_timing(s, std::move(recorded_us), s.deadline_misses);  // misses: replayed as recorded
-  if (score) *score = s;
-  return with_lost_fields(to_metrics(s), mode);
+Metrics replay_metrics(const Mode& mode, const RecordingContents& rec) {
+  std::vector<double> recorded_us(rec.solver.size());
+  for (std::size_t k = 0; k < rec.solver.size(); ++k) recorded_us[k] = rec.solver[k].total_us;
+  return with_lost_fields(mode.replayed_metrics(recorded_us), mode);
 }
 
 std::string in_embedded_scenario(const std::string& path, const std::string& error) {
@@ -151,4 +145,28 @@ std::string ReplayCheck::first_difference(std::int64_t steps) const {
   return "";
 }
 
-}  // namespace mixpilot::cli
+std::optional<ReplayResult> replay_recording(const RecordingContents& rec, const std::string& path,
+                                             std::string& error, TelemetrySink* extra) {
+  const std::string* text = embedded_scenario(rec, path, error);
+  if (!text) return std::nullopt;
+  ReplayResult r;
+  r.mode = replay_mode(rec, path, *text, embedded_scenario_source(rec, path), {}, error);
+  if (!r.mode) return std::nullopt;
+  Session session(*r.mode);
+  ReplayCheck check(rec);
+  session.add_sink(&check);
+  if (extra) session.add_sink(extra);
+  session.run();
+  r.metrics = replay_metrics(*r.mode, rec);
+  r.difference = check.first_difference(r.mode->steps_done());
+  if (rec.end && rec.end->interrupted) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "interrupted at t = %.1f s of %.1f s",
+                  double(r.mode->steps_done()) * r.mode->dt(),
+                  double(r.mode->steps_total()) * r.mode->dt());
+    r.ended_early = buf;
+  }
+  return r;
+}
+
+}  // namespace mixpilot
