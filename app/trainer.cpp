@@ -141,6 +141,15 @@ std::unique_ptr<LiveFlight> Trainer::make_live(std::string& error, int& status) 
     f->check.emplace(*f->flight.recording);
     f->session->add_sink(&*f->check);
   }
+  if (o.publish) {
+    f->publisher.emplace();
+    if (!f->publisher->start(o.domain, mode.telemetry(), error)) {
+      error = "--publish: " + error;
+      status = kExitError;
+      return nullptr;
+    }
+    f->session->add_sink(&*f->publisher);
+  }
   f->runner = std::make_unique<RealtimeRunner>(*f->session, 8192);
   const std::string source =
       f->flight.pilot.empty() ? std::string("the thesis's controller") : "pilot " + f->flight.pilot;
@@ -184,6 +193,13 @@ void Trainer::refresh_choices() {
 void Trainer::close_live(LiveFlight& f) {
   f.runner->stop();
   while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
+  if (f.publisher) {
+    f.publisher->stop();
+    if (f.started)
+      say("published " + std::to_string(f.publisher->published()) + " steps on rt/mixpilot/* (domain " +
+              std::to_string(options_.domain) + "; " + std::to_string(f.publisher->dropped()) + " dropped)",
+          f.publisher->dropped() > 0);
+  }
   if (!f.record_path.empty()) {
     std::string error;
     if (f.recorder.close(error, !f.flight.mode->finished())) {
@@ -612,6 +628,10 @@ int Trainer::finish() {
   print_realtime(st, mode.dt());
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   for (const std::string& path : recorded_) std::printf("  recorded %s\n", path.c_str());
+  if (f.publisher)
+    std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
+                (unsigned long long)f.publisher->published(), unsigned(options_.domain),
+                (unsigned long long)f.publisher->dropped());
   if (!options_.report.empty()) {
     const Metrics metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
                                                : with_lost_fields(mode.metrics(), mode);

@@ -15,6 +15,7 @@
 #include "core/recording/session_recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "input/mapping_wizard.hpp"
+#include "input/net/telemetry_publisher.hpp"
 #include "ui/screen.hpp"
 
 namespace mixpilot::cli {
@@ -27,6 +28,7 @@ struct LiveFlight {
   std::string record_path;  // "" when not recording
   std::optional<ReplayCheck> check;  // flying a recording's pilot commands
   std::optional<HapticSink> haptic;  // a gamepad pilot: λ to the rumble
+  std::optional<net::TelemetryPublisher> publisher;  // --publish: the telemetry over DDS
   std::unique_ptr<RealtimeRunner> runner;
   ui::Scene scene;
   ui::History history;

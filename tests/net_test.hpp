@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <regex>
 #include <string>
 #include <thread>
 
@@ -70,6 +71,37 @@ inline int finished(const std::filesystem::path& dir, const std::string& out, do
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return -1;
+}
+
+// What tests/net/dds_echo.c printed of mixpilot's telemetry (mi_helix) after `fly --publish`:
+// the four topics with ROS 2's type names and plausible values.
+inline void expect_echoed_telemetry(const std::string& out) {
+  EXPECT_NE(out.find("pose type geometry_msgs::msg::dds_::PoseStamped_"), std::string::npos);
+  EXPECT_NE(out.find("lambda type std_msgs::msg::dds_::Float64_"), std::string::npos);
+  EXPECT_NE(out.find("predicted_path type nav_msgs::msg::dds_::Path_"), std::string::npos);
+  EXPECT_NE(out.find("reference_path type nav_msgs::msg::dds_::Path_"), std::string::npos);
+  // Samples arrived on every topic (best effort: how many of the 200 is the machine's timing;
+  // the publisher's own count above is exact) and values: inside the arena, a unit quaternion,
+  // λ in (0, 1), paths of N + 1 = 51 nodes (mi_helix: N = 50).
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(
+      R"(pose (\d+) samples, last position (\S+) (\S+) (\S+), quaternion (\S+) (\S+) (\S+) (\S+))")))
+      << out;
+  EXPECT_GE(std::stoi(m[1]), 1);
+  const double z = std::stod(m[4]);
+  EXPECT_GT(z, 0.0);
+  EXPECT_LT(z, 3.0);
+  double qn = 0;
+  for (int i = 5; i <= 8; ++i) qn += std::stod(m[i]) * std::stod(m[i]);
+  EXPECT_NEAR(qn, 1.0, 1e-3);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(lambda (\d+) samples, last (\S+))"))) << out;
+  EXPECT_GE(std::stoi(m[1]), 1);
+  EXPECT_GT(std::stod(m[2]), 0.0);
+  EXPECT_LT(std::stod(m[2]), 1.0);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(predicted_path (\d+) samples, last (\d+) poses)")))
+      << out;
+  EXPECT_GE(std::stoi(m[1]), 1);
+  EXPECT_EQ(std::stoi(m[2]), 51);
 }
 
 }  // namespace mixpilot::net
