@@ -2,7 +2,7 @@
 // A recording shown in the app (SPEC §8 "Replay"): its session flown again from the embedded
 // scenario into a tape of every step's telemetry, on a loader thread, so the window can play it
 // at any speed, scrub back and forth and jump to events while the rest still loads. The replay
-// is checked step by step against the recording (app/replay.hpp).
+// is checked step by step against the recording (core/recording/replay.hpp).
 #include <atomic>
 #include <cstdint>
 #include <memory>

@@ -1,4 +1,4 @@
-// Replay integrity (app/replay.hpp): a recording flown again is checked step by step, and a
+// Replay integrity (core/recording/replay.hpp): a recording flown again is checked step by step, and a
 // change to any recorded pilot command — the last one included, whose only trace is the last
 // applied input — is caught.
 #include <gtest/gtest.h>
