@@ -207,8 +207,10 @@ void Devices::cue(double lambda) const {
   if (gamepad) gamepad->set_rumble(input::rumble_intensity(lambda, settings.haptic));
 }
 
-// --vehicle dds: the link to `mixpilot vehicle`, once the vehicle has been heard.
-bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
+namespace {
+
+// --vehicle dds: the link to `mixpilot vehicle`, listening (attach_vehicle() waits for it).
+bool open_vehicle_link(const FlyOptions& o, Flight& f, std::string& error) {
   net::RemoteVehicle::Options vo;
   vo.domain = o.domain;
   const ModeKind kind = f.mode->kind();
@@ -231,20 +233,24 @@ bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
   std::printf("mixpilot %s: waiting up to %.0f s for the vehicle in DDS domain %u (mixpilot "
               "vehicle --scenario ...)\n", o.command, o.vehicle_wait_s, unsigned(o.domain));
   std::fflush(stdout);
-  if (!f.vehicle->wait_for_vehicle(o.vehicle_wait_s)) {
-    const net::RemoteVehicleStats s = f.vehicle->stats();
-    if (s.rejected() > 0) {
-      error = "--vehicle dds: " + std::to_string(s.rejected()) +
-              " states arrived on rt/mixpilot/vehicle/state in DDS domain " +
-              std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
-              " s and none was taken (the newest as " + s.last_rejection + ")";
-    } else {
-      error = "--vehicle dds: no vehicle heard on rt/mixpilot/vehicle/state in DDS domain " +
-              std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
-              " s (start `mixpilot vehicle --scenario ...` first)";
-    }
-    return false;
-  }
+  return true;
+}
+
+}  // namespace
+
+std::string vehicle_not_heard(const FlyOptions& o, const Flight& f) {
+  const net::RemoteVehicleStats s = f.vehicle->stats();
+  if (s.rejected() > 0)
+    return "--vehicle dds: " + std::to_string(s.rejected()) +
+           " states arrived on rt/mixpilot/vehicle/state in DDS domain " +
+           std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
+           " s and none was taken (the newest as " + s.last_rejection + ")";
+  return "--vehicle dds: no vehicle heard on rt/mixpilot/vehicle/state in DDS domain " +
+         std::to_string(o.domain) + " within " + seconds_text(o.vehicle_wait_s) +
+         " s (start `mixpilot vehicle --scenario ...` first)";
+}
+
+bool attach_vehicle(Flight& f, std::string& error) {
   if (!f.mode->set_vehicle(f.vehicle.get())) {
     error = "--vehicle dds: this mode cannot fly a remote vehicle";
     return false;
@@ -253,7 +259,7 @@ bool open_vehicle(const FlyOptions& o, Flight& f, std::string& error) {
 }
 
 std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status,
-                                     std::shared_ptr<input::Gamepad> gamepad) {
+                                     std::shared_ptr<input::Gamepad> gamepad, VehicleWait wait) {
   status = kExitError;  // unless said otherwise below
   std::optional<Flight> f = load_flight(o, error, status);
   if (!f) return std::nullopt;
@@ -282,7 +288,16 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
   }
   if (!f->mode) return std::nullopt;
   f->pilot = f->mode->identity().pilot;
-  if (o.vehicle == "dds" && !open_vehicle(o, *f, error)) return std::nullopt;
+  if (o.vehicle == "dds") {
+    if (!open_vehicle_link(o, *f, error)) return std::nullopt;
+    if (wait == VehicleWait::block) {
+      if (!f->vehicle->wait_for_vehicle(o.vehicle_wait_s)) {
+        error = vehicle_not_heard(o, *f);
+        return std::nullopt;
+      }
+      if (!attach_vehicle(*f, error)) return std::nullopt;
+    }
+  }
   status = kExitOk;
   return f;
 }

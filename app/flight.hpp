@@ -103,8 +103,17 @@ input::InputSettings load_input_settings(const std::string& path, std::string& n
 // the recording's).
 // `gamepad`: the app's running gamepad, used instead of starting one (SDL's joystick state
 // has one owner per process).
+// `wait`: block waits for a --vehicle dds vehicle here (up to --vehicle-wait); later returns
+// with the link listening, for a caller that must not block (the window): it polls
+// Flight::vehicle->heard() and calls attach_vehicle() once it is.
+enum class VehicleWait { block, later };
 std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, int& status,
-                                     std::shared_ptr<input::Gamepad> gamepad = nullptr);
+                                     std::shared_ptr<input::Gamepad> gamepad = nullptr,
+                                     VehicleWait wait = VehicleWait::block);
+// The heard vehicle flies the flight's mode; false with the reason.
+[[nodiscard]] bool attach_vehicle(Flight& f, std::string& error);
+// Why no vehicle flies after --vehicle-wait: none heard, or what was rejected.
+std::string vehicle_not_heard(const FlyOptions& o, const Flight& f);
 
 // What a recording of the flight says about it (its metadata). `trainee` is the person flying,
 // when the app knows.

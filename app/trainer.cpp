@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -127,9 +128,16 @@ std::unique_ptr<LiveFlight> Trainer::make_live(std::string& error, int& status) 
     // A script's virtual pad must exist before SDL's pads are listed: the flight plugs it.
     if (o.gamepad_script.empty() && !(pad = gamepad(error))) return nullptr;
   }
-  std::optional<Flight> flight = prepare_flight(o, error, status, pad);
+  // The window never waits for a remote vehicle: update_vehicle_wait() listens frame by frame.
+  std::optional<Flight> flight = prepare_flight(o, error, status, pad, VehicleWait::later);
   if (!flight) return nullptr;
   f->flight = std::move(*flight);
+  if (f->flight.vehicle) {
+    f->awaiting_vehicle = true;
+    f->vehicle_deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(o.vehicle_wait_s));
+  }
   if (f->flight.devices && f->flight.devices->gamepad) gamepad_ = f->flight.devices->gamepad;
   Mode& mode = *f->flight.mode;
   f->session = std::make_unique<Session>(mode);
@@ -224,6 +232,7 @@ void Trainer::start() {
     return;
   }
   if (!live_ || live_->started) return;
+  if (live_->awaiting_vehicle || live_->no_vehicle) return;  // the status line says why
   // A gamepad pilot starts once a pad is connected (the banner asks for one meanwhile).
   if (live_->flight.devices && live_->flight.devices->gamepad &&
       !live_->flight.devices->gamepad->connected()) {
@@ -285,8 +294,35 @@ bool Trainer::open_replay(const std::string& path, std::string& error) {
   return true;
 }
 
+void Trainer::update_vehicle_wait(LiveFlight& f) {
+  const auto now = std::chrono::steady_clock::now();
+  std::string error;
+  if (f.flight.vehicle->heard()) {
+    f.awaiting_vehicle = false;
+    if (attach_vehicle(f.flight, error)) {
+      say("the vehicle is there: Start (Space) flies it");
+    } else {
+      f.no_vehicle = true;
+      say(error, true);
+    }
+  } else if (now >= f.vehicle_deadline) {
+    f.awaiting_vehicle = false;
+    f.no_vehicle = true;
+    say(vehicle_not_heard(options_, f.flight) + "; Restart (R) waits again", true);
+  } else {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "waiting for the vehicle in DDS domain %u (mixpilot vehicle): %.0f s left, Esc "
+                  "cancels",
+                  unsigned(options_.domain),
+                  std::ceil(std::chrono::duration<double>(f.vehicle_deadline - now).count()));
+    say(text);
+  }
+}
+
 void Trainer::update_live() {
   LiveFlight& f = *live_;
+  if (f.awaiting_vehicle) update_vehicle_wait(f);
   if (!f.closed) {
     while (f.runner->telemetry().pop(f.sample)) {
       f.history.push(f.sample);
@@ -302,7 +338,8 @@ void Trainer::update_live() {
   if (over && f.metrics.empty())
     f.metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
                                    : with_lost_fields(mode.metrics(), mode);
-  run_.state = !f.started ? ui::RunState::ready
+  run_.state = f.awaiting_vehicle ? ui::RunState::waiting
+               : !f.started ? ui::RunState::ready
                : mode.lost() ? ui::RunState::lost
                : over ? ui::RunState::finished
                : f.runner->paused() ? ui::RunState::paused
@@ -435,6 +472,11 @@ void Trainer::build_frame(double wall_dt) {
 
 void Trainer::act(const ui::UiRequest& req) {
   std::string error;
+  if (req.cancel_wait && live_ && live_->awaiting_vehicle) {
+    live_->awaiting_vehicle = false;
+    live_->no_vehicle = true;
+    say("no vehicle: the wait was cancelled; Restart (R) waits again");
+  }
   if (!req.open.empty()) {
     if (req.open.ends_with(".mcap")) {
       if (!open_replay(req.open, error)) say(error, true);

@@ -3,6 +3,7 @@
 // thread, or a recording's replay, the session panel's choices, and what the user's requests do
 // to them. One frame: build_frame() between ImGui::NewFrame() and ImGui::Render(). The window
 // (app/window.cpp) and the headless tests drive the same object.
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -36,6 +37,10 @@ struct LiveFlight {
   ui::RunInfo counts;  // fallbacks and deadline misses so far (ui::count_step)
   bool started = false, closed = false;
   bool waiting = false;  // Start asked for, waiting for the gamepad
+  // --vehicle dds: listening for the vehicle until vehicle_deadline while the window draws on;
+  // no_vehicle: none came (or the wait was cancelled), so this flight cannot start.
+  bool awaiting_vehicle = false, no_vehicle = false;
+  std::chrono::steady_clock::time_point vehicle_deadline;
   Metrics metrics;   // once the run is over
 };
 
@@ -80,6 +85,7 @@ class Trainer {
   void close_live(LiveFlight& f);
   void refresh_choices();
   void update_live();
+  void update_vehicle_wait(LiveFlight& f);
   void update_replay(double wall_dt);
   void say(std::string message, bool error = false);
   void update_input();

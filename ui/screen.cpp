@@ -25,6 +25,7 @@ const char* to_string(Camera c) {
 const char* to_string(RunState s) {
   switch (s) {
     case RunState::ready: return "READY";
+    case RunState::waiting: return "WAITING";
     case RunState::flying: return "FLYING";
     case RunState::paused: return "PAUSED";
     case RunState::finished: return "FINISHED";
@@ -52,6 +53,7 @@ ImU32 state_colour(RunState s) {
   switch (s) {
     case RunState::flying: return colour::kMpc;
     case RunState::paused: return colour::kCaution;
+    case RunState::waiting: return colour::kCaution;
     case RunState::lost: return colour::kCritical;
     case RunState::replay: return colour::kPilot;
     default: return colour::rgb(0x80, 0x88, 0x90);
@@ -118,6 +120,8 @@ float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui
     };
     if (run.state == RunState::ready) {
       if (button("Start (Space)")) req.start = true;
+    } else if (run.state == RunState::waiting) {
+      if (button("Cancel (Esc)")) req.cancel_wait = true;
     } else if (run.state == RunState::flying || run.state == RunState::paused) {
       if (button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
         req.toggle_pause = true;
@@ -454,7 +458,8 @@ void keys(UiState& ui, UiRequest& req, const RunInfo& run, const History& h) {
   }
   if (pressed(ImGuiKey_Escape) && ui.show_help) ui.show_help = false;
   else if (run.replay) replay_keys(run, req);
-  if (pressed(ImGuiKey_Space))
+  else if (pressed(ImGuiKey_Escape) && run.state == RunState::waiting) req.cancel_wait = true;
+  if (pressed(ImGuiKey_Space) && run.state != RunState::waiting)
     (run.state == RunState::ready ? req.start : req.toggle_pause) = true;
   if (pressed('R') && run.can_restart && !run.replay) req.restart = true;
   if (pressed('1')) ui.camera = Camera::chase;

@@ -21,7 +21,8 @@ enum class Camera { chase, orbit, top, side };
 const char* to_string(Camera c);
 
 // What the app shows about the flight besides its telemetry.
-enum class RunState { ready, flying, paused, finished, replay, loading, lost };
+// waiting: the flight waits for its remote vehicle (--vehicle dds) and can be cancelled.
+enum class RunState { ready, waiting, flying, paused, finished, replay, loading, lost };
 const char* to_string(RunState s);
 
 // Events a replay's timeline marks and jumps to (UI.md §6).
@@ -149,6 +150,7 @@ struct UiRequest {
   bool start = false;
   bool toggle_pause = false;   // live: pause / resume; replay: play / pause
   bool restart = false;
+  bool cancel_wait = false;    // stop waiting for the remote vehicle (Esc)
   bool quit = false;
   double speed = 0.0;          // > 0: a new speed (live: 0.25–1; replay: 0.25–8)
   int scenario = -1;           // ≥ 0: fly this scenario of SessionChoices next
