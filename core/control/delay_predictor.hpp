@@ -69,11 +69,12 @@ class DelayPredictor {
   double substep() const { return h_; }
   long commands_sent() const { return sent_.k; }
 
-  // The commands sent, and back: restore() takes those of a predictor set up alike (false,
-  // changing nothing, for a ring of another size). Allocates nothing.
+  // The commands sent, and back: restore() takes those that fit(), of a predictor set up
+  // alike (false, changing nothing, for any other). Allocates nothing.
   const Sent& sent() const { return sent_; }
-  [[nodiscard]] bool restore(const Sent& sent) {
-    if (sent.ring.size() != sent_.ring.size()) return false;
+  bool fits(const Sent& sent) const { return sent.ring.size() == sent_.ring.size(); }
+  bool restore(const Sent& sent) {
+    if (!fits(sent)) return false;
     sent_ = sent;
     return true;
   }

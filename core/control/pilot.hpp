@@ -59,17 +59,14 @@ class PilotSource {
 
   // Snapshots of a flight (Mode::save, Mode::restore). save() copies what the next command()
   // reads into `state`: the first save makes it (replacing another source's), later ones copy
-  // into it and allocate nothing. A source that keeps nothing between commands leaves it null.
-  // false: the source cannot go back to an earlier command (the default: a device reads the
-  // present, not the past).
-  virtual bool save(std::unique_ptr<PilotState>& state) const {
-    state.reset();
-    return false;
-  }
+  // into it and allocate nothing. A source that keeps nothing between commands, or cannot go
+  // back to an earlier one, leaves it null (the default).
+  virtual void save(std::unique_ptr<PilotState>& state) const { state.reset(); }
   // Continues from `state`, saved by a source of the same kind and setup; false, changing
-  // nothing, when it cannot (the default). A source whose commands follow from the step and
-  // the vehicle's state alone (a recording, the reckless pilot) continues from any state, so
-  // it can take over a flight saved with another source.
+  // nothing, when it cannot. A source whose commands follow from the step and the vehicle's
+  // state alone (a recording, the reckless pilot) continues from any state, so it can take
+  // over a flight saved with another source. The default refuses: a device reads the present,
+  // and cannot give the commands of the past again.
   [[nodiscard]] virtual bool restore(const PilotState* state) {
     (void)state;
     return false;

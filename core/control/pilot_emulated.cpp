@@ -73,7 +73,7 @@ bool EmulatedPilot::command(std::int64_t step, double t, const Eigen::VectorXd& 
   return true;
 }
 
-bool EmulatedPilot::save(std::unique_ptr<PilotState>& state) const {
+void EmulatedPilot::save(std::unique_ptr<PilotState>& state) const {
   auto* s = dynamic_cast<State*>(state.get());
   if (!s) {
     state = std::make_unique<State>();
@@ -82,12 +82,12 @@ bool EmulatedPilot::save(std::unique_ptr<PilotState>& state) const {
   s->rti = rti_.state();
   s->delay_line = delay_line_;
   s->started = started_;
-  return true;
 }
 
 bool EmulatedPilot::restore(const PilotState* state) {
   const auto* s = dynamic_cast<const State*>(state);
-  if (!s || s->delay_line.size() != delay_line_.size() || !rti_.restore(s->rti)) return false;
+  if (!s || s->delay_line.size() != delay_line_.size() || !rti_.fits(s->rti)) return false;
+  rti_.restore(s->rti);
   delay_line_ = s->delay_line;
   started_ = s->started;
   return true;

@@ -33,7 +33,7 @@ class EmulatedPilot final : public PilotSource {
     std::vector<PilotCommand> delay_line;
     bool started = false;
   };
-  bool save(std::unique_ptr<PilotState>& state) const override;
+  void save(std::unique_ptr<PilotState>& state) const override;
   // Only a State of a pilot with the same horizon and reaction delay.
   [[nodiscard]] bool restore(const PilotState* state) override;
 
@@ -60,11 +60,7 @@ class RecklessPilot final : public PilotSource {
 
   std::string name() const override { return "reckless"; }
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
-  // Keeps nothing: its command follows from the vehicle's state.
-  bool save(std::unique_ptr<PilotState>& state) const override {
-    state.reset();
-    return true;
-  }
+  // Keeps nothing (save() leaves the state null): its command follows from the vehicle's state.
   [[nodiscard]] bool restore(const PilotState*) override { return true; }
 
  private:

@@ -324,17 +324,20 @@ bool same_sizes(const std::vector<Eigen::VectorXd>& a, const std::vector<Eigen::
 
 }  // namespace
 
-bool RtiSolver::restore(const RtiState& state) {
+bool RtiSolver::fits(const RtiState& state) const {
   const OcpTrajectory& t = state.trajectory;
   const OcpQpSolution& q = state.qp_solution;
   const OcpQpSolution& mine = state_.qp_solution;
-  if (!ocp_ || !same_sizes(t.x, state_.trajectory.x) || !same_sizes(t.u, state_.trajectory.u) ||
-      !same_sizes(q.x, mine.x) || !same_sizes(q.u, mine.u) || !same_sizes(q.pi, mine.pi) ||
-      !same_sizes(q.lam_l, mine.lam_l) || !same_sizes(q.lam_u, mine.lam_u) ||
-      !same_sizes(q.sl, mine.sl) || !same_sizes(q.su, mine.su) ||
-      !same_sizes(q.lam_sl, mine.lam_sl) || !same_sizes(q.lam_su, mine.lam_su) ||
-      q.lam_x0.size() != mine.lam_x0.size())
-    return false;
+  return ocp_ && same_sizes(t.x, state_.trajectory.x) && same_sizes(t.u, state_.trajectory.u) &&
+         same_sizes(q.x, mine.x) && same_sizes(q.u, mine.u) && same_sizes(q.pi, mine.pi) &&
+         same_sizes(q.lam_l, mine.lam_l) && same_sizes(q.lam_u, mine.lam_u) &&
+         same_sizes(q.sl, mine.sl) && same_sizes(q.su, mine.su) &&
+         same_sizes(q.lam_sl, mine.lam_sl) && same_sizes(q.lam_su, mine.lam_su) &&
+         q.lam_x0.size() == mine.lam_x0.size();
+}
+
+bool RtiSolver::restore(const RtiState& state) {
+  if (!fits(state)) return false;
   state_ = state;
   return true;
 }

@@ -142,10 +142,12 @@ class RtiSolver {
   const OcpQpSolution& qp_solution() const { return state_.qp_solution; }
   const Ocp* ocp() const { return ocp_; }
 
-  // The solver's state (RtiState), and back: restore() continues from a state of a solver set
-  // up for the same OCP (false, changing nothing, when its sizes differ). Allocates nothing.
+  // The solver's state (RtiState), and back: restore() continues from a state that fits(),
+  // one of a solver set up for the same OCP (false, changing nothing, for any other).
+  // Allocates nothing.
   const RtiState& state() const { return state_; }
-  [[nodiscard]] bool restore(const RtiState& state);
+  bool fits(const RtiState& state) const;
+  bool restore(const RtiState& state);
 
  private:
   void linearize_cost(int i);
