@@ -269,6 +269,40 @@ bool MiMode::step() {
   return true;
 }
 
+struct MiMode::Saved final : ModeSnapshot::State {
+  RtiState rti;                      // the MPC's warm start
+  MiController::Outputs controller;  // λ for the next step, the last plan's outputs
+  ScoreAccumulator::Sums score;
+  Run run;
+  std::unique_ptr<PilotState> pilot;  // null: the source keeps nothing, or cannot go back
+  bool remote = false;
+};
+
+void MiMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = controller_.rti().state();
+  s.controller = controller_.outputs();
+  s.score = scorer_.sums();
+  s.run = run_;
+  if (pilot_) pilot_->save(s.pilot);
+  s.remote = link_ != nullptr;
+}
+
+RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (s.remote || link_) return RestoreStatus::remote_vehicle;
+  if (!controller_.rti().fits(s.rti) || s.run.u_delay.size() != run_.u_delay.size() ||
+      s.controller.predicted.cols() != controller_.outputs().predicted.cols())
+    return RestoreStatus::other_scenario;
+  if (!pilot_ || !pilot_->restore(s.pilot.get())) return RestoreStatus::pilot;
+  controller_.rti().restore(s.rti);
+  controller_.restore(s.controller);
+  scorer_.restore(s.score);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 Metrics MiMode::metrics() const {
   Metrics m = to_metrics(score());
   if (link_) {

@@ -72,7 +72,14 @@ class MiMode final : public Mode {
   const SafetyNet& safety_net() const { return run_.safety; }
   const Eigen::VectorXd& state() const { return run_.x; }
 
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the MPC's RTI state and outputs, the score's sums,
+  // Run and the pilot source's state. With a remote vehicle they refuse.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+
  private:
+  struct Saved;
   bool left_the_world() const;
   void measure(double t);
   void measure_remote(double t);

@@ -253,6 +253,28 @@ void ObstacleMode::set_channels(double step_min_distance, double tracking_error)
 // ---------------------------------------------------------------------------------------------
 // Results
 
+struct ObstacleMode::Saved final : ModeSnapshot::State {
+  RtiState rti;  // the NMPC's warm start
+  Run run;
+};
+
+void ObstacleMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = rti_.state();
+  s.run = run_;
+}
+
+RestoreStatus ObstacleMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (!ready_ || !rti_.fits(s.rti) ||
+      s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
+    return RestoreStatus::other_scenario;
+  rti_.restore(s.rti);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 ObstacleRunResult ObstacleMode::result() const {
   ObstacleRunResult r;
   r.form = settings_.form;

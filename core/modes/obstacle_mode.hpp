@@ -98,7 +98,13 @@ class ObstacleMode final : public Mode {
   // The run so far (allocates: for reports, not for the loop); trajectories left empty.
   ObstacleRunResult result() const;
 
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state and Run.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+
  private:
+  struct Saved;
   SetupResult check_scenario() const;
   void warm_start();
   void reset_telemetry();

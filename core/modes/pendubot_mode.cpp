@@ -344,6 +344,27 @@ void PendubotMode::set_channels() {
   s.set_channel(kPendubotTorqueBound, "torque bound", "N m", oc.u_max);
 }
 
+struct PendubotMode::Saved final : ModeSnapshot::State {
+  RtiState rti;  // the NMPC's warm start
+  Run run;
+};
+
+void PendubotMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = rti_.state();
+  s.run = run_;
+}
+
+RestoreStatus PendubotMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (!ok_ || !rti_.fits(s.rti) || s.run.x0.size() != run_.x0.size())
+    return RestoreStatus::other_scenario;
+  rti_.restore(s.rti);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 PendubotRun PendubotMode::result() const {
   PendubotRun r;
   r.ok = ok_;

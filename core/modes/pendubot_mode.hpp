@@ -128,7 +128,13 @@ class PendubotMode final : public Mode {
   bool lqr_active() const { return run_.lqr_active; }
   const SafetyNet& safety_net() const { return run_.safety; }
 
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state and Run.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+
  private:
+  struct Saved;
   SetupResult check_settings() const;
   void warm_start();
   void measure();

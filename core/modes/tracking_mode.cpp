@@ -383,6 +383,38 @@ void TrackingMode::set_channels(double predictor_us, double controller_us) {
   }
 }
 
+struct TrackingMode::Saved final : ModeSnapshot::State {
+  bool nmpc = false;
+  RtiState rti;  // the NMPC's warm start (empty for the LQR)
+  CrazyflieDelayPredictor::Sent predictor;
+  Run run;
+  bool remote = false;
+};
+
+void TrackingMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.nmpc = rti_ != nullptr;
+  if (rti_) s.rti = rti_->state();
+  s.predictor = predictor_.sent();
+  s.run = run_;
+  s.remote = link_ != nullptr;
+}
+
+RestoreStatus TrackingMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (s.remote || link_) return RestoreStatus::remote_vehicle;
+  if (!ok_ || s.nmpc != (rti_ != nullptr) || (rti_ && !rti_->fits(s.rti)) ||
+      !predictor_.fits(s.predictor) || s.run.states.size() != run_.states.size() ||
+      s.run.cmds.size() != run_.cmds.size() ||
+      s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
+    return RestoreStatus::other_scenario;
+  if (rti_) rti_->restore(s.rti);
+  predictor_.restore(s.predictor);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 TrackingResult TrackingMode::result() const {
   TrackingResult r;
   r.ok = ok_;

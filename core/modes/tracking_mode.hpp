@@ -124,7 +124,14 @@ class TrackingMode final : public Mode {
   bool nmpc() const { return problem_ != nullptr; }
   const SafetyNet& safety_net() const { return run_.safety; }
 
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state, the predictor's sent
+  // commands and Run. With a remote vehicle they refuse.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+
  private:
+  struct Saved;
   std::size_t ring(long j) const { return std::size_t(j % long(run_.states.size())); }
   void measure();
   void control();
