@@ -4,7 +4,7 @@
 Each mutation below is a small, deliberate defect in production code at a place the tests
 promise to guard -- allocation in the control loop, pacing by the wall clock, staleness of
 device input, the score's formulas, replay equality, deadline accounting, the safety net, the
-QP's handling of singular directions, the TOML nesting bound. For each one the script applies
+QP's handling of singular directions, what a snapshot of a flight keeps, the TOML nesting bound. For each one the script applies
 the edit to a private copy of the tree (a git worktree under build/break-it, built there with
 the release preset), builds the named test target and runs the named tests. The mutation is
 *killed* when a test fails (or crashes, or times out), *survived* when every test passes; a
@@ -31,8 +31,8 @@ MUTATIONS = [
      "  bool finite = true;\n  { void* volatile p = std::malloc(64); std::free(p); }\n",
      "test_no_malloc", "NoMalloc.*"),
     ("allocation in the MI mode's step", "core/modes/mi_mode.cpp",
-     "  const double t = double(step_) * dt_;\n",
-     "  const double t = double(step_) * dt_;\n  { void* volatile p = std::malloc(64); std::free(p); }\n",
+     "  const double t = double(run_.step) * dt_;\n",
+     "  const double t = double(run_.step) * dt_;\n  { void* volatile p = std::malloc(64); std::free(p); }\n",
      "test_modes", "Shipped/EveryMode.RunsDeterministically*/mi_helix_novice"),
     ("runner does not sleep", "core/runtime/realtime_runner.cpp",
      "    std::this_thread::sleep_until(next);\n", "\n",
@@ -57,7 +57,7 @@ MUTATIONS = [
      "std::lround(1.0 / dt_));", "std::lround(2.0 / dt_));",
      "test_score", "ScoreFormula.*"),
     ("a collision per contact step", "core/modes/score.cpp",
-     "  const bool started = contact && !in_contact_;\n",
+     "  const bool started = contact && !m.in_contact;\n",
      "  const bool started = contact;\n",
      "test_score", "ScoreFormula.*"),
     ("replay check ignores λ", "core/recording/replay.cpp",
@@ -79,6 +79,23 @@ MUTATIONS = [
      "        p = std::max(pivot_floor, psd_tol * mag);  // no curvature: regularized (see the header)\n",
      "        p = 1e300;  // dropped: its column vanishes\n",
      "test_session", "MixedInitiative.ThePlannerFliesEveryStepWhileTheInputIsLost"),
+    ("a snapshot leaves the random generator out", "core/modes/mi_mode.cpp",
+     "  scorer_.restore(s.score);\n  run_ = s.run;\n",
+     "  scorer_.restore(s.score);\n  const auto rng = run_.rng;\n  const auto noise = run_.noise;\n"
+     "  run_ = s.run;\n  run_.rng = rng;\n  run_.noise = noise;\n",
+     "test_snapshot", "Shipped/Restore.*/mi_helix_noise_and_delay"),
+    ("a snapshot leaves the QP warm start out", "core/nlp/rti.cpp",
+     "  if (!fits(state)) return false;\n  state_ = state;\n",
+     "  if (!fits(state)) return false;\n  const OcpQpSolution kept = state_.qp_solution;\n"
+     "  const bool had = state_.have_qp_solution;\n  state_ = state;\n"
+     "  state_.qp_solution = kept;\n  state_.have_qp_solution = had;\n",
+     "test_snapshot", "Shipped/Restore.*"),
+    ("a snapshot leaves the pilot's reaction delay out", "core/control/pilot_emulated.cpp",
+     "  delay_line_ = s->delay_line;\n", "",
+     "test_snapshot", "Shipped/Restore.*/mi_helix_novice"),
+    ("a restore leaves the replay cursors out", "core/modes/mode.cpp",
+     "  next_forced_ = s.next_forced_;\n", "",
+     "test_snapshot", "Shipped/Restore.IntoTheModeThatFlewOn*"),
     ("no TOML nesting bound", "core/scenario/toml_read.hpp",
      "  if (const std::optional<Pos> at = too_deep(text)) {",
      "  if (const std::optional<Pos> at = std::optional<Pos>{}) {",

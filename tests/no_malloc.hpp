@@ -30,17 +30,23 @@ extern "C" void* __libc_realloc(void*, std::size_t);
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<long> g_allocations{0};
+std::atomic<long> g_bytes{0};  // requested by the counted allocations
+void count_allocation(std::size_t bytes) {
+  if (!g_counting.load(std::memory_order_relaxed)) return;
+  g_allocations.fetch_add(1);
+  g_bytes.fetch_add(long(bytes));
+}
 }  // namespace
 extern "C" void* malloc(std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  count_allocation(n);
   return __libc_malloc(n);
 }
 extern "C" void* calloc(std::size_t n, std::size_t m) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  count_allocation(n * m);
   return __libc_calloc(n, m);
 }
 extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  count_allocation(n);
   return __libc_realloc(p, n);
 }
 #endif
@@ -65,6 +71,38 @@ struct NoMalloc {
   static long count() {
 #if MIXPILOT_COUNT_MALLOC
     return g_allocations.load();
+#else
+    return 0;
+#endif
+  }
+};
+
+// Counts the allocations in its scope and the bytes they asked for, forbidding none (what a
+// first save into a snapshot allocates, say). 0 under AddressSanitizer.
+struct AllocationCount {
+  AllocationCount() {
+#if MIXPILOT_COUNT_MALLOC
+    g_allocations = 0;
+    g_bytes = 0;
+    g_counting = true;
+#endif
+  }
+  ~AllocationCount() { stop(); }
+  void stop() {
+#if MIXPILOT_COUNT_MALLOC
+    g_counting = false;
+#endif
+  }
+  static long count() {
+#if MIXPILOT_COUNT_MALLOC
+    return g_allocations.load();
+#else
+    return 0;
+#endif
+  }
+  static long bytes() {
+#if MIXPILOT_COUNT_MALLOC
+    return g_bytes.load();
 #else
     return 0;
 #endif

@@ -144,6 +144,22 @@ class IdleMode final : public Mode {
   ModeView view() const override { return {}; }
   void set_deadline_us(double) override {}
 
+ protected:
+  struct Saved final : ModeSnapshot::State {
+    std::int64_t done = 0;
+    Telemetry telemetry;
+  };
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override {
+    if (!state) state = std::make_unique<Saved>();
+    static_cast<Saved&>(*state).done = done_;
+    static_cast<Saved&>(*state).telemetry = telemetry_;
+  }
+  RestoreStatus restore_state(const ModeSnapshot::State& state) override {
+    done_ = static_cast<const Saved&>(state).done;
+    telemetry_ = static_cast<const Saved&>(state).telemetry;
+    return RestoreStatus::ok;
+  }
+
  private:
   std::int64_t steps_, done_ = 0;
   std::string name_ = "idle";

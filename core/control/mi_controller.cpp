@@ -82,13 +82,13 @@ SetupResult MiController::setup(const models::MikroKopter& model, const MiContro
   const MiWeights& w = settings.weights;
   weights_.resize(ny);
   weights_ << w.q_eta, Eigen::VectorXd::Constant(6, w.q_nu), w.q_e, Eigen::VectorXd::Constant(4, w.r);
-  control_ = model.hover_input();
-  applied_ = model.hover_state(Eigen::Vector3d::Zero());
-  predicted_.setZero(3, N + 1);
-  reference_.setZero(3, N + 1);
+  out_.control = model.hover_input();
+  out_.applied = model.hover_state(Eigen::Vector3d::Zero());
+  out_.predicted.setZero(3, N + 1);
+  out_.reference.setZero(3, N + 1);
   nearest_.resize(int(arena.obstacles.size()));
   distance_.resize(int(arena.obstacles.size()));
-  lambda_next_ = lambda_used_ = settings.ph.initial_lambda;
+  out_.lambda_next = out_.lambda_used = settings.ph.initial_lambda;
   return {};
 }
 
@@ -96,13 +96,13 @@ void MiController::reset(const Eigen::VectorXd& x) {
   const Eigen::VectorXd hover = model_.hover_state(x.head<3>());
   for (auto& xi : rti_.trajectory().x) xi = hover;
   for (auto& ui : rti_.trajectory().u) ui = model_.hover_input();
-  control_ = model_.hover_input();
-  lambda_next_ = lambda_used_ = settings_.ph.initial_lambda;
+  out_.control = model_.hover_input();
+  out_.lambda_next = out_.lambda_used = settings_.ph.initial_lambda;
 }
 
 void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x) {
   const int N = settings_.N;
-  const double l = lambda_used_;
+  const double l = out_.lambda_used;
   OcpStageData& data = rti_.data();
   for (int i = 0; i <= N; ++i) {
     Eigen::VectorXd& y = data.yref[i];
@@ -142,31 +142,32 @@ void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eig
 
 RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
   // The source's authority caps λ (input loss hands the vehicle to the planner, SPEC §6).
-  lambda_used_ = std::min(lambda_next_, std::clamp(pilot.authority, 0.0, 1.0));
+  out_.lambda_used = std::min(out_.lambda_next, std::clamp(pilot.authority, 0.0, 1.0));
   set_stage_data(t, pilot, x);
   rti_.prepare();
   const RtiStatus status = rti_.feedback(x);
-  control_ = rti_.control();
+  out_.control = rti_.control();
 
   // The prediction and reference of this step, and from them λ for the next (SPEC §5.4).
   const OcpTrajectory& traj = rti_.trajectory();
   double d_res = 0.0;
   for (int i = 0; i <= settings_.N; ++i) {
-    predicted_.col(i) = traj.x[i].head<3>();
-    reference_.col(i) = rti_.data().yref[i].head<3>();
-    if (i <= settings_.ph.N_b) d_res = std::max(d_res, (predicted_.col(i) - reference_.col(i)).norm());
+    out_.predicted.col(i) = traj.x[i].head<3>();
+    out_.reference.col(i) = rti_.data().yref[i].head<3>();
+    if (i <= settings_.ph.N_b)
+      d_res = std::max(d_res, (out_.predicted.col(i) - out_.reference.col(i)).norm());
   }
-  lambda_next_ = ph_lambda(d_res, settings_.ph);
-  applied_ = traj.x[1];
+  out_.lambda_next = ph_lambda(d_res, settings_.ph);
+  out_.applied = traj.x[1];
   rti_.shift();
   return status;
 }
 
 PilotCommand MiController::applied_command() const {
   PilotCommand c;
-  c.roll = applied_(3);
-  c.pitch = applied_(4);
-  c.rotor_speed = applied_.segment<4>(12);
+  c.roll = out_.applied(3);
+  c.pitch = out_.applied(4);
+  c.rotor_speed = out_.applied.segment<4>(12);
   return c;
 }
 

@@ -30,6 +30,17 @@ class MiController {
   static constexpr int nu = models::MikroKopter::nu;  // 4
   static constexpr int ny = 20;                        // η (3), ν (6), e (7), u (4)
 
+  // What the next step reads of the last one besides the RTI solver's state (rti().state()):
+  // λ for the next step, and the last step's outputs (a snapshot of a flight copies it).
+  struct Outputs {
+    Eigen::VectorXd control;     // nu
+    Eigen::VectorXd applied;     // nx: predicted state at stage 1
+    Eigen::Matrix3Xd predicted;  // 3 x (N+1)
+    Eigen::Matrix3Xd reference;  // 3 x (N+1)
+    double lambda_next = 0.5;
+    double lambda_used = 0.5;
+  };
+
   MiController() = default;
   MiController(const MiController&) = delete;  // the Ocp points into this object
   MiController& operator=(const MiController&) = delete;
@@ -47,18 +58,23 @@ class MiController {
   // Allocates nothing. control() then holds τ to apply (never NaN).
   RtiStatus step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot);
 
-  const Eigen::VectorXd& control() const { return control_; }  // τ (nu)
-  double lambda() const { return lambda_used_; }               // λ used in the last step
+  const Eigen::VectorXd& control() const { return out_.control; }  // τ (nu)
+  double lambda() const { return out_.lambda_used; }               // λ used in the last step
   // The MPC's own (φ, θ, Ω) at stage 1: what the pilot's command became.
   PilotCommand applied_command() const;
   // Predicted positions and planner reference at the nodes of the last step (3 x (N+1)).
-  const Eigen::Matrix3Xd& predicted_positions() const { return predicted_; }
-  const Eigen::Matrix3Xd& reference_positions() const { return reference_; }
+  const Eigen::Matrix3Xd& predicted_positions() const { return out_.predicted; }
+  const Eigen::Matrix3Xd& reference_positions() const { return out_.reference; }
   const RtiSolver& rti() const { return rti_; }
   RtiSolver& rti() { return rti_; }
   const models::MikroKopter& model() const { return model_; }
   const MiControllerSettings& settings() const { return settings_; }
   int constrained_obstacles() const { return num_obstacles_; }
+
+  // The outputs and λ, and back (a controller set up alike: no allocation). The RTI solver's
+  // state is rti().state() and rti().restore().
+  const Outputs& outputs() const { return out_; }
+  void restore(const Outputs& outputs) { out_ = outputs; }
 
  private:
   void set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x);
@@ -76,14 +92,9 @@ class MiController {
   int num_obstacles_ = 0;
 
   Eigen::VectorXd weights_;           // ny: unscaled diagonal of W
-  Eigen::VectorXd control_;           // nu
-  Eigen::VectorXd applied_;           // nx: predicted state at stage 1
-  Eigen::Matrix3Xd predicted_;        // 3 x (N+1)
-  Eigen::Matrix3Xd reference_;        // 3 x (N+1)
+  Outputs out_;
   Eigen::VectorXi nearest_;           // obstacle indices, by distance (scratch)
   Eigen::VectorXd distance_;          // per obstacle (scratch)
-  double lambda_next_ = 0.5;
-  double lambda_used_ = 0.5;
 };
 
 }  // namespace mixpilot

@@ -3,6 +3,7 @@
 // yields the same command stream, one command per control step (SPEC §6).
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,12 @@ struct JoyInput {
   int num_buttons = 0;
 };
 
+// What a pilot source keeps between commands, saved with a snapshot of the flight
+// (core/modes/mode.hpp: Mode::save). Each source that keeps something derives its own.
+struct PilotState {
+  virtual ~PilotState() = default;
+};
+
 class PilotSource {
  public:
   virtual ~PilotSource() = default;
@@ -49,6 +56,21 @@ class PilotSource {
                        PilotCommand& out) = 0;
   // The raw device input behind the last command, if the source is a device.
   virtual const JoyInput* joy() const { return nullptr; }
+
+  // Snapshots of a flight (Mode::save, Mode::restore). save() copies what the next command()
+  // reads into `state`: the first save makes it (replacing another source's), later ones copy
+  // into it and allocate nothing. A source that keeps nothing between commands, or cannot go
+  // back to an earlier one, leaves it null (the default).
+  virtual void save(std::unique_ptr<PilotState>& state) const { state.reset(); }
+  // Continues from `state`, saved by a source of the same kind and setup; false, changing
+  // nothing, when it cannot. A source whose commands follow from the step and the vehicle's
+  // state alone (a recording, the reckless pilot) continues from any state, so it can take
+  // over a flight saved with another source. The default refuses: a device reads the present,
+  // and cannot give the commands of the past again.
+  [[nodiscard]] virtual bool restore(const PilotState* state) {
+    (void)state;
+    return false;
+  }
 };
 
 }  // namespace mixpilot

@@ -73,6 +73,26 @@ bool EmulatedPilot::command(std::int64_t step, double t, const Eigen::VectorXd& 
   return true;
 }
 
+void EmulatedPilot::save(std::unique_ptr<PilotState>& state) const {
+  auto* s = dynamic_cast<State*>(state.get());
+  if (!s) {
+    state = std::make_unique<State>();
+    s = static_cast<State*>(state.get());
+  }
+  s->rti = rti_.state();
+  s->delay_line = delay_line_;
+  s->started = started_;
+}
+
+bool EmulatedPilot::restore(const PilotState* state) {
+  const auto* s = dynamic_cast<const State*>(state);
+  if (!s || s->delay_line.size() != delay_line_.size() || !rti_.fits(s->rti)) return false;
+  rti_.restore(s->rti);
+  delay_line_ = s->delay_line;
+  started_ = s->started;
+  return true;
+}
+
 bool RecklessPilot::command(std::int64_t, double, const Eigen::VectorXd& x, PilotCommand& out) {
   out.rotor_speed.setConstant(model_.hover_speed());
   out.roll = out.pitch = 0.0;

@@ -27,6 +27,16 @@ class EmulatedPilot final : public PilotSource {
   std::string name() const override { return profile_.name; }
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
 
+  // The pilot's NMPC and its reaction delay line.
+  struct State final : PilotState {
+    RtiState rti;
+    std::vector<PilotCommand> delay_line;
+    bool started = false;
+  };
+  void save(std::unique_ptr<PilotState>& state) const override;
+  // Only a State of a pilot with the same horizon and reaction delay.
+  [[nodiscard]] bool restore(const PilotState* state) override;
+
  private:
   models::MikroKopter model_{};
   IntegratorErk4<models::MikroKopter> integrator_{};
@@ -50,6 +60,8 @@ class RecklessPilot final : public PilotSource {
 
   std::string name() const override { return "reckless"; }
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
+  // Keeps nothing (save() leaves the state null): its command follows from the vehicle's state.
+  [[nodiscard]] bool restore(const PilotState*) override { return true; }
 
  private:
   models::MikroKopter model_;

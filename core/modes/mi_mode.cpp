@@ -32,7 +32,7 @@ enum MiChannel {
 SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot) {
   scenario_ = std::move(scenario);
   pilot_ = std::move(pilot);
-  finished_ = true;  // until setup succeeds
+  run_.finished = true;  // until setup succeeds
   if (!pilot_) return SetupResult::failure("no pilot source");
   if (scenario_.mode != "mixed_initiative" || scenario_.model != "mikrokopter")
     return SetupResult::failure("only mode 'mixed_initiative' on model 'mikrokopter' is supported");
@@ -49,32 +49,32 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
     return SetupResult::failure("the controller settings do not form a valid OCP: " + r.reason());
   if (SetupResult r = hover_.setup(model_, scenario_.controller.weights, dt_); !r)
     return SetupResult::failure("the safe controller cannot be set up: " + r.reason());
-  safety_.reset();
-  command_ = model_.hover_input();
-  x_ = model_.hover_state(scenario_.reference.position(0.0));
-  controller_.reset(x_);
+  run_.safety.reset();
+  run_.command = model_.hover_input();
+  run_.x = model_.hover_state(scenario_.reference.position(0.0));
+  controller_.reset(run_.x);
   const int delay_steps = int(std::lround(scenario_.plant.input_delay / dt_));
-  u_delay_.assign(std::size_t(delay_steps) + 1, model_.hover_input());
-  rng_.seed(scenario_.plant.seed);
-  noise_.reset();
+  run_.u_delay.assign(std::size_t(delay_steps) + 1, model_.hover_input());
+  run_.rng.seed(scenario_.plant.seed);
+  run_.noise.reset();
   scorer_.setup(scenario_);
-  step_ = 0;
+  run_.step = 0;
   steps_total_ = std::int64_t(std::lround(scenario_.duration / dt_));
   const double h = dt_ / substeps_;
   const int max_substeps = int(std::lround(VehicleFeed::kMaxRtt / h));
   predictor_.setup(model_, substeps_, h, 0, max_substeps);
   feed_.setup(models::MikroKopter::nx, dt_, h, max_substeps, 2 * std::size_t(steps_total_) + 2);
   link_ = nullptr;
-  lost_reason_ = "";
-  finished_ = steps_total_ <= 0;
-  lost_ = false;
-  lost_at_ = -1.0;
+  run_.lost_reason = "";
+  run_.finished = steps_total_ <= 0;
+  run_.lost = false;
+  run_.lost_at = -1.0;
 
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   s = Telemetry{};
   s.mode = ModeKind::mixed_initiative;
-  s.x = x_;
-  s.x_measured = x_;
+  s.x = run_.x;
+  s.x_measured = run_.x;
   s.u = model_.hover_input();
   s.reference = Eigen::VectorXd::Zero(3);
   set_reference(0.0);
@@ -89,21 +89,21 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
 
 // RK4 at the plant rate with the input held (ZOH) over the control period.
 void MiMode::plant_step(const Eigen::VectorXd& u) {
-  models::MikroKopter::State x = x_, xn;
+  models::MikroKopter::State x = run_.x, xn;
   const models::MikroKopter::Input us = u;
   const double h = dt_ / substeps_;
   for (int s = 0; s < substeps_; ++s) {
     plant_.step(x, us, h, xn);
     x = xn;
   }
-  x_ = x;
+  run_.x = x;
 }
 
 // Lost: a non-finite state, or farther than mi_defaults::kLostMargin outside the arena.
 bool MiMode::left_the_world() const {
-  if (!x_.allFinite()) return true;
+  if (!run_.x.allFinite()) return true;
   const Arena& a = scenario_.arena;
-  const Eigen::Vector3d p = x_.head<3>();
+  const Eigen::Vector3d p = run_.x.head<3>();
   return (p - p.cwiseMax(a.min).cwiseMin(a.max)).norm() > mi_defaults::kLostMargin;
 }
 
@@ -111,54 +111,55 @@ bool MiMode::left_the_world() const {
 // for an out-of-bounds read (-Warray-bounds).
 void MiMode::set_reference(double t) {
   const Eigen::Vector3d p = scenario_.reference.position(t);
-  for (int i = 0; i < 3; ++i) telemetry_.reference(i) = p(i);
+  for (int i = 0; i < 3; ++i) run_.telemetry.reference(i) = p(i);
 }
 
 // The controller's view of the state: the true state, positions with noise if configured.
 void MiMode::measure(double t) {
-  Telemetry& s = telemetry_;
-  s.step = step_;
+  Telemetry& s = run_.telemetry;
+  s.step = run_.step;
   s.t = t;
-  s.x = x_;
-  s.x_measured = x_;
+  s.x = run_.x;
+  s.x_measured = run_.x;
   if (scenario_.plant.position_noise > 0.0) {
-    for (int i = 0; i < 3; ++i) s.x_measured(i) += scenario_.plant.position_noise * noise_(rng_);
+    for (int i = 0; i < 3; ++i)
+      s.x_measured(i) += scenario_.plant.position_noise * run_.noise(run_.rng);
   }
 }
 
 // A remote vehicle's newest state, predicted over the estimated round-trip time; lost when it
 // left the world or went silent.
 void MiMode::measure_remote(double t) {
-  Telemetry& s = telemetry_;
-  s.step = step_;
+  Telemetry& s = run_.telemetry;
+  s.step = run_.step;
   s.t = t;
   now_ns_ = link_->now_ns();
-  const VehicleFeed::Reading r = feed_.read(*link_, step_, now_ns_, substeps_);
+  const VehicleFeed::Reading r = feed_.read(*link_, run_.step, now_ns_, substeps_);
   if (r.heard) {
     const VehicleSample& v = *r.sample;
-    for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = v.x(i);
+    for (int i = 0; i < models::MikroKopter::nx; ++i) run_.x(i) = v.x(i);
   }
   const VehicleWorld world = VehicleWorld::box(scenario_.arena.min, scenario_.arena.max,
                                                mi_defaults::kLostMargin);
-  const char* outside = r.heard ? world.outside(x_.head<3>()) : nullptr;
+  const char* outside = r.heard ? world.outside(run_.x.head<3>()) : nullptr;
   if (left_the_world() || outside || (r.heard && r.sample->left_world)) {
-    x_ = s.x;  // the last state known inside it
-    lost_reason_ = outside ? outside : "it left the arena";
+    run_.x = s.x;  // the last state known inside it
+    run_.lost_reason = outside ? outside : "it left the arena";
   } else if (r.lost) {
-    lost_reason_ = feed_.lost_reason();
+    run_.lost_reason = feed_.lost_reason();
   }
   // What is known of the vehicle now: the state predicted to t_k, which the pilot sees, the
   // controller starts from and the score takes.
-  const models::MikroKopter::State y = x_;
+  const models::MikroKopter::State y = run_.x;
   models::MikroKopter::State predicted;
   predictor_.predict(y, predicted, r.horizon_substeps);
-  for (int i = 0; i < models::MikroKopter::nx; ++i) x_(i) = predicted(i);
-  s.x = x_;
-  s.x_measured = x_;
+  for (int i = 0; i < models::MikroKopter::nx; ++i) run_.x(i) = predicted(i);
+  s.x = run_.x;
+  s.x_measured = run_.x;
 }
 
 void MiMode::set_channels() {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   const double deviation = (s.x.head<3>() - s.reference.head<3>()).norm();
   s.set_channel(kLambda, "lambda", "", s.lambda);
   s.set_channel(kDeviation, "deviation", "m", deviation);
@@ -177,18 +178,18 @@ void MiMode::set_channels() {
 }
 
 bool MiMode::step() {
-  if (finished_ || stopped_at(step_)) return false;
+  if (run_.finished || stopped_at(run_.step)) return false;
   const auto started = std::chrono::steady_clock::now();
-  const double t = double(step_) * dt_;
-  Telemetry& s = telemetry_;
+  const double t = double(run_.step) * dt_;
+  Telemetry& s = run_.telemetry;
   if (link_) {
     measure_remote(t);
-    if (*lost_reason_ != '\0') {
-      lost_ = finished_ = true;
-      lost_at_ = t;
+    if (*run_.lost_reason != '\0') {
+      run_.lost = run_.finished = true;
+      run_.lost_at = t;
       s.events = kEventLost;
       link_->finish();
-      ++step_;
+      ++run_.step;
       return true;
     }
   } else {
@@ -197,14 +198,14 @@ bool MiMode::step() {
   const InputState was = s.pilot.input;
   s.pilot.authority = 1.0;  // sources without a device leave these as they are
   s.pilot.input = InputState::ok;
-  if (!pilot_->command(step_, t, x_, s.pilot)) {
-    finished_ = true;
+  if (!pilot_->command(run_.step, t, run_.x, s.pilot)) {
+    run_.finished = true;
     return false;
   }
   const JoyInput* joy = pilot_->joy();
   s.has_joy = joy != nullptr;
   if (joy) s.joy = *joy;
-  if (forced_overrun(step_)) controller_.rti().force_overrun_next();
+  if (forced_overrun(run_.step)) controller_.rti().force_overrun_next();
   controller_.step(t, s.x_measured, s.pilot);
   s.solved = true;
   s.lambda = controller_.lambda();
@@ -215,57 +216,91 @@ bool MiMode::step() {
   s.predicted_reference = controller_.reference_positions();
   // The MPC's plan spent: the safe controller holds the position where it took over, and the
   // pilot has no authority meanwhile.
-  const bool safe = safety_.update(s.stats.status != RtiStatus::success);
+  const bool safe = run_.safety.update(s.stats.status != RtiStatus::success);
   if (safe) {
-    if (safety_.switched()) hold_ = s.x_measured.head<3>();
-    hover_.control(s.x_measured, hold_, u_safe_);
+    if (run_.safety.switched()) run_.hold = s.x_measured.head<3>();
+    hover_.control(s.x_measured, run_.hold, run_.u_safe);
     s.lambda = 0.0;
-    command_ = u_safe_;
+    run_.command = run_.u_safe;
   } else {
-    command_ = controller_.control();
+    run_.command = controller_.control();
   }
   const double compute_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
 
   if (link_) {
     // The command leaves at once: the link is the delay line.
-    s.u = command_;
+    s.u = run_.command;
     const models::MikroKopter::Input u = s.u;
     predictor_.record_sent(u);
-    feed_.send(*link_, step_, now_ns_, u.data(), models::MikroKopter::nu);
+    feed_.send(*link_, run_.step, now_ns_, u.data(), models::MikroKopter::nu);
   } else {
     // The command enters the delay line; the rotors get the one sent input_delay ago.
-    const std::size_t n = u_delay_.size();
-    u_delay_[std::size_t(step_) % n] = command_;
-    s.u = u_delay_[std::size_t(step_ + 1) % n];
+    const std::size_t n = run_.u_delay.size();
+    run_.u_delay[std::size_t(run_.step) % n] = run_.command;
+    s.u = run_.u_delay[std::size_t(run_.step + 1) % n];
   }
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (s.stats.overrun) s.events |= kEventOverrun;
   if (safe) s.events |= kEventSafeHold;
-  if (safety_.switched()) s.events |= kEventSwitch;
-  s.events |= deadline_event(step_, compute_us, s.stats.overrun);
+  if (run_.safety.switched()) s.events |= kEventSwitch;
+  s.events |= deadline_event(run_.step, compute_us, s.stats.overrun);
   if (s.pilot.input == InputState::lost && was != InputState::lost) s.events |= kEventInputLost;
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();
 
   if (link_) {
-    ++step_;
-    if (step_ >= steps_total_) {
-      finished_ = true;
+    ++run_.step;
+    if (run_.step >= steps_total_) {
+      run_.finished = true;
       link_->finish();
     }
     return true;
   }
   plant_step(s.u);
-  ++step_;
+  ++run_.step;
   if (left_the_world()) {
-    if (!x_.allFinite()) x_ = s.x;  // never hand a non-finite state to anyone
-    lost_ = finished_ = true;
-    lost_at_ = double(step_) * dt_;
+    if (!run_.x.allFinite()) run_.x = s.x;  // never hand a non-finite state to anyone
+    run_.lost = run_.finished = true;
+    run_.lost_at = double(run_.step) * dt_;
     s.events |= kEventLost;
   }
-  if (step_ >= steps_total_) finished_ = true;
+  if (run_.step >= steps_total_) run_.finished = true;
   return true;
+}
+
+struct MiMode::Saved final : ModeSnapshot::State {
+  RtiState rti;                      // the MPC's warm start
+  MiController::Outputs controller;  // λ for the next step, the last plan's outputs
+  ScoreAccumulator::Sums score;
+  Run run;
+  std::unique_ptr<PilotState> pilot;  // null: the source keeps nothing, or cannot go back
+  bool remote = false;
+};
+
+void MiMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = controller_.rti().state();
+  s.controller = controller_.outputs();
+  s.score = scorer_.sums();
+  s.run = run_;
+  if (pilot_) pilot_->save(s.pilot);
+  s.remote = link_ != nullptr;
+}
+
+RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (s.remote || link_) return RestoreStatus::remote_vehicle;
+  if (!controller_.rti().fits(s.rti) || s.run.u_delay.size() != run_.u_delay.size() ||
+      s.controller.predicted.cols() != controller_.outputs().predicted.cols())
+    return RestoreStatus::other_scenario;
+  if (!pilot_ || !pilot_->restore(s.pilot.get())) return RestoreStatus::pilot;
+  controller_.rti().restore(s.rti);
+  controller_.restore(s.controller);
+  scorer_.restore(s.score);
+  run_ = s.run;
+  return RestoreStatus::ok;
 }
 
 Metrics MiMode::metrics() const {
@@ -337,16 +372,16 @@ std::string MiMode::summary() const {
                   s.input_lost_s);
     out += buf;
   }
-  out += safe_hold_summary(safety_, dt_, "a hover-hold controller");
-  if (lost_ && link_) {
-    std::snprintf(buf, sizeof buf, "  the remote vehicle was lost at t = %.3f s: %s\n", lost_at_,
-                  lost_reason_);
+  out += safe_hold_summary(run_.safety, dt_, "a hover-hold controller");
+  if (run_.lost && link_) {
+    std::snprintf(buf, sizeof buf, "  the remote vehicle was lost at t = %.3f s: %s\n",
+                  run_.lost_at, run_.lost_reason);
     out += buf;
-  } else if (lost_) {
+  } else if (run_.lost) {
     std::snprintf(buf, sizeof buf,
                   "  the vehicle was lost at t = %.3f s: it left the arena by more than %.1f m or "
                   "its state stopped being finite\n",
-                  lost_at_, mi_defaults::kLostMargin);
+                  run_.lost_at, mi_defaults::kLostMargin);
     out += buf;
   }
   if (link_ && feed_.sample_count() == 0) {

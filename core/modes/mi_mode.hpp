@@ -45,13 +45,13 @@ class MiMode final : public Mode {
   const std::string& scenario_name() const override { return scenario_.name; }
   double dt() const override { return dt_; }
   std::int64_t steps_total() const override { return steps_total_; }
-  std::int64_t steps_done() const override { return step_; }
+  std::int64_t steps_done() const override { return run_.step; }
   // Ends early (returning false) when the pilot source has nothing more to give.
   [[nodiscard]] bool step() override;
-  bool finished() const override { return finished_; }
-  bool lost() const override { return lost_; }
-  double lost_at() const override { return lost_at_; }
-  const Telemetry& telemetry() const override { return telemetry_; }
+  bool finished() const override { return run_.finished; }
+  bool lost() const override { return run_.lost; }
+  double lost_at() const override { return run_.lost_at; }
+  const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
   // The score; with a remote vehicle also rtt_s (the median round-trip sample) and
   // rtt_estimated_s (the final estimate).
@@ -72,10 +72,17 @@ class MiMode final : public Mode {
   const models::MikroKopter& model() const { return model_; }
   const PilotSource& pilot() const { return *pilot_; }
   const MiController& controller() const { return controller_; }
-  const SafetyNet& safety_net() const { return safety_; }
-  const Eigen::VectorXd& state() const { return x_; }
+  const SafetyNet& safety_net() const { return run_.safety; }
+  const Eigen::VectorXd& state() const { return run_.x; }
+
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the MPC's RTI state and outputs, the score's sums,
+  // Run and the pilot source's state. With a remote vehicle they refuse.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
  private:
+  struct Saved;
   bool left_the_world() const;
   void measure(double t);
   void measure_remote(double t);
@@ -88,26 +95,32 @@ class MiMode final : public Mode {
   models::MikroKopter model_{};
   IntegratorErk4<models::MikroKopter> plant_{};
   MiController controller_;
-  // The safe controller: hover-hold at hold_ while the MPC's plan is spent.
+  // The safe controller: hover-hold at run_.hold while the MPC's plan is spent.
   HoverLqr hover_;
-  SafetyNet safety_;
-  Eigen::Vector3d hold_ = Eigen::Vector3d::Zero();
-  models::MikroKopter::Input u_safe_ = models::MikroKopter::Input::Zero();  // nu
-  Eigen::VectorXd command_;  // nu: the step's command (the MPC's or the safe controller's)
   ScoreAccumulator scorer_;  // sized in setup() for the whole flight
-  Telemetry telemetry_;
-  Eigen::VectorXd x_;                      // nx: true state
-  std::vector<Eigen::VectorXd> u_delay_;   // ring of commands in flight, each nu
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
   double dt_ = 0.015;
   int substeps_ = 15;
-  std::int64_t step_ = 0;
   std::int64_t steps_total_ = 0;
-  bool finished_ = false;
-  bool lost_ = false;
-  double lost_at_ = -1.0;
-  const char* lost_reason_ = "";
+
+  // What the flight changes step by step, besides the states of the controller, the score
+  // and the pilot: a snapshot copies it.
+  struct Run {
+    Telemetry telemetry;
+    Eigen::VectorXd x;                     // nx: true state
+    std::vector<Eigen::VectorXd> u_delay;  // ring of commands in flight, each nu
+    std::mt19937_64 rng;                   // position noise
+    std::normal_distribution<double> noise{0.0, 1.0};
+    SafetyNet safety;
+    Eigen::Vector3d hold = Eigen::Vector3d::Zero();  // where the safe controller holds
+    models::MikroKopter::Input u_safe = models::MikroKopter::Input::Zero();  // nu
+    Eigen::VectorXd command;  // nu: the step's command (the MPC's or the safe controller's)
+    std::int64_t step = 0;
+    bool finished = false;
+    bool lost = false;
+    double lost_at = -1.0;
+    const char* lost_reason = "";
+  };
+  Run run_;
 
   // Remote vehicle.
   VehicleLink* link_ = nullptr;

@@ -23,6 +23,44 @@ std::optional<ModeKind> mode_kind_from_string(std::string_view name) {
   return std::nullopt;
 }
 
+const char* to_string(RestoreStatus status) {
+  switch (status) {
+    case RestoreStatus::ok: return "";
+    case RestoreStatus::empty: return "the snapshot is empty: nothing was saved into it";
+    case RestoreStatus::other_kind: return "the snapshot is of another kind of mode";
+    case RestoreStatus::other_scenario:
+      return "the snapshot is of another scenario, or of one with another length or shape";
+    case RestoreStatus::pilot: return "the pilot source cannot continue from the saved one";
+    case RestoreStatus::remote_vehicle:
+      return "a remote vehicle flies the mode or flew the snapshot: its plant cannot go back";
+  }
+  return "unknown";
+}
+
+void Mode::save(ModeSnapshot& snapshot) const {
+  ModeSnapshot& s = snapshot;
+  if (s.state_ && s.kind_ != kind()) s.state_.reset();
+  s.kind_ = kind();
+  s.scenario_name_ = scenario_name();
+  s.steps_total_ = steps_total();
+  s.step_ = steps_done();
+  s.next_forced_ = next_forced_;
+  s.next_miss_ = next_miss_;
+  save_state(s.state_);
+}
+
+RestoreStatus Mode::restore(const ModeSnapshot& snapshot) {
+  const ModeSnapshot& s = snapshot;
+  if (!s.state_) return RestoreStatus::empty;
+  if (s.kind_ != kind()) return RestoreStatus::other_kind;
+  if (s.scenario_name_ != scenario_name() || s.steps_total_ != steps_total())
+    return RestoreStatus::other_scenario;
+  if (const RestoreStatus r = restore_state(*s.state_); r != RestoreStatus::ok) return r;
+  next_forced_ = s.next_forced_;
+  next_miss_ = s.next_miss_;
+  return RestoreStatus::ok;
+}
+
 std::string mode_kind_names() {
   std::string names;
   for (ModeKind k : kModeKinds) names += std::string(names.empty() ? "" : ", ") + to_string(k);

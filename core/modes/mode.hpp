@@ -2,10 +2,12 @@
 // One interface for every mode (SPEC §5.1–§5.4): mixed initiative, Pendubot swing-up, tracking
 // under delay, obstacle avoidance. A mode is made from a parsed scenario (core/modes/
 // make_mode.hpp); step() advances one control period, plant substeps included, and allocates
-// nothing. Between steps its telemetry and metrics can be read. The session
+// nothing. Between steps its telemetry and metrics can be read, and its whole state saved into
+// a ModeSnapshot and restored, into it or another mode of the same scenario. The session
 // (core/modes/session.hpp) drives any mode and hands each step's telemetry to its sinks.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -93,6 +95,43 @@ struct Telemetry {
 // Name → value in report order (`mixpilot fly --report` writes them as a JSON object).
 using Metrics = std::vector<std::pair<std::string, double>>;
 
+// Why Mode::restore() refused a snapshot, or ok.
+enum class RestoreStatus {
+  ok,
+  empty,           // nothing was saved into the snapshot
+  other_kind,      // it was saved from a mode of another kind
+  other_scenario,  // from another scenario, or one of another shape (length, horizon, delays)
+  pilot,           // this mode's pilot source cannot continue from the saved one
+  remote_vehicle,  // a remote vehicle flies this mode or flew the saved one: it cannot go back
+};
+// The reason in words ("the snapshot is of another kind of mode"; "" for ok).
+const char* to_string(RestoreStatus status);
+
+// A mode's whole state at one step, saved by Mode::save() and put back by Mode::restore(). The
+// caller owns it; it outlives the mode if need be. The first save into it sizes it (and allocates);
+// saving a flight of the same scenario into it again allocates nothing.
+class ModeSnapshot {
+ public:
+  // The part only the mode kind knows (each *_mode.cpp derives its own).
+  struct State {
+    virtual ~State() = default;
+  };
+
+  bool empty() const { return !state_; }
+  ModeKind kind() const { return kind_; }
+  const std::string& scenario_name() const { return scenario_name_; }
+  std::int64_t step() const { return step_; }  // steps_done() when saved: the next step
+
+ private:
+  friend class Mode;
+  ModeKind kind_ = ModeKind::mixed_initiative;
+  std::string scenario_name_;
+  std::int64_t steps_total_ = 0;
+  std::int64_t step_ = 0;
+  std::size_t next_forced_ = 0, next_miss_ = 0;  // replay_timing()'s cursors
+  std::unique_ptr<State> state_;
+};
+
 class Mode {
  public:
   virtual ~Mode() = default;
@@ -167,7 +206,28 @@ class Mode {
     next_forced_ = next_miss_ = 0;
   }
 
+  // Snapshots. save() copies everything the next step() reads into `snapshot`: the plant and
+  // its delay lines, the sensor and estimators, the random generators, the controllers' warm
+  // starts (the RTI iterates and multipliers, the QP's warm start), the safety net, the pilot
+  // source's state, the metrics so far, the telemetry, the step counter. restore() puts it
+  // back, into this mode or another one made from the same scenario (and the same pilot, or one
+  // that takes over from any: a recording), and the steps from there on are bit for bit those
+  // the saved flight flew from that step on. Neither allocates once the snapshot is sized (by
+  // its first save); step() is untouched by them. What the caller sets, not the flight, is
+  // neither saved nor restored: the deadline, the pacing, stop_after() and replay_timing()'s
+  // lists (their cursors are restored, so give a fresh mode the same lists). restore() refuses,
+  // changing nothing, a snapshot of another kind of mode or scenario (RestoreStatus).
+  void save(ModeSnapshot& snapshot) const;
+  [[nodiscard]] RestoreStatus restore(const ModeSnapshot& snapshot);
+
  protected:
+  // The kind's part of save() and restore(). save_state() makes `state` when it is null (the
+  // first save into a snapshot, or one of another kind) and copies into it; restore_state() is
+  // given a state that this kind saved from a mode with the same scenario name and length,
+  // checks the rest of its shape and copies it back, or refuses changing nothing.
+  virtual void save_state(std::unique_ptr<ModeSnapshot::State>& state) const = 0;
+  [[nodiscard]] virtual RestoreStatus restore_state(const ModeSnapshot::State& state) = 0;
+
   // Whether a replay stops before step k (stop_after()).
   bool stopped_at(std::int64_t k) const { return stop_after_ >= 0 && k >= stop_after_; }
   // Whether step k's solve is a recorded overrun (asked with increasing k).

@@ -32,11 +32,11 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   scenario_ = std::move(scenario);
   settings_ = scenario_.controller;
   if (form) settings_.form = *form;
-  finished_ = true;  // until setup succeeds
+  run_.finished = true;  // until setup succeeds
   ready_ = false;
-  lost_ = false;
-  lost_at_ = -1.0;
-  step_ = 0;
+  run_.lost = false;
+  run_.lost_at = -1.0;
+  run_.step = 0;
   steps_total_ = 0;
   problem_.emplace(scenario_.world.size(), settings_);
   if (SetupResult r = rti_.setup(problem_->ocp()); !r)
@@ -44,32 +44,32 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   if (SetupResult r = check_scenario(); !r) return r;
   if (SetupResult r = safe_lqr_.setup(model_, settings_.dt); !r)
     return SetupResult::failure("the safe controller: " + r.reason());
-  safety_.reset();
+  run_.safety.reset();
 
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   last_x_ = int(ref.x.size()) - 1;
   substeps_ = int(std::lround(settings_.dt * scenario_.plant_rate_hz));
   steps_total_ = std::lround(scenario_.duration / settings_.dt);
-  x_ = ref.x[0];
+  run_.x = ref.x[0];
   warm_start();
-  rti_us_.clear();
-  rti_us_.reserve(std::size_t(std::max<std::int64_t>(steps_total_, 0)));
-  min_distance_ = kInf;
-  min_distance_time_ = 0.0;
-  closest_obstacle_ = -1;
-  min_distance_control_ = kInf;
-  violations_ = 0;
-  sq_tracking_ = 0.0;
-  qp_iterations_max_ = 0;
+  run_.rti_us.clear();
+  run_.rti_us.reserve(std::size_t(std::max<std::int64_t>(steps_total_, 0)));
+  run_.min_distance = kInf;
+  run_.min_distance_time = 0.0;
+  run_.closest_obstacle = -1;
+  run_.min_distance_control = kInf;
+  run_.violations = 0;
+  run_.sq_tracking = 0.0;
+  run_.qp_iterations_max = 0;
 
   reset_telemetry();
   bool violated = false;
   const double distance = check_distances(0.0, violated);
-  if (violated) ++violations_;
+  if (violated) ++run_.violations;
   check_control_instant(0.0);
-  set_channels(distance, (x_.head<3>() - ref.x[0].head<3>()).norm());
+  set_channels(distance, (run_.x.head<3>() - ref.x[0].head<3>()).norm());
   ready_ = true;
-  finished_ = steps_total_ <= 0;
+  run_.finished = steps_total_ <= 0;
   return {};
 }
 
@@ -105,11 +105,11 @@ void ObstacleMode::warm_start() {
 
 // Sizes every telemetry member for the run: the initial state, the warm start as prediction.
 void ObstacleMode::reset_telemetry() {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   s = Telemetry{};
   s.mode = ModeKind::obstacle_avoidance;
-  s.x = x_;
-  s.x_measured = x_;
+  s.x = run_.x;
+  s.x_measured = run_.x;
   s.u = problem_->model().hover_input();
   s.reference = Eigen::VectorXd::Zero(3);
   s.predicted = Eigen::Matrix3Xd::Zero(3, settings_.N + 1);
@@ -125,63 +125,63 @@ void ObstacleMode::reset_telemetry() {
 // One control period
 
 bool ObstacleMode::step() {
-  if (finished_ || stopped_at(step_)) return false;
+  if (run_.finished || stopped_at(run_.step)) return false;
   const auto started = std::chrono::steady_clock::now();
-  const int k = int(step_);
+  const int k = int(run_.step);
   const double t = k * settings_.dt;
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   problem_->set_reference(rti_.data(), ref, k);
   problem_->set_obstacles(rti_.data(), scenario_.world, t);
   rti_.prepare();
-  if (forced_overrun(step_)) rti_.force_overrun_next();
-  rti_.feedback(x_);
+  if (forced_overrun(run_.step)) rti_.force_overrun_next();
+  rti_.feedback(run_.x);
   const RtiStats& st = rti_.stats();
-  rti_us_.push_back(st.total_us);
-  qp_iterations_max_ = std::max(qp_iterations_max_, st.qp_iterations);
+  run_.rti_us.push_back(st.total_us);
+  run_.qp_iterations_max = std::max(run_.qp_iterations_max, st.qp_iterations);
   models::Crazyflie::Input u = rti_.control();
   // The plan spent after fallbacks in a row: hover-hold where the safe controller took over.
-  const bool safe = safety_.update(st.status != RtiStatus::success);
+  const bool safe = run_.safety.update(st.status != RtiStatus::success);
   if (safe) {
-    if (safety_.switched()) hold_ = model_.hover_state(x_.head<3>());
-    safe_lqr_.control(x_, hold_, model_.hover_input(), u);
+    if (run_.safety.switched()) run_.hold = model_.hover_state(run_.x.head<3>());
+    safe_lqr_.control(run_.x, run_.hold, model_.hover_input(), u);
   }
   const double compute_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
 
-  Telemetry& s = telemetry_;
-  s.step = step_;
+  Telemetry& s = run_.telemetry;
+  s.step = run_.step;
   s.t = t;
-  s.x = x_;
-  s.x_measured = x_;
+  s.x = run_.x;
+  s.x_measured = run_.x;
   s.u = u;
   s.solved = true;
   s.stats = st;
   set_reference_position(k);
   set_predictions();
-  const double sq_error = (x_.head<3>() - ref.x[std::min(k, last_x_)].head<3>()).squaredNorm();
-  sq_tracking_ += sq_error;
+  const double sq_error = (run_.x.head<3>() - ref.x[std::min(k, last_x_)].head<3>()).squaredNorm();
+  run_.sq_tracking += sq_error;
 
   bool violated = false;
   const double distance = plant_step(u, t, violated);
-  if (violated) ++violations_;
+  if (violated) ++run_.violations;
   check_control_instant(t + settings_.dt);
-  ++step_;
+  ++run_.step;
   s.events = st.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (st.overrun) s.events |= kEventOverrun;
   if (safe) s.events |= kEventSafeHold;
-  if (safety_.switched()) s.events |= kEventSwitch;
+  if (run_.safety.switched()) s.events |= kEventSwitch;
   s.events |= deadline_event(s.step, compute_us, st.overrun);
   if (violated) s.events |= kEventViolation;
   set_channels(distance, std::sqrt(sq_error));
-  if (!x_.allFinite()) {  // never hand a non-finite state to anyone
-    x_ = s.x;
-    lost_ = finished_ = true;
-    lost_at_ = t;
+  if (!run_.x.allFinite()) {  // never hand a non-finite state to anyone
+    run_.x = s.x;
+    run_.lost = run_.finished = true;
+    run_.lost_at = t;
     s.events |= kEventLost;
     return true;
   }
   rti_.shift();
-  if (step_ >= steps_total_) finished_ = true;
+  if (run_.step >= steps_total_) run_.finished = true;
   return true;
 }
 
@@ -193,8 +193,8 @@ double ObstacleMode::plant_step(const models::Crazyflie::Input& u, double t, boo
   models::Crazyflie::State xn;
   double distance = kInf;
   for (int s = 0; s < substeps_; ++s) {
-    erk4.step(x_, u, h, xn);
-    x_ = xn;
+    erk4.step(run_.x, u, h, xn);
+    run_.x = xn;
     distance = std::min(distance, check_distances(t + (s + 1) * h, violated));
   }
   return distance;
@@ -205,11 +205,11 @@ double ObstacleMode::plant_step(const models::Crazyflie::Input& u, double t, boo
 double ObstacleMode::check_distances(double t, bool& violated) {
   double smallest = kInf;
   for (int j = 0; j < scenario_.world.size(); ++j) {
-    const double dist = (x_.head<3>() - scenario_.world.position(j, t)).norm();
-    if (dist < min_distance_) {
-      min_distance_ = dist;
-      min_distance_time_ = t;
-      closest_obstacle_ = j;
+    const double dist = (run_.x.head<3>() - scenario_.world.position(j, t)).norm();
+    if (dist < run_.min_distance) {
+      run_.min_distance = dist;
+      run_.min_distance_time = t;
+      run_.closest_obstacle = j;
     }
     smallest = std::min(smallest, dist);
     violated |= dist < settings_.clearance - obstacle_defaults::kViolationTolerance;
@@ -220,15 +220,15 @@ double ObstacleMode::check_distances(double t, bool& violated) {
 // The same at a control instant, where the constraint is imposed.
 void ObstacleMode::check_control_instant(double t) {
   for (int j = 0; j < scenario_.world.size(); ++j)
-    min_distance_control_ =
-        std::min(min_distance_control_, (x_.head<3>() - scenario_.world.position(j, t)).norm());
+    run_.min_distance_control = std::min(
+        run_.min_distance_control, (run_.x.head<3>() - scenario_.world.position(j, t)).norm());
 }
 
 // η^r(t_k) = the reference position of step k (clamped to the last state), element by element
 // (a fixed-size segment into a VectorXd: no temporary).
 void ObstacleMode::set_reference_position(int k) {
   const Eigen::VectorXd& r = scenario_.reference.trajectory.x[std::min(k, last_x_)];
-  for (int i = 0; i < 3; ++i) telemetry_.reference(i) = r(i);
+  for (int i = 0; i < 3; ++i) run_.telemetry.reference(i) = r(i);
 }
 
 // Predicted positions of the RTI trajectory and the reference positions at the N + 1 nodes.
@@ -236,13 +236,13 @@ void ObstacleMode::set_predictions() {
   const OcpTrajectory& traj = rti_.trajectory();
   const OcpStageData& data = rti_.data();
   for (int i = 0; i <= settings_.N; ++i) {
-    telemetry_.predicted.col(i) = traj.x[i].head<3>();
-    telemetry_.predicted_reference.col(i) = data.yref[i].head<3>();
+    run_.telemetry.predicted.col(i) = traj.x[i].head<3>();
+    run_.telemetry.predicted_reference.col(i) = data.yref[i].head<3>();
   }
 }
 
 void ObstacleMode::set_channels(double step_min_distance, double tracking_error) {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   s.set_channel(kMinDistance, "min distance", "m", step_min_distance);
   s.set_channel(kClearanceMargin, "clearance margin", "m",
                 step_min_distance - settings_.clearance);
@@ -253,6 +253,28 @@ void ObstacleMode::set_channels(double step_min_distance, double tracking_error)
 // ---------------------------------------------------------------------------------------------
 // Results
 
+struct ObstacleMode::Saved final : ModeSnapshot::State {
+  RtiState rti;  // the NMPC's warm start
+  Run run;
+};
+
+void ObstacleMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = rti_.state();
+  s.run = run_;
+}
+
+RestoreStatus ObstacleMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (!ready_ || !rti_.fits(s.rti) ||
+      s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
+    return RestoreStatus::other_scenario;
+  rti_.restore(s.rti);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 ObstacleRunResult ObstacleMode::result() const {
   ObstacleRunResult r;
   r.form = settings_.form;
@@ -261,21 +283,22 @@ ObstacleRunResult ObstacleMode::result() const {
     return r;
   }
   const OcpTrajectory& ref = scenario_.reference.trajectory;
-  r.steps = int(step_);
-  r.min_distance_m = min_distance_;
-  r.min_margin_m = min_distance_ - settings_.clearance;
-  r.min_distance_control_m = min_distance_control_;
-  r.min_distance_time = min_distance_time_;
-  r.closest_obstacle = closest_obstacle_;
-  r.violations = violations_;
-  r.tracking_rms_m = r.steps > 0 ? std::sqrt(sq_tracking_ / r.steps) : 0.0;
-  r.final_error_m = (x_.head<3>() - ref.x[last_x_].head<3>()).norm();
-  r.rti_median_us = percentile(rti_us_, 0.5);
-  r.rti_p99_us = percentile(rti_us_, 0.99);
-  r.rti_max_us = rti_us_.empty() ? 0.0 : *std::max_element(rti_us_.begin(), rti_us_.end());
+  r.steps = int(run_.step);
+  r.min_distance_m = run_.min_distance;
+  r.min_margin_m = run_.min_distance - settings_.clearance;
+  r.min_distance_control_m = run_.min_distance_control;
+  r.min_distance_time = run_.min_distance_time;
+  r.closest_obstacle = run_.closest_obstacle;
+  r.violations = run_.violations;
+  r.tracking_rms_m = r.steps > 0 ? std::sqrt(run_.sq_tracking / r.steps) : 0.0;
+  r.final_error_m = (run_.x.head<3>() - ref.x[last_x_].head<3>()).norm();
+  r.rti_median_us = percentile(run_.rti_us, 0.5);
+  r.rti_p99_us = percentile(run_.rti_us, 0.99);
+  const std::vector<double>& rti_us = run_.rti_us;
+  r.rti_max_us = rti_us.empty() ? 0.0 : *std::max_element(rti_us.begin(), rti_us.end());
   r.fallbacks = int(rti_.stats().fallbacks);
-  r.lost = lost_;
-  r.qp_iterations_max = qp_iterations_max_;
+  r.lost = run_.lost;
+  r.qp_iterations_max = run_.qp_iterations_max;
   return r;
 }
 
@@ -333,7 +356,7 @@ std::string ObstacleMode::summary() const {
                 r.min_distance_control_m, r.violations, r.tracking_rms_m, r.final_error_m,
                 r.rti_median_us, r.rti_p99_us, r.rti_max_us, r.fallbacks,
                 r.lost ? "\n  the vehicle was lost" : "");
-  return buf + safe_hold_summary(safety_, settings_.dt, "a hover-hold LQR");
+  return buf + safe_hold_summary(run_.safety, settings_.dt, "a hover-hold LQR");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@
 #include "core/modes/mode.hpp"
 #include "core/modes/safety_net.hpp"
 #include "core/nlp/rti.hpp"
+#include "core/numerics/reserved_vector.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 #include "models/crazyflie.hpp"
@@ -73,12 +74,12 @@ class ObstacleMode final : public Mode {
   const std::string& scenario_name() const override { return scenario_.name; }
   double dt() const override { return settings_.dt; }
   std::int64_t steps_total() const override { return steps_total_; }
-  std::int64_t steps_done() const override { return step_; }
+  std::int64_t steps_done() const override { return run_.step; }
   [[nodiscard]] bool step() override;
-  bool finished() const override { return finished_; }
-  bool lost() const override { return lost_; }
-  double lost_at() const override { return lost_at_; }
-  const Telemetry& telemetry() const override { return telemetry_; }
+  bool finished() const override { return run_.finished; }
+  bool lost() const override { return run_.lost; }
+  double lost_at() const override { return run_.lost_at; }
+  const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { rti_.set_deadline_us(d); }
   // min_distance_m, min_margin_m, min_distance_control_m, clearance_m, violations,
   // tracking_rms_m, final_error_m, rti_median_us, rti_p99_us, fallbacks, form (0 lcl,
@@ -94,11 +95,17 @@ class ObstacleMode final : public Mode {
   const ObstacleControllerSettings& settings() const { return settings_; }
   const RtiSolver& rti() const { return rti_; }
   // True plant state now (13): at t_{steps_done()}.
-  const models::Crazyflie::State& state() const { return x_; }
+  const models::Crazyflie::State& state() const { return run_.x; }
   // The run so far (allocates: for reports, not for the loop); trajectories left empty.
   ObstacleRunResult result() const;
 
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state and Run.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+
  private:
+  struct Saved;
   SetupResult check_scenario() const;
   void warm_start();
   void reset_telemetry();
@@ -113,31 +120,36 @@ class ObstacleMode final : public Mode {
   ObstacleControllerSettings settings_;
   std::optional<ObstacleAvoidanceOcp> problem_;  // rebuilt by setup(); rti_ points into it
   RtiSolver rti_;
-  // The safe controller: hover-hold at hold_ while the NMPC's plan is spent.
+  // The safe controller: hover-hold at run_.hold while the NMPC's plan is spent.
   models::Crazyflie model_{};
   TrackingLqr safe_lqr_;
-  SafetyNet safety_;
-  models::Crazyflie::State hold_ = models::Crazyflie::State::Zero();  // 13
-  Telemetry telemetry_;
-  models::Crazyflie::State x_;  // 13: true plant state
-  std::vector<double> rti_us_;  // steps_total_: per step, RTI prepare + feedback [us]
   int substeps_ = 15;           // plant RK4 steps per Δt
   int last_x_ = 0;              // last index of the reference states
-  std::int64_t step_ = 0;
   std::int64_t steps_total_ = 0;
   bool ready_ = false;  // setup() succeeded
-  bool finished_ = true;
-  bool lost_ = false;
-  double lost_at_ = -1.0;
 
-  // Distances and tracking so far.
-  double min_distance_ = 0.0;          // over substeps and obstacles
-  double min_distance_time_ = 0.0;     // [s]
-  int closest_obstacle_ = -1;
-  double min_distance_control_ = 0.0;  // at the control instants
-  int violations_ = 0;
-  double sq_tracking_ = 0.0;           // Σ_k ‖p_k − p_ref,k‖²
-  int qp_iterations_max_ = 0;
+  // What the flight changes step by step, besides the NMPC's state: a snapshot copies it.
+  struct Run {
+    Telemetry telemetry;
+    models::Crazyflie::State x;  // 13: true plant state
+    SafetyNet safety;
+    models::Crazyflie::State hold = models::Crazyflie::State::Zero();  // 13
+    ReservedVector<double> rti_us;  // per step, RTI prepare + feedback [us]
+    std::int64_t step = 0;
+    bool finished = true;
+    bool lost = false;
+    double lost_at = -1.0;
+
+    // Distances and tracking so far.
+    double min_distance = 0.0;          // over substeps and obstacles
+    double min_distance_time = 0.0;     // [s]
+    int closest_obstacle = -1;
+    double min_distance_control = 0.0;  // at the control instants
+    int violations = 0;
+    double sq_tracking = 0.0;           // Σ_k ‖p_k − p_ref,k‖²
+    int qp_iterations_max = 0;
+  };
+  Run run_;
 };
 
 struct ObstacleRunOptions {

@@ -71,12 +71,12 @@ SetupResult PendubotMode::check_settings() const {
 SetupResult PendubotMode::setup(PendubotScenario scenario) {
   scenario_ = std::move(scenario);
   ok_ = false;
-  finished_ = true;  // until setup succeeds
-  step_ = steps_total_ = 0;
+  run_.finished = true;  // until setup succeeds
+  run_.step = steps_total_ = 0;
   problem_.reset();
   lqr_ = PendubotLqr{};
-  telemetry_ = Telemetry{};
-  telemetry_.mode = ModeKind::pendubot_swingup;
+  run_.telemetry = Telemetry{};
+  run_.telemetry.mode = ModeKind::pendubot_swingup;
   if (SetupResult r = check_settings(); !r) return r;
   const PendubotOcpSettings& oc = scenario_.controller;
   problem_ = std::make_unique<PendubotSwingup>(oc);
@@ -99,32 +99,32 @@ SetupResult PendubotMode::setup(PendubotScenario scenario) {
   lowpass_ = fc > 0 ? 1.0 - std::exp(-2.0 * std::numbers::pi * fc * oc.dt) : 1.0;
   observer_ = scenario_.sensor.estimator == "observer";
 
-  x_ = scenario_.plant.initial_state;
-  xm_ = x_;
-  xw_ = x_;
-  q_prev_ = Eigen::Vector2d(quantize(x_(0), scenario_.sensor.counts_q1),
-                            quantize(x_(1), scenario_.sensor.counts_q2));
-  v_filt_.setZero();
-  x0_ = Eigen::VectorXd::Zero(4);
-  u_prev_ = 0.0;
-  lqr_active_ = false;
-  safety_.reset();
+  run_.x = scenario_.plant.initial_state;
+  run_.xm = run_.x;
+  run_.xw = run_.x;
+  run_.q_prev = Eigen::Vector2d(quantize(run_.x(0), scenario_.sensor.counts_q1),
+                                quantize(run_.x(1), scenario_.sensor.counts_q2));
+  run_.v_filt.setZero();
+  run_.x0 = Eigen::VectorXd::Zero(4);
+  run_.u_prev = 0.0;
+  run_.lqr_active = false;
+  run_.safety.reset();
 
-  max_abs_u_ = worst_velocity_violation_ = err2_ = lqr_time_ = 0.0;
-  velocity_violations_ = err_n_ = nmpc_steps_ = lqr_entries_ = 0;
-  lqr_entry_time_ = -1.0;
-  last_outside_ = -1;
+  run_.max_abs_u = run_.worst_velocity_violation = run_.err2 = run_.lqr_time = 0.0;
+  run_.velocity_violations = run_.err_n = run_.nmpc_steps = run_.lqr_entries = 0;
+  run_.lqr_entry_time = -1.0;
+  run_.last_outside = -1;
   record_angle_norm();
-  rti_us_.clear();
-  rti_us_.reserve(std::size_t(steps_total_));
+  run_.rti_us.clear();
+  run_.rti_us.reserve(std::size_t(steps_total_));
 
-  telemetry_.x = x_;
-  telemetry_.x_measured = xm_;
-  telemetry_.u = Eigen::VectorXd::Zero(1);
-  telemetry_.reference = Eigen::VectorXd::Zero(4);
+  run_.telemetry.x = run_.x;
+  run_.telemetry.x_measured = run_.xm;
+  run_.telemetry.u = Eigen::VectorXd::Zero(1);
+  run_.telemetry.reference = Eigen::VectorXd::Zero(4);
   set_telemetry(0.0, false, 0.0);
   ok_ = true;
-  finished_ = false;
+  run_.finished = false;
   return {};
 }
 
@@ -150,45 +150,46 @@ void PendubotMode::measure() {
   const PendubotScenario::Sensor& sn = scenario_.sensor;
   const double dt = scenario_.controller.dt;
   if (sn.quantization) {
-    const Eigen::Vector2d q(quantize(x_(0), sn.counts_q1), quantize(x_(1), sn.counts_q2));
+    const Eigen::Vector2d q(quantize(run_.x(0), sn.counts_q1), quantize(run_.x(1), sn.counts_q2));
     if (observer_) {
-      if (step_ == 0) {
-        xm_ = Eigen::Vector4d(q(0), q(1), 0.0, 0.0);
+      if (run_.step == 0) {
+        run_.xm = Eigen::Vector4d(q(0), q(1), 0.0, 0.0);
       } else {
-        problem_->integrator().step<double>(xm_, models::Pendubot::Input(u_prev_), dt, xn_);
+        problem_->integrator().step<double>(run_.xm, models::Pendubot::Input(run_.u_prev), dt, xn_);
         const Eigen::Vector2d e = q - xn_.head<2>();
-        xm_.head<2>() = xn_.head<2>() + sn.observer_alpha * e;
-        xm_.tail<2>() = xn_.tail<2>() + (sn.observer_beta / dt) * e;
+        run_.xm.head<2>() = xn_.head<2>() + sn.observer_alpha * e;
+        run_.xm.tail<2>() = xn_.tail<2>() + (sn.observer_beta / dt) * e;
       }
     } else {
-      const Eigen::Vector2d v_raw = (q - q_prev_) / dt;
-      if (step_ > 0) v_filt_ += lowpass_ * (v_raw - v_filt_);
-      q_prev_ = q;
-      xm_ = Eigen::Vector4d(q(0), q(1), v_filt_(0), v_filt_(1));
+      const Eigen::Vector2d v_raw = (q - run_.q_prev) / dt;
+      if (run_.step > 0) run_.v_filt += lowpass_ * (v_raw - run_.v_filt);
+      run_.q_prev = q;
+      run_.xm = Eigen::Vector4d(q(0), q(1), run_.v_filt(0), run_.v_filt(1));
     }
   } else {
-    xm_ = x_;
+    run_.xm = run_.x;
   }
-  xw_ = xm_;
-  xw_(0) = wrap_angle(xm_(0));
-  xw_(1) = wrap_angle(xm_(1));
+  run_.xw = run_.xm;
+  run_.xw(0) = wrap_angle(run_.xm(0));
+  run_.xw(1) = wrap_angle(run_.xm(1));
 }
 
 // The switch rule (core/modes/pendubot_mode.hpp) on x̂_k; true when the controller changed.
 bool PendubotMode::switch_controller() {
   const PendubotScenario::Lqr& l = scenario_.lqr;
-  const double u_lqr = -lqr_.K.dot(xw_);
-  const double a = xw_.head<2>().norm();
-  if (l.enabled && !lqr_active_ && a <= l.enter_angle && xw_.tail<2>().norm() <= l.enter_velocity &&
-      std::abs(u_lqr) <= scenario_.controller.u_max) {
-    lqr_active_ = true;
-    ++lqr_entries_;
-    if (lqr_entry_time_ < 0) lqr_entry_time_ = double(step_) * scenario_.controller.dt;
+  const Eigen::Vector4d& xw = run_.xw;
+  const double u_lqr = -lqr_.K.dot(xw);
+  const double a = xw.head<2>().norm();
+  if (l.enabled && !run_.lqr_active && a <= l.enter_angle &&
+      xw.tail<2>().norm() <= l.enter_velocity && std::abs(u_lqr) <= scenario_.controller.u_max) {
+    run_.lqr_active = true;
+    ++run_.lqr_entries;
+    if (run_.lqr_entry_time < 0) run_.lqr_entry_time = double(run_.step) * scenario_.controller.dt;
     return true;
   }
-  if (lqr_active_ && a > l.exit_angle) {
-    lqr_active_ = false;
-    PendubotSwingup::constant_guess(rti_.trajectory(), xw_);  // restart towards up-up
+  if (run_.lqr_active && a > l.exit_angle) {
+    run_.lqr_active = false;
+    PendubotSwingup::constant_guess(rti_.trajectory(), xw);  // restart towards up-up
     return true;
   }
   return false;
@@ -197,54 +198,54 @@ bool PendubotMode::switch_controller() {
 // u_k: the LQR law or one RTI step, finite and inside |u| ≤ u_max.
 double PendubotMode::control() {
   double u = 0.0;
-  if (lqr_active_) {
-    u = -lqr_.K.dot(xw_);
-    lqr_time_ += scenario_.controller.dt;
-    telemetry_.solved = false;
-    telemetry_.stats = RtiStats{};
-    telemetry_.stats.fallbacks = rti_.stats().fallbacks;
+  if (run_.lqr_active) {
+    u = -lqr_.K.dot(run_.xw);
+    run_.lqr_time += scenario_.controller.dt;
+    run_.telemetry.solved = false;
+    run_.telemetry.stats = RtiStats{};
+    run_.telemetry.stats.fallbacks = rti_.stats().fallbacks;
   } else {
     u = nmpc();
     // The plan spent after fallbacks in a row: the LQR near the top, no torque elsewhere (the
     // links then swing down and settle instead of being driven by a stale plan).
-    if (safety_.update(telemetry_.stats.status != RtiStatus::success))
-      u = xw_.head<2>().norm() <= scenario_.lqr.exit_angle ? -lqr_.K.dot(xw_) : 0.0;
+    if (run_.safety.update(run_.telemetry.stats.status != RtiStatus::success))
+      u = run_.xw.head<2>().norm() <= scenario_.lqr.exit_angle ? -lqr_.K.dot(run_.xw) : 0.0;
   }
   if (!std::isfinite(u)) u = 0.0;
   const double u_max = scenario_.controller.u_max;
   u = std::clamp(u, -u_max, u_max);  // guards rounding only: the QP bounds u
-  max_abs_u_ = std::max(max_abs_u_, std::abs(u));
-  u_prev_ = u;
+  run_.max_abs_u = std::max(run_.max_abs_u, std::abs(u));
+  run_.u_prev = u;
   return u;
 }
 
 // One RTI step from x̂_k: angles unwrapped as measured while tracking the reference, wrapped
 // once it is over (the target is then up-up).
 double PendubotMode::nmpc() {
-  const int k = int(step_);
+  const int k = int(run_.step);
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   const bool tracking = k < ref_steps_;
-  x0_ = tracking ? xm_ : xw_;
+  run_.x0 = tracking ? run_.xm : run_.xw;
   if (!tracking && k == ref_steps_) {
     // Re-express the warm start around the wrapped angles.
     for (auto& xi : rti_.trajectory().x) {
-      xi(0) += xw_(0) - xm_(0);
-      xi(1) += xw_(1) - xm_(1);
+      xi(0) += run_.xw(0) - run_.xm(0);
+      xi(1) += run_.xw(1) - run_.xm(1);
     }
   }
   problem_->set_reference(rti_.data(), ref, k);
   rti_.prepare();
-  if (forced_overrun(step_)) rti_.force_overrun_next();
-  rti_.feedback(x0_);
+  if (forced_overrun(run_.step)) rti_.force_overrun_next();
+  rti_.feedback(run_.x0);
   const double u = rti_.control()(0);
   rti_.shift();
-  telemetry_.solved = true;
-  telemetry_.stats = rti_.stats();
-  rti_us_.push_back(rti_.stats().total_us);
-  ++nmpc_steps_;
+  run_.telemetry.solved = true;
+  run_.telemetry.stats = rti_.stats();
+  run_.rti_us.push_back(rti_.stats().total_us);
+  ++run_.nmpc_steps;
   if (tracking) {
-    err2_ += (x_.head<2>() - ref.x[std::size_t(k)].head<2>()).squaredNorm();
-    ++err_n_;
+    run_.err2 += (run_.x.head<2>() - ref.x[std::size_t(k)].head<2>()).squaredNorm();
+    ++run_.err_n;
   }
   return u;
 }
@@ -258,54 +259,55 @@ double PendubotMode::integrate(double u) {
   const double b1 = scenario_.controller.velocity_bound(0);
   const double b2 = scenario_.controller.velocity_bound(1);
   const double h = h_;
-  State x = x_, xn;
+  State x = run_.x, xn;
   double worst = 0.0;
   for (int j = 0; j < substeps_; ++j) {
     erk4.step<double>(x, models::Pendubot::Input(u), h, xn);
     x = xn;
     worst = std::max({worst, std::abs(x(2)) - b1, std::abs(x(3)) - b2});
   }
-  x_ = x;
+  run_.x = x;
   if (worst > 0) {
-    ++velocity_violations_;
-    worst_velocity_violation_ = std::max(worst_velocity_violation_, worst);
+    ++run_.velocity_violations;
+    run_.worst_velocity_violation = std::max(run_.worst_velocity_violation, worst);
   }
   return worst;
 }
 
-// ‖wrap(q)‖ of the state now (index step_), for the swing-up time and the final norm.
+// ‖wrap(q)‖ of the state now (index step), for the swing-up time and the final norm.
 void PendubotMode::record_angle_norm() {
-  angle_norm_ = angle_norm(x_);
-  if (angle_norm_ > scenario_.angle_tolerance) last_outside_ = step_;
+  run_.angle_norm = angle_norm(run_.x);
+  if (run_.angle_norm > scenario_.angle_tolerance) run_.last_outside = run_.step;
 }
 
 bool PendubotMode::step() {
-  if (finished_ || stopped_at(step_)) return false;
+  if (run_.finished || stopped_at(run_.step)) return false;
   const auto started = std::chrono::steady_clock::now();
   measure();
   const bool switched = switch_controller();
   const double u = control();
   const double compute_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
-  const State x_k = x_;
+  const State x_k = run_.x;
   const double worst = integrate(u);
-  telemetry_.x = x_k;
+  Telemetry& s = run_.telemetry;
+  s.x = x_k;
   set_telemetry(u, switched, worst);
-  telemetry_.events |= deadline_event(step_, compute_us, telemetry_.solved && telemetry_.stats.overrun);
-  ++step_;
+  s.events |= deadline_event(run_.step, compute_us, s.solved && s.stats.overrun);
+  ++run_.step;
   record_angle_norm();
-  finished_ = step_ >= steps_total_;
+  run_.finished = run_.step >= steps_total_;
   return true;
 }
 
 // Step k's telemetry (x already holds x_k): x̂_k, u_k, the reference node k, events, channels.
 void PendubotMode::set_telemetry(double u, bool switched, double worst_violation) {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   const OcpTrajectory& ref = scenario_.reference.trajectory;
-  const std::size_t k = std::size_t(step_);
-  s.step = step_;
-  s.t = double(step_) * scenario_.controller.dt;
-  s.x_measured = xm_;
+  const std::size_t k = std::size_t(run_.step);
+  s.step = run_.step;
+  s.t = double(run_.step) * scenario_.controller.dt;
+  s.x_measured = run_.xm;
   s.u(0) = u;
   if (k < ref.x.size()) {
     s.reference = ref.x[k];
@@ -317,13 +319,13 @@ void PendubotMode::set_telemetry(double u, bool switched, double worst_violation
   if (worst_violation > 0) s.events |= kEventViolation;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
   if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
-  if (!lqr_active_ && safety_.engaged()) s.events |= kEventSafeHold;
-  if (!lqr_active_ && safety_.switched()) s.events |= kEventSwitch;
+  if (!run_.lqr_active && run_.safety.engaged()) s.events |= kEventSafeHold;
+  if (!run_.lqr_active && run_.safety.switched()) s.events |= kEventSwitch;
   set_channels();
 }
 
 void PendubotMode::set_channels() {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   const PendubotOcpSettings& oc = scenario_.controller;
   s.set_channel(kPendubotQ1, "q1", "rad", wrap_angle(s.x(0)));
   s.set_channel(kPendubotQ2, "q2", "rad", wrap_angle(s.x(1)));
@@ -334,7 +336,7 @@ void PendubotMode::set_channels() {
   s.set_channel(kPendubotDq1Reference, "dq1 reference", "rad/s", s.reference(2));
   s.set_channel(kPendubotDq2Reference, "dq2 reference", "rad/s", s.reference(3));
   s.set_channel(kPendubotTorque, "torque", "N m", s.u(0));
-  s.set_channel(kPendubotLqrActive, "LQR active", "", lqr_active_ ? 1.0 : 0.0);
+  s.set_channel(kPendubotLqrActive, "LQR active", "", run_.lqr_active ? 1.0 : 0.0);
   s.set_channel(kPendubotAngleNorm, "angle norm", "rad",
                 std::hypot(wrap_angle(s.x(0)), wrap_angle(s.x(1))));
   s.set_channel(kPendubotDq1Bound, "dq1 bound", "rad/s", oc.velocity_bound(0));
@@ -342,26 +344,48 @@ void PendubotMode::set_channels() {
   s.set_channel(kPendubotTorqueBound, "torque bound", "N m", oc.u_max);
 }
 
+struct PendubotMode::Saved final : ModeSnapshot::State {
+  RtiState rti;  // the NMPC's warm start
+  Run run;
+};
+
+void PendubotMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.rti = rti_.state();
+  s.run = run_;
+}
+
+RestoreStatus PendubotMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (!ok_ || !rti_.fits(s.rti) || s.run.x0.size() != run_.x0.size())
+    return RestoreStatus::other_scenario;
+  rti_.restore(s.rti);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 PendubotRun PendubotMode::result() const {
   PendubotRun r;
   r.ok = ok_;
   if (!ok_) return r;
   const double dt = scenario_.controller.dt;
-  r.steps = int(step_);
-  if (last_outside_ < step_) r.swingup_time = double(int(last_outside_ + 1)) * dt;
-  r.final_angle_norm = angle_norm_;
-  r.max_abs_u = max_abs_u_;
-  r.velocity_violations = velocity_violations_;
-  r.worst_velocity_violation = worst_velocity_violation_;
-  r.tracking_rms = err_n_ > 0 ? std::sqrt(err2_ / err_n_) : 0.0;
-  r.rti_median_us = percentile(rti_us_, 0.5);
-  r.rti_p99_us = percentile(rti_us_, 0.99);
-  r.rti_max_us = rti_us_.empty() ? 0.0 : *std::max_element(rti_us_.begin(), rti_us_.end());
-  r.nmpc_steps = nmpc_steps_;
+  r.steps = int(run_.step);
+  if (run_.last_outside < run_.step) r.swingup_time = double(int(run_.last_outside + 1)) * dt;
+  r.final_angle_norm = run_.angle_norm;
+  r.max_abs_u = run_.max_abs_u;
+  r.velocity_violations = run_.velocity_violations;
+  r.worst_velocity_violation = run_.worst_velocity_violation;
+  r.tracking_rms = run_.err_n > 0 ? std::sqrt(run_.err2 / run_.err_n) : 0.0;
+  r.rti_median_us = percentile(run_.rti_us, 0.5);
+  r.rti_p99_us = percentile(run_.rti_us, 0.99);
+  const std::vector<double>& rti_us = run_.rti_us;
+  r.rti_max_us = rti_us.empty() ? 0.0 : *std::max_element(rti_us.begin(), rti_us.end());
+  r.nmpc_steps = run_.nmpc_steps;
   r.fallbacks = rti_.stats().fallbacks;
-  r.lqr_time = lqr_time_;
-  r.lqr_entries = lqr_entries_;
-  r.lqr_entry_time = lqr_entry_time_;
+  r.lqr_time = run_.lqr_time;
+  r.lqr_entries = run_.lqr_entries;
+  r.lqr_entry_time = run_.lqr_entry_time;
   return r;
 }
 
@@ -429,7 +453,7 @@ std::string PendubotMode::summary() const {
                 run.rti_median_us, run.rti_p99_us, run.nmpc_steps, (long long)run.fallbacks,
                 run.lqr_entry_time, run.lqr_time, run.lqr_entries, run.final_angle_norm);
   out += buf;
-  out += safe_hold_summary(safety_, scenario_.controller.dt,
+  out += safe_hold_summary(run_.safety, scenario_.controller.dt,
                            "the LQR near the top (no torque elsewhere)");
   return out;
 }

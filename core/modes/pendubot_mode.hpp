@@ -35,6 +35,7 @@
 #include "core/modes/mode.hpp"
 #include "core/modes/safety_net.hpp"
 #include "core/nlp/rti.hpp"
+#include "core/numerics/reserved_vector.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/pendubot_scenario.hpp"
 #include "models/pendubot.hpp"
@@ -105,12 +106,12 @@ class PendubotMode final : public Mode {
   const std::string& scenario_name() const override { return scenario_.name; }
   double dt() const override { return scenario_.controller.dt; }
   std::int64_t steps_total() const override { return steps_total_; }
-  std::int64_t steps_done() const override { return step_; }
+  std::int64_t steps_done() const override { return run_.step; }
   [[nodiscard]] bool step() override;
-  bool finished() const override { return finished_; }
+  bool finished() const override { return run_.finished; }
   bool lost() const override { return false; }  // the arm is mounted: never lost
   double lost_at() const override { return -1.0; }
-  const Telemetry& telemetry() const override { return telemetry_; }
+  const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { rti_.set_deadline_us(d); }
   // duration_s, swingup_time_s, hold_time_s, final_angle_norm, max_abs_u, velocity_violations,
   // worst_velocity_violation, tracking_rms, rti_median_us, rti_p99_us, rti_max_us, nmpc_steps,
@@ -124,11 +125,17 @@ class PendubotMode final : public Mode {
   const PendubotScenario& scenario() const { return scenario_; }
   const PendubotLqr& lqr() const { return lqr_; }
   // The true plant state now, x(t = steps_done·Δt): after the last step, the final state.
-  const State& state() const { return x_; }
-  bool lqr_active() const { return lqr_active_; }
-  const SafetyNet& safety_net() const { return safety_; }
+  const State& state() const { return run_.x; }
+  bool lqr_active() const { return run_.lqr_active; }
+  const SafetyNet& safety_net() const { return run_.safety; }
+
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state and Run.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
  private:
+  struct Saved;
   SetupResult check_settings() const;
   void warm_start();
   void measure();
@@ -144,8 +151,6 @@ class PendubotMode final : public Mode {
   std::unique_ptr<PendubotSwingup> problem_;
   RtiSolver rti_;
   PendubotLqr lqr_;  // zero gain when the scenario's LQR is disabled
-  // The NMPC's safety net: the LQR near the top, no torque elsewhere, once its plan is spent.
-  SafetyNet safety_;
 
   std::int64_t steps_total_ = 0;
   int substeps_ = 1;      // plant RK4 substeps per control step
@@ -153,36 +158,42 @@ class PendubotMode final : public Mode {
   int ref_steps_ = 0;     // reference intervals: the NMPC tracks it while k < ref_steps_
   double lowpass_ = 1.0;  // velocity low-pass gain per step, 1 − exp(−2π f_c Δt) (1: none)
   bool observer_ = false;
-
-  // Plant and sensor.
-  State x_ = State::Zero();         // true state x_k
-  State xn_ = State::Zero();        // ERK4 output
-  Eigen::Vector4d xm_ = Eigen::Vector4d::Zero();  // estimate x̂_k (angles as measured)
-  Eigen::Vector4d xw_ = Eigen::Vector4d::Zero();  // x̂_k with wrapped angles
-  Eigen::Vector2d q_prev_ = Eigen::Vector2d::Zero();  // previous encoder angles
-  Eigen::Vector2d v_filt_ = Eigen::Vector2d::Zero();  // low-passed differenced velocities
-  Eigen::VectorXd x0_;              // 4: the NMPC's initial state
-  double u_prev_ = 0.0;             // u_{k−1}, the observer's prediction input
-  bool lqr_active_ = false;
-
-  // Metrics so far.
-  double max_abs_u_ = 0.0;
-  int velocity_violations_ = 0;
-  double worst_velocity_violation_ = 0.0;
-  double err2_ = 0.0;  // Σ ‖q_k − q_ref,k‖² over NMPC steps inside the reference
-  int err_n_ = 0;
-  int nmpc_steps_ = 0;
-  double lqr_time_ = 0.0;
-  int lqr_entries_ = 0;
-  double lqr_entry_time_ = -1.0;
-  double angle_norm_ = 0.0;           // ‖wrap(q)‖ of x_ (the state now)
-  std::int64_t last_outside_ = -1;    // last k with ‖wrap(q_k)‖ > angle_tolerance
-  std::vector<double> rti_us_;        // per NMPC step, reserved for steps_total
-
-  Telemetry telemetry_;
-  std::int64_t step_ = 0;
   bool ok_ = false;  // setup succeeded
-  bool finished_ = true;
+  State xn_ = State::Zero();  // ERK4 output (scratch)
+
+  // What the flight changes step by step, besides the NMPC's state: a snapshot copies it.
+  struct Run {
+    // Plant and sensor.
+    State x = State::Zero();                         // true state x_k
+    Eigen::Vector4d xm = Eigen::Vector4d::Zero();      // estimate x̂_k (angles as measured)
+    Eigen::Vector4d xw = Eigen::Vector4d::Zero();      // x̂_k with wrapped angles
+    Eigen::Vector2d q_prev = Eigen::Vector2d::Zero();  // previous encoder angles
+    Eigen::Vector2d v_filt = Eigen::Vector2d::Zero();  // low-passed differenced velocities
+    Eigen::VectorXd x0;                               // 4: the NMPC's initial state
+    double u_prev = 0.0;                              // u_{k−1}, the observer's prediction input
+    bool lqr_active = false;
+    // The NMPC's safety net: the LQR near the top, no torque elsewhere, once its plan is spent.
+    SafetyNet safety;
+
+    // Metrics so far.
+    double max_abs_u = 0.0;
+    int velocity_violations = 0;
+    double worst_velocity_violation = 0.0;
+    double err2 = 0.0;  // Σ ‖q_k − q_ref,k‖² over NMPC steps inside the reference
+    int err_n = 0;
+    int nmpc_steps = 0;
+    double lqr_time = 0.0;
+    int lqr_entries = 0;
+    double lqr_entry_time = -1.0;
+    double angle_norm = 0.0;          // ‖wrap(q)‖ of x (the state now)
+    std::int64_t last_outside = -1;   // last k with ‖wrap(q_k)‖ > angle_tolerance
+    ReservedVector<double> rti_us;    // per NMPC step, reserved for steps_total
+
+    Telemetry telemetry;
+    std::int64_t step = 0;
+    bool finished = true;
+  };
+  Run run_;
 };
 
 // Runs the scenario to its end. With `log`, one entry per control step and the final state.

@@ -13,38 +13,41 @@ void ScoreAccumulator::setup(const Scenario& scenario) {
   scenario_ = &scenario;
   dt_ = scenario.controller.dt;
   const auto steps = std::size_t(std::lround(scenario.duration / dt_)) + 1;
-  position_.reserve(steps);
-  reference_.reserve(steps);
-  lambda_.reserve(steps);
-  rti_us_.reserve(steps);
+  Sums& m = sums_;
+  m.position.reserve(steps);
+  m.reference.reserve(steps);
+  m.lambda.reserve(steps);
+  m.rti_us.reserve(steps);
 }
 
 bool ScoreAccumulator::add(const Telemetry& s) {
+  Sums& m = sums_;
   const Eigen::Vector3d p = s.x.head<3>();
-  position_.push_back(p);
-  reference_.push_back(s.reference.head<3>());
-  lambda_.push_back(s.lambda);
-  rti_us_.push_back(s.stats.total_us);
-  if (s.stats.status == RtiStatus::fallback) ++fallbacks_;
-  if (s.events & kEventDeadlineMiss) ++deadline_misses_;
-  if (s.events & kEventSafeHold) ++safe_hold_steps_;
-  if (s.pilot.input == InputState::lost) ++input_lost_steps_;
+  m.position.push_back(p);
+  m.reference.push_back(s.reference.head<3>());
+  m.lambda.push_back(s.lambda);
+  m.rti_us.push_back(s.stats.total_us);
+  if (s.stats.status == RtiStatus::fallback) ++m.fallbacks;
+  if (s.events & kEventDeadlineMiss) ++m.deadline_misses;
+  if (s.events & kEventSafeHold) ++m.safe_hold_steps;
+  if (s.pilot.input == InputState::lost) ++m.input_lost_steps;
 
   const double dr = s.pilot.roll - s.applied.roll, dp = s.pilot.pitch - s.applied.pitch;
-  sum_override_sq_ += dr * dr + dp * dp;
-  if (!position_.empty() && position_.size() > 1) {
-    const double vr = (s.pilot.roll - prev_roll_) / dt_, vp = (s.pilot.pitch - prev_pitch_) / dt_;
-    sum_stick_sq_ += vr * vr + vp * vp;
+  m.sum_override_sq += dr * dr + dp * dp;
+  if (!m.position.empty() && m.position.size() > 1) {
+    const double vr = (s.pilot.roll - m.prev_roll) / dt_;
+    const double vp = (s.pilot.pitch - m.prev_pitch) / dt_;
+    m.sum_stick_sq += vr * vr + vp * vp;
   }
-  prev_roll_ = s.pilot.roll;
-  prev_pitch_ = s.pilot.pitch;
+  m.prev_roll = s.pilot.roll;
+  m.prev_pitch = s.pilot.pitch;
 
   // Clearance of the vehicle sphere to obstacles, walls and floor.
   const double rv = scenario_->controller.vehicle_radius;
   double clearance = 1e9;
   for (const Obstacle& o : scenario_->arena.obstacles) {
     const double c = (p - o.center).norm() - o.radius - rv;
-    min_clearance_ = std::min(min_clearance_, c);
+    m.min_clearance = std::min(m.min_clearance, c);
     clearance = std::min(clearance, c);
   }
   const Arena& a = scenario_->arena;
@@ -52,15 +55,16 @@ bool ScoreAccumulator::add(const Telemetry& s) {
     clearance = std::min({clearance, p(i) - a.min(i) - rv, a.max(i) - p(i) - rv});
   }
   const bool contact = clearance < 0.0;
-  const bool started = contact && !in_contact_;
-  if (started) ++collisions_;
-  in_contact_ = contact;
+  const bool started = contact && !m.in_contact;
+  if (started) ++m.collisions;
+  m.in_contact = contact;
   return started;
 }
 
 Score ScoreAccumulator::finish() const {
+  const Sums& m = sums_;
   Score sc;
-  const std::size_t K = position_.size();
+  const std::size_t K = m.position.size();
   if (K == 0) return sc;
   const double r = scenario_->controller.ph.r;
   sc.duration_s = double(K) * dt_;
@@ -68,7 +72,7 @@ Score ScoreAccumulator::finish() const {
   double sum_sq = 0, max_dev = 0;
   std::size_t in_ball = 0;
   for (std::size_t k = 0; k < K; ++k) {
-    const double d = (position_[k] - reference_[k]).norm();
+    const double d = (m.position[k] - m.reference[k]).norm();
     sum_sq += d * d;
     max_dev = std::max(max_dev, d);
     if (d <= r) ++in_ball;
@@ -86,7 +90,7 @@ Score ScoreAccumulator::finish() const {
     const std::int64_t lo = std::max<std::int64_t>(0, k - window);
     const std::int64_t hi = std::min<std::int64_t>(std::int64_t(K) - 1, k + window);
     for (std::int64_t j = lo; j <= hi; ++j) {
-      if ((position_[std::size_t(j)] - reference_[std::size_t(k)]).norm() <= r) {
+      if ((m.position[std::size_t(j)] - m.reference[std::size_t(k)]).norm() <= r) {
         ++reached;
         break;
       }
@@ -95,21 +99,21 @@ Score ScoreAccumulator::finish() const {
   sc.progress = double(reached) / double(std::max<std::int64_t>(total, std::int64_t(K)));
 
   double sum_l = 0, min_l = 1.0;
-  for (double l : lambda_) {
+  for (double l : m.lambda) {
     sum_l += l;
     min_l = std::min(min_l, l);
   }
   sc.mean_lambda = sum_l / double(K);
   sc.min_lambda = min_l;
-  sc.collisions = collisions_;
-  sc.min_clearance_m = scenario_->arena.obstacles.empty() ? 0.0 : min_clearance_;
-  sc.override_rms = std::sqrt(sum_override_sq_ / double(K));
-  sc.stick_smoothness = K > 1 ? std::sqrt(sum_stick_sq_ / double(K - 1)) : 0.0;
+  sc.collisions = m.collisions;
+  sc.min_clearance_m = scenario_->arena.obstacles.empty() ? 0.0 : m.min_clearance;
+  sc.override_rms = std::sqrt(m.sum_override_sq / double(K));
+  sc.stick_smoothness = K > 1 ? std::sqrt(m.sum_stick_sq / double(K - 1)) : 0.0;
 
-  set_timing(sc, rti_us_, deadline_misses_);
-  sc.fallbacks = fallbacks_;
-  sc.input_lost_s = double(input_lost_steps_) * dt_;
-  sc.safe_hold_s = double(safe_hold_steps_) * dt_;
+  set_timing(sc, m.rti_us, m.deadline_misses);
+  sc.fallbacks = m.fallbacks;
+  sc.input_lost_s = double(m.input_lost_steps) * dt_;
+  sc.safe_hold_s = double(m.safe_hold_steps) * dt_;
 
   const double quality = 0.4 * sc.time_in_ball + 0.4 * sc.mean_lambda +
                          0.2 * std::exp(-sc.override_rms / 0.1);

@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 
 #include "core/modes/mode.hpp"
+#include "core/numerics/reserved_vector.hpp"
 #include "core/scenario/scenario.hpp"
 
 namespace mixpilot {
@@ -68,6 +69,24 @@ void set_timing(Score& score, std::vector<double> total_us, int deadline_misses)
 // sized it for.
 class ScoreAccumulator {
  public:
+  // What add() has accumulated so far (a snapshot of the flight copies it).
+  struct Sums {
+    ReservedVector<Eigen::Vector3d> position;   // per step
+    ReservedVector<Eigen::Vector3d> reference;  // per step
+    ReservedVector<double> lambda;              // per step
+    ReservedVector<double> rti_us;              // per step
+    double sum_override_sq = 0;
+    double sum_stick_sq = 0;
+    double prev_roll = 0, prev_pitch = 0;
+    double min_clearance = 1e9;
+    int collisions = 0;
+    bool in_contact = false;
+    std::int64_t fallbacks = 0;
+    int deadline_misses = 0;
+    std::int64_t input_lost_steps = 0;
+    std::int64_t safe_hold_steps = 0;
+  };
+
   ScoreAccumulator() = default;
   explicit ScoreAccumulator(const Scenario& scenario) { setup(scenario); }
   // Starts over for a flight of `scenario` (which must outlive the accumulator).
@@ -76,23 +95,15 @@ class ScoreAccumulator {
   bool add(const Telemetry& step);
   Score finish() const;
 
+  // The sums so far, and back: restore() takes those of an accumulator set up for the same
+  // flight (they then fit its reserved logs: no allocation).
+  const Sums& sums() const { return sums_; }
+  void restore(const Sums& sums) { sums_ = sums; }
+
  private:
   const Scenario* scenario_ = nullptr;
   double dt_ = 0.015;
-  std::vector<Eigen::Vector3d> position_;
-  std::vector<Eigen::Vector3d> reference_;
-  std::vector<double> lambda_;
-  std::vector<double> rti_us_;
-  double sum_override_sq_ = 0;
-  double sum_stick_sq_ = 0;
-  double prev_roll_ = 0, prev_pitch_ = 0;
-  double min_clearance_ = 1e9;
-  int collisions_ = 0;
-  bool in_contact_ = false;
-  std::int64_t fallbacks_ = 0;
-  int deadline_misses_ = 0;
-  std::int64_t input_lost_steps_ = 0;
-  std::int64_t safe_hold_steps_ = 0;
+  Sums sums_;
 };
 
 }  // namespace mixpilot

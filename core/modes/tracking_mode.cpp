@@ -42,10 +42,10 @@ double position_error(const Eigen::Vector3d& p, const Eigen::Vector3d& p_ref) {
 
 SetupResult TrackingMode::setup(TrackingScenario scenario) {
   scenario_ = std::move(scenario);
-  ok_ = lost_ = false;
-  finished_ = true;  // until setup succeeds
-  lost_at_ = -1.0;
-  step_ = steps_total_ = 0;
+  ok_ = run_.lost = false;
+  run_.finished = true;  // until setup succeeds
+  run_.lost_at = -1.0;
+  run_.step = steps_total_ = 0;
   problem_.reset();
   rti_.reset();
   const TrackingControllerSettings& c = scenario_.controller;
@@ -77,43 +77,43 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   }
   // The LQR law, or the NMPC's safe controller (core/modes/safety_net.hpp).
   if (SetupResult r = lqr_.setup(model_, c.dt); !r) return r;
-  safety_.reset();
+  run_.safety.reset();
   predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(VehicleFeed::kMaxRtt / h_)));
   link_ = nullptr;
   feed_.setup(models::Crazyflie::nx, c.dt, h_, predictor_.max_substeps(),
               2 * std::size_t(steps_total_) + 2);
-  lost_reason_ = "";
+  run_.lost_reason = "";
 
   // Ring sizes. States: step k reads boundary k·s − n_m and then integrates at most to
   // (k+1)·s + n_c while boundaries from k·s on are still needed: n_r + s + 1 boundaries.
   // Commands: the substeps integrated in step k use commands k − ⌈n_c/s⌉ .. k.
   x_init_ = model_.hover_state(pl.start);
-  states_.assign(std::size_t(n_r_ + s_ + 1), x_init_);
-  cmds_.assign(std::size_t((n_c_ + s_ - 1) / s_ + 2), Input::Zero());
-  j_sim_ = j_ = 0;
-  j_lost_ = -1;
-  y_ = x0_ = x_init_;
-  u_ = model_.hover_input();
+  run_.states.assign(std::size_t(n_r_ + s_ + 1), x_init_);
+  run_.cmds.assign(std::size_t((n_c_ + s_ - 1) / s_ + 2), Input::Zero());
+  run_.j_sim = run_.j = 0;
+  run_.j_lost = -1;
+  run_.y = run_.x0 = x_init_;
+  run_.u = model_.hover_input();
 
   ref_start_ = ref.x.front().head<3>();
   ref_target_ = ref.x.back().head<3>();
   const Eigen::Vector3d step = ref_target_ - ref_start_;
   step_len_ = step.norm();
   step_dir_ = step_len_ > 0 ? Eigen::Vector3d(step / step_len_) : Eigen::Vector3d::Zero();
-  max_error_ = final_error_ = max_progress_ = max_input_violation_ = 0.0;
-  err2_.clear();
+  run_.max_error = run_.final_error = run_.max_progress = run_.max_input_violation = 0.0;
+  run_.err2.clear();
   // Remote: a sample per state received, at most about two per step.
-  err2_.reserve(2 * std::size_t(steps_total_) + 2);
-  last_outside_ = -1;
-  solve_us_.clear();
-  solve_us_.reserve(std::size_t(steps_total_));
-  predict_us_.clear();
-  predict_us_.reserve(std::size_t(steps_total_));
+  run_.err2.reserve(2 * std::size_t(steps_total_) + 2);
+  run_.last_outside = -1;
+  run_.solve_us.clear();
+  run_.solve_us.reserve(std::size_t(steps_total_));
+  run_.predict_us.clear();
+  run_.predict_us.reserve(std::size_t(steps_total_));
   if (n_c_ == 0) sample(0, x_init_);  // boundary 0 is σ = t_0
 
   init_telemetry();
   ok_ = true;
-  finished_ = false;
+  run_.finished = false;
   return {};
 }
 
@@ -121,17 +121,17 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
 // input; the NMPC's plan is its initial guess.
 void TrackingMode::init_telemetry() {
   const int nodes = problem_ ? scenario_.controller.N + 1 : 0;
-  telemetry_ = Telemetry{};
-  telemetry_.mode = ModeKind::crazyflie_tracking;
-  telemetry_.x = x_init_;
-  telemetry_.x_measured = x_init_;
-  telemetry_.u = u_;
-  telemetry_.reference = Eigen::VectorXd::Zero(3);
-  telemetry_.predicted.setZero(3, nodes);
-  telemetry_.predicted_reference.setZero(3, nodes);
+  run_.telemetry = Telemetry{};
+  run_.telemetry.mode = ModeKind::crazyflie_tracking;
+  run_.telemetry.x = x_init_;
+  run_.telemetry.x_measured = x_init_;
+  run_.telemetry.u = run_.u;
+  run_.telemetry.reference = Eigen::VectorXd::Zero(3);
+  run_.telemetry.predicted.setZero(3, nodes);
+  run_.telemetry.predicted_reference.setZero(3, nodes);
   for (int i = 0; i < nodes; ++i) {
-    telemetry_.predicted.col(i) = rti_->trajectory().x[std::size_t(i)].head<3>();
-    telemetry_.predicted_reference.col(i) = rti_->data().yref[std::size_t(i)].head<3>();
+    run_.telemetry.predicted.col(i) = rti_->trajectory().x[std::size_t(i)].head<3>();
+    run_.telemetry.predicted_reference.col(i) = rti_->data().yref[std::size_t(i)].head<3>();
   }
   set_telemetry();
   set_channels(0.0, 0.0);
@@ -140,75 +140,76 @@ void TrackingMode::init_telemetry() {
 // y = the state of boundary k·s − n_m (the initial state before the start), then x0: its
 // prediction over τ_r, or y itself.
 void TrackingMode::measure() {
-  const long b = long(step_) * s_ - n_m_;
-  y_ = b <= 0 ? x_init_ : states_[ring(b)];
+  const long b = long(run_.step) * s_ - n_m_;
+  run_.y = b <= 0 ? x_init_ : run_.states[ring(b)];
   const auto t0 = std::chrono::steady_clock::now();
   if (scenario_.controller.compensation) {
-    predictor_.predict(y_, x0_);
+    predictor_.predict(run_.y, run_.x0);
   } else {
-    x0_ = y_;
+    run_.x0 = run_.y;
   }
-  predict_us_.push_back(microseconds_since(t0));
+  run_.predict_us.push_back(microseconds_since(t0));
 }
 
 // u_k from x0: one RTI step (its plan kept for the telemetry before the shift), or the LQR law.
 void TrackingMode::control() {
-  const long k = long(step_);
+  const long k = long(run_.step);
   const OcpTrajectory& ref = scenario_.reference_trajectory;
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   if (problem_) {
     RtiSolver& rti = *rti_;
     problem_->set_reference(rti.data(), ref, int(k));
     rti.prepare();
-    if (forced_overrun(step_)) rti.force_overrun_next();
-    rti.feedback(x0_);
-    u_ = rti.control();
+    if (forced_overrun(run_.step)) rti.force_overrun_next();
+    rti.feedback(run_.x0);
+    run_.u = rti.control();
     s.solved = true;
     s.stats = rti.stats();
     // The plan spent after fallbacks in a row: the LQR tracks the reference meanwhile.
-    if (safety_.update(s.stats.status != RtiStatus::success)) {
+    if (run_.safety.update(s.stats.status != RtiStatus::success)) {
       const Eigen::VectorXd& xr = ref.x[std::size_t(std::min(k, last_x_))];
-      lqr_.control(x0_, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), u_);
+      lqr_.control(run_.x0, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), run_.u);
     }
     for (int i = 0; i <= scenario_.controller.N; ++i) {
       s.predicted.col(i) = rti.trajectory().x[std::size_t(i)].head<3>();
       s.predicted_reference.col(i) = rti.data().yref[std::size_t(i)].head<3>();
     }
     rti.shift();
-    solve_us_.push_back(s.stats.total_us);
+    run_.solve_us.push_back(s.stats.total_us);
   } else {
     const auto t0 = std::chrono::steady_clock::now();
     const Eigen::VectorXd& xr = ref.x[std::size_t(std::min(k, last_x_))];
-    lqr_.control(x0_, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), u_);
+    lqr_.control(run_.x0, State(xr), Input(ref.u[std::size_t(std::min(k, last_u_))]), run_.u);
     const double us = microseconds_since(t0);
     s.solved = false;
     s.stats = RtiStats{};
     s.stats.total_us = us;
-    solve_us_.push_back(us);
+    run_.solve_us.push_back(us);
   }
 }
 
 // u_k leaves: into the predictor's and the plant's command rings.
 void TrackingMode::send() {
-  max_input_violation_ = std::max({max_input_violation_, model_.p.omega_min - u_.minCoeff(),
-                                   u_.maxCoeff() - model_.p.omega_max});
-  predictor_.record_sent(u_);
-  cmds_[std::size_t(step_ % std::int64_t(cmds_.size()))] = u_;
+  run_.max_input_violation =
+      std::max({run_.max_input_violation, model_.p.omega_min - run_.u.minCoeff(),
+                run_.u.maxCoeff() - model_.p.omega_max});
+  predictor_.record_sent(run_.u);
+  run_.cmds[std::size_t(run_.step % std::int64_t(run_.cmds.size()))] = run_.u;
 }
 
 // RK4 substeps up to boundary `end`, each with the command on the rotors during it (none before
 // the first command arrives at boundary n_c: the vehicle rests).
 void TrackingMode::integrate_to(long end) {
-  while (j_sim_ < end) {
-    const long m = floor_div(j_sim_ - n_c_, s_);
-    const State& x = states_[ring(j_sim_)];
-    State& xn = states_[ring(j_sim_ + 1)];
+  while (run_.j_sim < end) {
+    const long m = floor_div(run_.j_sim - n_c_, s_);
+    const State& x = run_.states[ring(run_.j_sim)];
+    State& xn = run_.states[ring(run_.j_sim + 1)];
     if (m >= 0) {
-      plant_.step<double>(x, cmds_[std::size_t(m % long(cmds_.size()))], h_, xn);
+      plant_.step<double>(x, run_.cmds[std::size_t(m % long(run_.cmds.size()))], h_, xn);
     } else {
       xn = x;
     }
-    ++j_sim_;
+    ++run_.j_sim;
   }
 }
 
@@ -216,14 +217,14 @@ void TrackingMode::integrate_to(long end) {
 // where the vehicle is lost: not finite, or outside the kLostRadius ball around its start.
 bool TrackingMode::process_to(long end) {
   const Eigen::Vector3d& start = scenario_.plant.start;
-  while (j_ < end) {
-    ++j_;
-    const State& x = states_[ring(j_)];
+  while (run_.j < end) {
+    ++run_.j;
+    const State& x = run_.states[ring(run_.j)];
     if (!x.allFinite() || (x.head<3>() - start).norm() > tracking_defaults::kLostRadius) {
-      j_lost_ = j_;
+      run_.j_lost = run_.j;
       return false;
     }
-    if (j_ >= n_c_ && (j_ - n_c_) % s_ == 0) sample((j_ - n_c_) / s_, x);
+    if (run_.j >= n_c_ && (run_.j - n_c_) % s_ == 0) sample((run_.j - n_c_) / s_, x);
   }
   return true;
 }
@@ -246,14 +247,14 @@ void TrackingMode::sample_at(double sigma, const State& x) {
 }
 
 void TrackingMode::add_sample(long m, const Eigen::Vector3d& p, const Eigen::Vector3d& pr) {
-  if (err2_.size() == err2_.capacity()) return;  // never grow in the loop
+  if (run_.err2.size() == run_.err2.capacity()) return;  // never grow in the loop
   const double e = position_error(p, pr);
-  err2_.push_back(e * e);
-  max_error_ = std::max(max_error_, e);
-  final_error_ = e;
+  run_.err2.push_back(e * e);
+  run_.max_error = std::max(run_.max_error, e);
+  run_.final_error = e;
   if (scenario_.reference.kind == TrackingReferenceKind::smooth_step) {
-    max_progress_ = std::max(max_progress_, (p - ref_start_).dot(step_dir_));
-    if ((p - ref_target_).norm() > tracking_defaults::kSettleRadius) last_outside_ = m;
+    run_.max_progress = std::max(run_.max_progress, (p - ref_start_).dot(step_dir_));
+    if ((p - ref_target_).norm() > tracking_defaults::kSettleRadius) run_.last_outside = m;
   }
 }
 
@@ -263,59 +264,60 @@ bool TrackingMode::set_vehicle(VehicleLink* link) {
 }
 
 void TrackingMode::lose(double at, const char* reason) {
-  lost_ = true;
-  lost_at_ = at;
-  lost_reason_ = reason;
+  run_.lost = true;
+  run_.lost_at = at;
+  run_.lost_reason = reason;
 }
 
 bool TrackingMode::step() {
-  if (finished_ || stopped_at(step_)) return false;
+  if (run_.finished || stopped_at(run_.step)) return false;
   if (link_) return step_remote();
-  const long k = long(step_);
+  const long k = long(run_.step);
   const auto started = std::chrono::steady_clock::now();
   measure();
   control();
-  compute_us_ = microseconds_since(started);
+  run_.compute_us = microseconds_since(started);
   send();
   // The plant to the next control boundary; after the last step on to K·s + n_c (sample K).
   const long end = (k + 1) * s_ + (k + 1 == steps_total_ ? n_c_ : 0);
   integrate_to(std::max(end, k * s_ + n_c_));
   const bool alive = process_to(end);
-  if (!alive) lose(double(j_lost_ - n_c_) * h_, "it left the world");
+  if (!alive) lose(double(run_.j_lost - n_c_) * h_, "it left the world");
   set_telemetry();
-  telemetry_.events |= deadline_event(step_, compute_us_, telemetry_.solved && telemetry_.stats.overrun);
-  set_channels(predict_us_.back(), solve_us_.back());
-  ++step_;
-  finished_ = lost_ || step_ >= steps_total_;
+  Telemetry& s = run_.telemetry;
+  s.events |= deadline_event(run_.step, run_.compute_us, s.solved && s.stats.overrun);
+  set_channels(run_.predict_us.back(), run_.solve_us.back());
+  ++run_.step;
+  run_.finished = run_.lost || run_.step >= steps_total_;
   return true;
 }
 
 // Step k with a remote vehicle: the newest state (a round-trip and an error sample when it is
 // new), the prediction over the estimated round-trip time, the controller, the command out.
 bool TrackingMode::step_remote() {
-  const long k = long(step_);
+  const long k = long(run_.step);
   const std::int64_t now = link_->now_ns();
   const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
   const VehicleSample& v = *r.sample;
   const double t = double(k) * scenario_.controller.dt;
-  y_ = r.heard ? State(v.x) : x_init_;
+  run_.y = r.heard ? State(v.x) : x_init_;
   const VehicleWorld world =
       VehicleWorld::ball(scenario_.plant.start, tracking_defaults::kLostRadius);
-  const char* outside = r.heard ? world.outside(y_.head<3>()) : nullptr;
-  if (r.heard && (v.left_world || !y_.allFinite() || outside)) {
+  const char* outside = r.heard ? world.outside(run_.y.head<3>()) : nullptr;
+  if (r.heard && (v.left_world || !run_.y.allFinite() || outside)) {
     lose(t, outside ? outside : "it left the world");
-    y_ = x_init_;
+    run_.y = x_init_;
   } else if (r.lost) {
     lose(t, feed_.lost_reason());
   } else if (r.fresh) {
     sample_at(r.sigma, State(v.x));  // only states inside the world are scored
   }
-  if (lost_) {
-    finished_ = true;
+  if (run_.lost) {
+    run_.finished = true;
     link_->finish();
     set_telemetry();
-    telemetry_.x = y_;
-    ++step_;
+    run_.telemetry.x = run_.y;
+    ++run_.step;
     return true;
   }
 
@@ -323,48 +325,49 @@ bool TrackingMode::step_remote() {
   // controller starts from it only with compensation, the telemetry always shows it (the
   // newest state itself is a round trip old: its error would be the delay's, not the loop's).
   const auto t0 = std::chrono::steady_clock::now();
-  predictor_.predict(y_, predicted_, r.horizon_substeps);
-  x0_ = scenario_.controller.compensation ? predicted_ : y_;
-  predict_us_.push_back(scenario_.controller.compensation ? microseconds_since(t0) : 0.0);
+  predictor_.predict(run_.y, run_.predicted, r.horizon_substeps);
+  run_.x0 = scenario_.controller.compensation ? run_.predicted : run_.y;
+  run_.predict_us.push_back(scenario_.controller.compensation ? microseconds_since(t0) : 0.0);
   control();
-  compute_us_ = microseconds_since(t0);
+  run_.compute_us = microseconds_since(t0);
   send();
-  feed_.send(*link_, k, now, u_.data(), int(u_.size()));
+  feed_.send(*link_, k, now, run_.u.data(), int(run_.u.size()));
 
   set_telemetry();
-  telemetry_.events |= deadline_event(step_, compute_us_, telemetry_.solved && telemetry_.stats.overrun);
-  telemetry_.x = predicted_;
-  set_channels(predict_us_.back(), solve_us_.back());
-  ++step_;
-  finished_ = step_ >= steps_total_;
-  if (finished_) link_->finish();
+  Telemetry& s = run_.telemetry;
+  s.events |= deadline_event(run_.step, run_.compute_us, s.solved && s.stats.overrun);
+  s.x = run_.predicted;
+  set_channels(run_.predict_us.back(), run_.solve_us.back());
+  ++run_.step;
+  run_.finished = run_.step >= steps_total_;
+  if (run_.finished) link_->finish();
   return true;
 }
 
 // Step k's telemetry on the controller's clock: x(σ = t_k), boundary k·s + n_c (when the vehicle
 // is lost before it, the last state inside the world), x0, u_k, p_ref(t_k).
 void TrackingMode::set_telemetry() {
-  const long k = long(step_);
-  Telemetry& s = telemetry_;
-  s.step = step_;
+  const long k = long(run_.step);
+  Telemetry& s = run_.telemetry;
+  s.step = run_.step;
   s.t = double(k) * scenario_.controller.dt;
   long jx = k * s_ + n_c_;
-  if (j_lost_ >= 0 && jx >= j_lost_) jx = j_lost_ - 1;
-  s.x = states_[ring(jx)];
-  s.x_measured = x0_;
-  s.u = u_;
+  if (run_.j_lost >= 0 && jx >= run_.j_lost) jx = run_.j_lost - 1;
+  s.x = run_.states[ring(jx)];
+  s.x_measured = run_.x0;
+  s.u = run_.u;
   const Eigen::VectorXd& xr = scenario_.reference_trajectory.x[std::size_t(std::min(k, last_x_))];
   for (int i = 0; i < 3; ++i) s.reference(i) = xr(i);
   s.events = 0;
   if (s.solved && s.stats.status == RtiStatus::fallback) s.events |= kEventFallback;
   if (s.solved && s.stats.overrun) s.events |= kEventOverrun;
-  if (safety_.engaged()) s.events |= kEventSafeHold;
-  if (safety_.switched()) s.events |= kEventSwitch;
-  if (lost_) s.events |= kEventLost;
+  if (run_.safety.engaged()) s.events |= kEventSafeHold;
+  if (run_.safety.switched()) s.events |= kEventSwitch;
+  if (run_.lost) s.events |= kEventLost;
 }
 
 void TrackingMode::set_channels(double predictor_us, double controller_us) {
-  Telemetry& s = telemetry_;
+  Telemetry& s = run_.telemetry;
   const Eigen::Vector3d p = s.x.head<3>(), pr = s.reference.head<3>();
   s.set_channel(kTrackingError, "tracking error", "m", position_error(p, pr));
   s.set_channel(kRtt, link_ ? "RTT estimate" : "RTT", "s",
@@ -380,26 +383,59 @@ void TrackingMode::set_channels(double predictor_us, double controller_us) {
   }
 }
 
+struct TrackingMode::Saved final : ModeSnapshot::State {
+  bool nmpc = false;
+  RtiState rti;  // the NMPC's warm start (empty for the LQR)
+  CrazyflieDelayPredictor::Sent predictor;
+  Run run;
+  bool remote = false;
+};
+
+void TrackingMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
+  if (!state) state = std::make_unique<Saved>();
+  Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
+  s.nmpc = rti_ != nullptr;
+  if (rti_) s.rti = rti_->state();
+  s.predictor = predictor_.sent();
+  s.run = run_;
+  s.remote = link_ != nullptr;
+}
+
+RestoreStatus TrackingMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (s.remote || link_) return RestoreStatus::remote_vehicle;
+  if (!ok_ || s.nmpc != (rti_ != nullptr) || (rti_ && !rti_->fits(s.rti)) ||
+      !predictor_.fits(s.predictor) || s.run.states.size() != run_.states.size() ||
+      s.run.cmds.size() != run_.cmds.size() ||
+      s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
+    return RestoreStatus::other_scenario;
+  if (rti_) rti_->restore(s.rti);
+  predictor_.restore(s.predictor);
+  run_ = s.run;
+  return RestoreStatus::ok;
+}
+
 TrackingResult TrackingMode::result() const {
   TrackingResult r;
   r.ok = ok_;
-  r.lost = lost_;
-  r.steps = int(step_);
+  r.lost = run_.lost;
+  r.steps = int(run_.step);
   // Squares rounded one by one, then summed in order: a running sum would let the compiler
   // fuse each square into the addition (FMA) and round differently.
   double sum = 0.0;
-  for (double e2 : err2_) sum += e2;
-  r.tracking_rms_m = err2_.empty() ? 0.0 : std::sqrt(sum / double(err2_.size()));
-  r.max_error_m = max_error_;
-  r.final_error_m = final_error_;
+  for (double e2 : run_.err2) sum += e2;
+  r.tracking_rms_m = run_.err2.empty() ? 0.0 : std::sqrt(sum / double(run_.err2.size()));
+  r.max_error_m = run_.max_error;
+  r.final_error_m = run_.final_error;
   if (scenario_.reference.kind == TrackingReferenceKind::smooth_step) {
-    r.overshoot_m = std::max(0.0, max_progress_ - step_len_);
-    r.settle_time_s = double(last_outside_ + 1) * scenario_.controller.dt;
+    r.overshoot_m = std::max(0.0, run_.max_progress - step_len_);
+    r.settle_time_s = double(run_.last_outside + 1) * scenario_.controller.dt;
   }
-  r.max_input_violation = max_input_violation_;
-  r.solve_median_us = percentile(solve_us_, 0.5);
-  r.solve_p99_us = percentile(solve_us_, 0.99);
-  r.predictor_median_us = scenario_.controller.compensation ? percentile(predict_us_, 0.5) : 0.0;
+  r.max_input_violation = run_.max_input_violation;
+  r.solve_median_us = percentile(run_.solve_us, 0.5);
+  r.solve_p99_us = percentile(run_.solve_us, 0.99);
+  r.predictor_median_us =
+      scenario_.controller.compensation ? percentile(run_.predict_us, 0.5) : 0.0;
   r.fallbacks = rti_ ? long(rti_->stats().fallbacks) : 0;
   r.rtt_substeps = int(n_r_);
   r.measurement_substeps = int(n_m_);
@@ -466,7 +502,7 @@ std::string TrackingMode::summary() const {
                 rtt_text.c_str(), scenario_.controller.compensation ? "on" : "off",
                 r.steps, r.tracking_rms_m, r.max_error_m, r.final_error_m);
   std::string out = buf;
-  if (err2_.empty()) {
+  if (run_.err2.empty()) {
     // A remote vehicle whose states never acknowledged a command gave no error to measure.
     std::snprintf(buf, sizeof buf,
                   "%s (crazyflie_tracking, %s, %s, %s, compensation %s)\n"
@@ -486,10 +522,10 @@ std::string TrackingMode::summary() const {
   out += buf;
   if (r.lost) {
     out.pop_back();
-    out += lost_reason_;
+    out += run_.lost_reason;
     out += "\n";
   }
-  out += safe_hold_summary(safety_, scenario_.controller.dt, "the LQR");
+  out += safe_hold_summary(run_.safety, scenario_.controller.dt, "the LQR");
   return out;
 }
 

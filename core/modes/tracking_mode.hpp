@@ -43,6 +43,7 @@
 #include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/numerics/integrator_erk4.hpp"
+#include "core/numerics/reserved_vector.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/tracking_scenario.hpp"
 #include "models/crazyflie.hpp"
@@ -95,12 +96,12 @@ class TrackingMode final : public Mode {
   const std::string& scenario_name() const override { return scenario_.name; }
   double dt() const override { return scenario_.controller.dt; }
   std::int64_t steps_total() const override { return steps_total_; }
-  std::int64_t steps_done() const override { return step_; }
+  std::int64_t steps_done() const override { return run_.step; }
   [[nodiscard]] bool step() override;
-  bool finished() const override { return finished_; }
-  bool lost() const override { return lost_; }
-  double lost_at() const override { return lost_at_; }  // σ of the boundary found lost, or −1
-  const Telemetry& telemetry() const override { return telemetry_; }
+  bool finished() const override { return run_.finished; }
+  bool lost() const override { return run_.lost; }
+  double lost_at() const override { return run_.lost_at; }  // σ of the boundary found lost, or −1
+  const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override {
     if (rti_) rti_->set_deadline_us(d);
   }
@@ -117,15 +118,22 @@ class TrackingMode final : public Mode {
   bool remote() const { return link_ != nullptr; }
   const RttEstimator& rtt_estimator() const { return feed_.rtt(); }
   // Why the vehicle was lost ("" while it is not): left the world, or silent.
-  const char* lost_reason() const { return lost_reason_; }
+  const char* lost_reason() const { return run_.lost_reason; }
 
   TrackingResult result() const;
   const TrackingScenario& scenario() const { return scenario_; }
   bool nmpc() const { return problem_ != nullptr; }
-  const SafetyNet& safety_net() const { return safety_; }
+  const SafetyNet& safety_net() const { return run_.safety; }
+
+ protected:
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state, the predictor's sent
+  // commands and Run. With a remote vehicle they refuse.
+  void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
+  [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
  private:
-  std::size_t ring(long j) const { return std::size_t(j % long(states_.size())); }
+  struct Saved;
+  std::size_t ring(long j) const { return std::size_t(j % long(run_.states.size())); }
   void measure();
   void control();
   void send();
@@ -146,8 +154,6 @@ class TrackingMode final : public Mode {
   std::unique_ptr<CrazyflieTracking> problem_;  // NMPC only
   std::unique_ptr<RtiSolver> rti_;              // NMPC only
   TrackingLqr lqr_;  // the LQR law, or the NMPC's safe controller
-  SafetyNet safety_;
-  double compute_us_ = 0.0;  // the step's measurement and control time
   CrazyflieDelayPredictor predictor_;
 
   // Delay model in plant substeps (core/control/tracking.hpp).
@@ -155,47 +161,57 @@ class TrackingMode final : public Mode {
   double h_ = 0;  // substep [s]
   long n_r_ = 0, n_m_ = 0, n_c_ = 0;  // τ_r, τ_m, τ_c
   long last_x_ = 0, last_u_ = 0;      // last reference node of x, of u
-
-  // Plant: states at substep boundaries j (ring, index j mod size), integrated up to j_sim_ and
-  // checked and sampled up to j_; the commands sent (ring, index k mod size).
-  std::vector<State> states_;
-  std::vector<Input> cmds_;
   State x_init_ = State::Zero();
-  long j_sim_ = 0;
-  long j_ = 0;
-  long j_lost_ = -1;  // boundary found lost
-
-  // Step k: the measurement, the controller's initial state, the command.
-  State y_ = State::Zero();
-  State x0_ = State::Zero();
-  State predicted_ = State::Zero();  // remote: the newest state predicted to t_k
-  Input u_ = Input::Zero();
 
   // Error samples m = 0..K at boundaries m·s + n_c (σ = t_m).
   Eigen::Vector3d ref_start_ = Eigen::Vector3d::Zero();   // p_ref of the first node
   Eigen::Vector3d ref_target_ = Eigen::Vector3d::Zero();  // p_ref of the last node
   Eigen::Vector3d step_dir_ = Eigen::Vector3d::Zero();    // unit (target − start), or 0
   double step_len_ = 0;
-  std::vector<double> err2_;  // ‖e_m‖² per sample, reserved for K + 1
-  double max_error_ = 0, final_error_ = 0;
-  double max_progress_ = 0;  // max_m (p_m − start)·dir
-  long last_outside_ = -1;   // last m outside the settle radius
-  double max_input_violation_ = 0;
-  std::vector<double> solve_us_;    // per step, reserved for steps_total
-  std::vector<double> predict_us_;  // per step, reserved for steps_total
 
   // Remote vehicle.
   VehicleLink* link_ = nullptr;
   VehicleFeed feed_;
-  const char* lost_reason_ = "";
 
-  Telemetry telemetry_;
-  std::int64_t step_ = 0;
   std::int64_t steps_total_ = 0;
   bool ok_ = false;  // setup succeeded
-  bool finished_ = true;
-  bool lost_ = false;
-  double lost_at_ = -1.0;
+
+  // What the flight changes step by step, besides the states of the NMPC and the predictor:
+  // a snapshot copies it.
+  struct Run {
+    // Plant: states at substep boundaries j (ring, index j mod size), integrated up to j_sim
+    // and checked and sampled up to j; the commands sent (ring, index k mod size).
+    std::vector<State> states;
+    std::vector<Input> cmds;
+    long j_sim = 0;
+    long j = 0;
+    long j_lost = -1;  // boundary found lost
+
+    // Step k: the measurement, the controller's initial state, the command.
+    State y = State::Zero();
+    State x0 = State::Zero();
+    State predicted = State::Zero();  // remote: the newest state predicted to t_k
+    Input u = Input::Zero();
+    SafetyNet safety;
+    double compute_us = 0.0;  // the step's measurement and control time
+
+    // Error samples and metrics so far.
+    ReservedVector<double> err2;  // ‖e_m‖² per sample, reserved for K + 1
+    double max_error = 0, final_error = 0;
+    double max_progress = 0;  // max_m (p_m − start)·dir
+    long last_outside = -1;   // last m outside the settle radius
+    double max_input_violation = 0;
+    ReservedVector<double> solve_us;    // per step, reserved for steps_total
+    ReservedVector<double> predict_us;  // per step, reserved for steps_total
+
+    const char* lost_reason = "";
+    Telemetry telemetry;
+    std::int64_t step = 0;
+    bool finished = true;
+    bool lost = false;
+    double lost_at = -1.0;
+  };
+  Run run_;
 };
 
 // Per control step k (optional log of a run), from the telemetry.

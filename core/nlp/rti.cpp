@@ -54,7 +54,7 @@ SetupResult RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   }
   if (!dims.valid()) return SetupResult::failure("the OCP gives invalid QP dimensions");
   qp_.resize(dims);
-  qp_sol_.resize(dims);
+  state_.qp_solution.resize(dims);
   qp_dense_.set_method(settings.qp_solver == QpSolverKind::condensed_active_set
                            ? CondensedQpMethod::active_set
                            : CondensedQpMethod::ipm);
@@ -83,7 +83,7 @@ SetupResult RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   }
 
   data_.resize(ocp);
-  traj_.resize(ocp);
+  state_.trajectory.resize(ocp);
   const int ny_max = std::max(ocp.ny(), ocp.ny_terminal());
   ws_.x_next.setZero(nx);
   ws_.y.setZero(ny_max);
@@ -108,9 +108,9 @@ SetupResult RtiSolver::setup(const Ocp& ocp, const Settings& settings) {
   if (selection_output_) z_index_ = z_index(*selection_output_);
   if (selection_terminal_) terminal_z_index_ = z_index(*selection_terminal_);
 
-  stats_ = RtiStats{};
-  prepared_ = false;
-  have_qp_solution_ = false;
+  state_.stats = RtiStats{};
+  state_.prepared = false;
+  state_.have_qp_solution = false;
   ocp_ = &ocp;
   return {};
 }
@@ -125,7 +125,8 @@ void RtiSolver::linearize_cost(int i) {
   const int ny = out.ny();
   const Eigen::MatrixXd& W = data_.W[i];
   OcpQpStage& s = qp_.stage[i];
-  const Eigen::VectorXd& x = traj_.x[i];
+  const OcpTrajectory& traj = state_.trajectory;
+  const Eigen::VectorXd& x = traj.x[i];
 
   if (sel) {
     // y selects components of z = (x, u): H[z_k, z_l] += W(k, l), grad[z_k] += (W r)_k, with
@@ -134,7 +135,7 @@ void RtiSolver::linearize_cost(int i) {
     auto r = ws_.res.head(ny);
     for (int k = 0; k < ny; ++k) {
       const int z = zi(k);
-      r(k) = (z < nx ? x(z) : traj_.u[i](z - nx)) - data_.yref[i](k);
+      r(k) = (z < nx ? x(z) : traj.u[i](z - nx)) - data_.yref[i](k);
     }
     auto wr = ws_.y.head(ny);
     wr.noalias() = W * r;
@@ -176,7 +177,7 @@ void RtiSolver::linearize_cost(int i) {
   if (terminal) {
     out.eval(x, ws_.empty, data_.p[i], y, Jx, ws_.empty_Ju);
   } else {
-    out.eval(x, traj_.u[i], data_.p[i], y, Jx, Ju);
+    out.eval(x, traj.u[i], data_.p[i], y, Jx, Ju);
   }
   auto r = ws_.res.head(ny);
   r = y - data_.yref[i];
@@ -198,21 +199,22 @@ void RtiSolver::linearize_constraints(int i) {
   const Ocp& ocp = *ocp_;
   OcpQpStage& s = qp_.stage[i];
   const OcpQpDims& d = qp_.dims;
+  const OcpTrajectory& traj = state_.trajectory;
   for (int k = 0; k < d.nbu[i]; ++k) {
-    const double v = traj_.u[i](ocp.idxbu(k));
+    const double v = traj.u[i](ocp.idxbu(k));
     s.lbu(k) = ocp.lbu(k) - v;
     s.ubu(k) = ocp.ubu(k) - v;
   }
   for (int k = 0; k < d.nbx[i]; ++k) {
-    const double v = traj_.x[i](ocp.idxbx(k));
+    const double v = traj.x[i](ocp.idxbx(k));
     s.lbx(k) = ocp.lbx(k) - v;
     s.ubx(k) = ocp.ubx(k) - v;
   }
   if (d.ng[i] > 0) {
     if (i == ocp.N) {
-      ocp.constraint->eval(traj_.x[i], ws_.empty, data_.p[i], ws_.g, s.C, ws_.empty_Gu);
+      ocp.constraint->eval(traj.x[i], ws_.empty, data_.p[i], ws_.g, s.C, ws_.empty_Gu);
     } else {
-      ocp.constraint->eval(traj_.x[i], traj_.u[i], data_.p[i], ws_.g, s.C, s.D);
+      ocp.constraint->eval(traj.x[i], traj.u[i], data_.p[i], ws_.g, s.C, s.D);
     }
     s.lg = ocp.lg - ws_.g;
     s.ug = ocp.ug - ws_.g;
@@ -222,14 +224,15 @@ void RtiSolver::linearize_constraints(int i) {
 RtiStatus RtiSolver::prepare() {
   if (!ocp_) return RtiStatus::invalid;
   const Ocp& ocp = *ocp_;
+  const OcpTrajectory& traj = state_.trajectory;
   const auto t0 = Clock::now();
   bool finite = true;
   for (int i = 0; i < ocp.N; ++i) {
     OcpQpStage& s = qp_.stage[i];
     const IntegratorStatus st =
-        ocp.integrator->step_sensitivities(traj_.x[i], traj_.u[i], ocp.dt, ws_.x_next, s.A, s.B);
+        ocp.integrator->step_sensitivities(traj.x[i], traj.u[i], ocp.dt, ws_.x_next, s.A, s.B);
     finite = finite && st == IntegratorStatus::success;
-    s.b = ws_.x_next - traj_.x[i + 1];  // multiple-shooting gap
+    s.b = ws_.x_next - traj.x[i + 1];  // multiple-shooting gap
   }
   const auto t1 = Clock::now();
   for (int i = 0; i <= ocp.N; ++i) {
@@ -237,73 +240,106 @@ RtiStatus RtiSolver::prepare() {
     linearize_constraints(i);
   }
   qp_solver().prepare(qp_);  // the x̄_0-free part of the QP solver's work (condensing)
-  stats_.integration_us = std::chrono::duration<double, std::micro>(t1 - t0).count();
-  stats_.linearization_us = micros_since(t1);
-  stats_.linearization_finite = finite;
-  prepared_ = true;
+  RtiStats& stats = state_.stats;
+  stats.integration_us = std::chrono::duration<double, std::micro>(t1 - t0).count();
+  stats.linearization_us = micros_since(t1);
+  stats.linearization_finite = finite;
+  state_.prepared = true;
   return RtiStatus::success;
 }
 
 RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
   if (!ocp_) return RtiStatus::invalid;
   if (x0.size() != ocp_->nx() || !x0.allFinite()) return RtiStatus::invalid;
-  if (!prepared_) return RtiStatus::not_prepared;
-  prepared_ = false;
+  RtiState& st = state_;
+  if (!st.prepared) return RtiStatus::not_prepared;
+  st.prepared = false;
   const auto t0 = Clock::now();
-  qp_.x0 = x0 - traj_.x[0];
+  qp_.x0 = x0 - st.trajectory.x[0];
 
   RtiStatus status = RtiStatus::fallback;
-  stats_.qp_iterations = 0;
-  if (stats_.linearization_finite) {
-    const QpWarmStart warm = settings_.qp_warm_start && have_qp_solution_
+  RtiStats& stats = st.stats;
+  stats.qp_iterations = 0;
+  if (stats.linearization_finite) {
+    const QpWarmStart warm = settings_.qp_warm_start && st.have_qp_solution
                                  ? QpWarmStart::primal_dual
                                  : QpWarmStart::cold;
-    stats_.qp_status = qp_solver().solve(qp_, qp_sol_, warm);
-    stats_.qp_iterations = qp_sol_.iterations;
-    const double elapsed_us =
-        stats_.integration_us + stats_.linearization_us + micros_since(t0);
-    stats_.overrun = force_overrun_ || (deadline_us_ > 0.0 && elapsed_us > deadline_us_);
-    if (stats_.qp_status == QpStatus::success && !stats_.overrun) {
-      for (int i = 0; i <= ocp_->N; ++i) traj_.x[i] += qp_sol_.x[i];
-      for (int i = 0; i < ocp_->N; ++i) traj_.u[i] += qp_sol_.u[i];
-      have_qp_solution_ = true;
+    stats.qp_status = qp_solver().solve(qp_, st.qp_solution, warm);
+    stats.qp_iterations = st.qp_solution.iterations;
+    const double elapsed_us = stats.integration_us + stats.linearization_us + micros_since(t0);
+    stats.overrun = st.force_overrun || (deadline_us_ > 0.0 && elapsed_us > deadline_us_);
+    if (stats.qp_status == QpStatus::success && !stats.overrun) {
+      for (int i = 0; i <= ocp_->N; ++i) st.trajectory.x[i] += st.qp_solution.x[i];
+      for (int i = 0; i < ocp_->N; ++i) st.trajectory.u[i] += st.qp_solution.u[i];
+      st.have_qp_solution = true;
       status = RtiStatus::success;
     }
   } else {
-    stats_.qp_status = QpStatus::invalid_data;
-    stats_.overrun = false;
+    stats.qp_status = QpStatus::invalid_data;
+    stats.overrun = false;
   }
-  force_overrun_ = false;
+  st.force_overrun = false;
   if (status == RtiStatus::fallback) {
-    ++stats_.fallbacks;
-    have_qp_solution_ = false;
+    ++stats.fallbacks;
+    st.have_qp_solution = false;
   }
-  stats_.qp_us = micros_since(t0);
-  stats_.total_us = stats_.integration_us + stats_.linearization_us + stats_.qp_us;
-  stats_.status = status;
+  stats.qp_us = micros_since(t0);
+  stats.total_us = stats.integration_us + stats.linearization_us + stats.qp_us;
+  stats.status = status;
   return status;
 }
 
 void RtiSolver::shift() {
   if (!ocp_) return;
-  shift_left(traj_.x);
-  shift_left(traj_.u);
-  if (have_qp_solution_) {
+  shift_left(state_.trajectory.x);
+  shift_left(state_.trajectory.u);
+  if (state_.have_qp_solution) {
     // Multipliers of the shifted problem for a primal-dual warm start (the last stage, whose
     // dims differ, keeps its own).
+    OcpQpSolution& sol = state_.qp_solution;
     const int N = ocp_->N;
     for (int i = 0; i + 1 < N; ++i) {
-      qp_sol_.pi[i].swap(qp_sol_.pi[i + 1]);
+      sol.pi[i].swap(sol.pi[i + 1]);
     }
     for (int i = 1; i + 1 < N; ++i) {
-      qp_sol_.lam_l[i].swap(qp_sol_.lam_l[i + 1]);
-      qp_sol_.lam_u[i].swap(qp_sol_.lam_u[i + 1]);
-      qp_sol_.sl[i].swap(qp_sol_.sl[i + 1]);
-      qp_sol_.su[i].swap(qp_sol_.su[i + 1]);
-      qp_sol_.lam_sl[i].swap(qp_sol_.lam_sl[i + 1]);
-      qp_sol_.lam_su[i].swap(qp_sol_.lam_su[i + 1]);
+      sol.lam_l[i].swap(sol.lam_l[i + 1]);
+      sol.lam_u[i].swap(sol.lam_u[i + 1]);
+      sol.sl[i].swap(sol.sl[i + 1]);
+      sol.su[i].swap(sol.su[i + 1]);
+      sol.lam_sl[i].swap(sol.lam_sl[i + 1]);
+      sol.lam_su[i].swap(sol.lam_su[i + 1]);
     }
   }
+}
+
+namespace {
+
+// Same sizes, vector by vector: a copy of one into the other allocates nothing.
+bool same_sizes(const std::vector<Eigen::VectorXd>& a, const std::vector<Eigen::VectorXd>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].size() != b[i].size()) return false;
+  return true;
+}
+
+}  // namespace
+
+bool RtiSolver::fits(const RtiState& state) const {
+  const OcpTrajectory& t = state.trajectory;
+  const OcpQpSolution& q = state.qp_solution;
+  const OcpQpSolution& mine = state_.qp_solution;
+  return ocp_ && same_sizes(t.x, state_.trajectory.x) && same_sizes(t.u, state_.trajectory.u) &&
+         same_sizes(q.x, mine.x) && same_sizes(q.u, mine.u) && same_sizes(q.pi, mine.pi) &&
+         same_sizes(q.lam_l, mine.lam_l) && same_sizes(q.lam_u, mine.lam_u) &&
+         same_sizes(q.sl, mine.sl) && same_sizes(q.su, mine.su) &&
+         same_sizes(q.lam_sl, mine.lam_sl) && same_sizes(q.lam_su, mine.lam_su) &&
+         q.lam_x0.size() == mine.lam_x0.size();
+}
+
+bool RtiSolver::restore(const RtiState& state) {
+  if (!fits(state)) return false;
+  state_ = state;
+  return true;
 }
 
 SqpResult RtiSolver::sqp(const Eigen::Ref<const Eigen::VectorXd>& x0, int max_iterations,
@@ -313,11 +349,12 @@ SqpResult RtiSolver::sqp(const Eigen::Ref<const Eigen::VectorXd>& x0, int max_it
     prepare();
     const RtiStatus st = feedback(x0);
     result.iterations = it + 1;
-    result.qp_status = stats_.qp_status;
+    result.qp_status = state_.stats.qp_status;
     if (st != RtiStatus::success) return result;
+    const OcpQpSolution& sol = state_.qp_solution;
     double step = 0.0;
-    for (const auto& dx : qp_sol_.x) step = std::max(step, dx.lpNorm<Eigen::Infinity>());
-    for (const auto& du : qp_sol_.u) step = std::max(step, du.lpNorm<Eigen::Infinity>());
+    for (const auto& dx : sol.x) step = std::max(step, dx.lpNorm<Eigen::Infinity>());
+    for (const auto& du : sol.u) step = std::max(step, du.lpNorm<Eigen::Infinity>());
     result.step_norm = step;
     if (step <= tol) {
       result.converged = true;

@@ -77,6 +77,20 @@ struct SqpResult {
   QpStatus qp_status = QpStatus::invalid_data;
 };
 
+// What the next control step reads of the previous ones: the state of an RTI solver, as a
+// plain value (a snapshot of a flight copies it, core/modes/mode.hpp). The QP data, the QP
+// solvers' workspaces and the preparation buffers are not in it: prepare() rebuilds them from
+// the trajectory and the stage data, which every owner sets whole before each prepare() (its
+// constant parts at setup). Copying it into a state of the same OCP allocates nothing.
+struct RtiState {
+  OcpTrajectory trajectory;   // the linearization point, shifted: the next step's warm start
+  OcpQpSolution qp_solution;  // the last QP's iterates and multipliers, shifted: its warm start
+  RtiStats stats{};           // the last step's (fallbacks counted since setup())
+  bool prepared = false;      // prepare() ran since the last feedback()
+  bool have_qp_solution = false;  // qp_solution holds a solution to warm-start from
+  bool force_overrun = false;     // the next feedback() is an overrun (force_overrun_next())
+};
+
 // Buffers of the preparation phase.
 struct RtiWorkspace {
   Eigen::VectorXd x_next;  // nx: F(x_i, u_i)
@@ -106,8 +120,8 @@ class RtiSolver {
   OcpStageData& data() { return data_; }
   const OcpStageData& data() const { return data_; }
   // The linearization point: initialize it (e.g. hover) before the first prepare().
-  OcpTrajectory& trajectory() { return traj_; }
-  const OcpTrajectory& trajectory() const { return traj_; }
+  OcpTrajectory& trajectory() { return state_.trajectory; }
+  const OcpTrajectory& trajectory() const { return state_.trajectory; }
 
   RtiStatus prepare();
   RtiStatus feedback(const Eigen::Ref<const Eigen::VectorXd>& x0);
@@ -117,16 +131,23 @@ class RtiSolver {
   // default, for runs not paced by a clock) is discarded after its QP, as when the QP fails.
   void set_deadline_us(double deadline_us) { deadline_us_ = deadline_us; }
   // The next feedback() is an overrun whatever its time: a replay reproduces a recorded one.
-  void force_overrun_next() { force_overrun_ = true; }
+  void force_overrun_next() { state_.force_overrun = true; }
 
   // Iterates prepare/feedback from the current trajectory until ‖(Δx, Δu)‖∞ ≤ tol.
   SqpResult sqp(const Eigen::Ref<const Eigen::VectorXd>& x0, int max_iterations, double tol);
 
-  const Eigen::VectorXd& control() const { return traj_.u[0]; }  // u_0 to apply (nu)
-  const RtiStats& stats() const { return stats_; }
+  const Eigen::VectorXd& control() const { return state_.trajectory.u[0]; }  // u_0 (nu)
+  const RtiStats& stats() const { return state_.stats; }
   const OcpQp& qp() const { return qp_; }
-  const OcpQpSolution& qp_solution() const { return qp_sol_; }
+  const OcpQpSolution& qp_solution() const { return state_.qp_solution; }
   const Ocp* ocp() const { return ocp_; }
+
+  // The solver's state (RtiState), and back: restore() continues from a state that fits(),
+  // one of a solver set up for the same OCP (false, changing nothing, for any other).
+  // Allocates nothing.
+  const RtiState& state() const { return state_; }
+  bool fits(const RtiState& state) const;
+  bool restore(const RtiState& state);
 
  private:
   void linearize_cost(int i);
@@ -135,9 +156,8 @@ class RtiSolver {
   const Ocp* ocp_ = nullptr;
   Settings settings_{};
   OcpStageData data_;
-  OcpTrajectory traj_;
+  RtiState state_;
   OcpQp qp_;
-  OcpQpSolution qp_sol_;
   QpSolver& qp_solver() {
     switch (settings_.qp_solver) {
       case QpSolverKind::riccati_ipm: return qp_riccati_;
@@ -153,11 +173,7 @@ class RtiSolver {
   const SelectionOutput* selection_terminal_ = nullptr;  // likewise for the terminal output
   Eigen::VectorXi z_index_;           // ny: index in z = (x, u) of each selected output
   Eigen::VectorXi terminal_z_index_;  // ny_N
-  RtiStats stats_{};
-  bool prepared_ = false;
-  bool have_qp_solution_ = false;
   double deadline_us_ = 0.0;
-  bool force_overrun_ = false;
 };
 
 }  // namespace mixpilot

@@ -93,6 +93,10 @@ class ReplayPilot final : public PilotSource {
   std::string name() const override { return name_; }
   // The recorded command of this step; false past the end of the recording.
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
+  // Keeps nothing (save() leaves the state null): its position in the recording is the step.
+  // Restored with a snapshot of any flight of the recorded scenario, it flies the recorded
+  // commands from the snapshot's step on.
+  [[nodiscard]] bool restore(const PilotState*) override { return true; }
 
  private:
   std::vector<PilotCommandMsg> commands_;
