@@ -53,30 +53,6 @@ extern "C" void* realloc(void* p, std::size_t n) {
 
 namespace mixpilot {
 
-// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
-struct NoMalloc {
-  NoMalloc() {
-#if MIXPILOT_COUNT_MALLOC
-    g_allocations = 0;
-    g_counting = true;
-#endif
-    Eigen::internal::set_is_malloc_allowed(false);
-  }
-  ~NoMalloc() {
-    Eigen::internal::set_is_malloc_allowed(true);
-#if MIXPILOT_COUNT_MALLOC
-    g_counting = false;
-#endif
-  }
-  static long count() {
-#if MIXPILOT_COUNT_MALLOC
-    return g_allocations.load();
-#else
-    return 0;
-#endif
-  }
-};
-
 // Counts the allocations in its scope and the bytes they asked for, forbidding none (what a
 // first save into a snapshot allocates, say). 0 under AddressSanitizer.
 struct AllocationCount {
@@ -107,6 +83,12 @@ struct AllocationCount {
     return 0;
 #endif
   }
+};
+
+// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
+struct NoMalloc : AllocationCount {
+  NoMalloc() { Eigen::internal::set_is_malloc_allowed(false); }
+  ~NoMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
 };
 
 struct GuardedSteps {

@@ -11,6 +11,12 @@ Eigen::Matrix3Xd sample_path(double duration, const std::function<Eigen::Vector3
   return out;
 }
 
+Eigen::Matrix3Xd positions_of(const OcpTrajectory& reference) {
+  Eigen::Matrix3Xd out(3, Eigen::Index(reference.x.size()));
+  for (std::size_t i = 0; i < reference.x.size(); ++i) out.col(Eigen::Index(i)) = reference.x[i].head<3>();
+  return out;
+}
+
 void fit_arena(ModeView& view, const Eigen::Matrix3Xd& points, double margin) {
   if (points.cols() == 0) return;
   view.arena_min = points.rowwise().minCoeff().array() - margin;

@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 
+#include "core/nlp/ocp.hpp"
+
 namespace mixpilot {
 
 // How the flight is looked at: a quadrotor in a 3D arena, or the Pendubot's arm side-on.
@@ -69,6 +71,9 @@ struct ModeIdentity {
 
 // Samples of a path given as p(t) over [0, duration], every 50 ms (2 to 4000 samples).
 Eigen::Matrix3Xd sample_path(double duration, const std::function<Eigen::Vector3d(double)>& p);
+
+// The positions (the first three states) of a reference trajectory's nodes, 3 x M.
+Eigen::Matrix3Xd positions_of(const OcpTrajectory& reference);
 
 // The arena of a view that has no walls: the box around `points` grown by `margin`, its floor
 // at z = 0 or below.

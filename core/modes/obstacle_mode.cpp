@@ -333,9 +333,7 @@ ModeView ObstacleMode::view() const {
     };
     v.moving_radius = r;
   }
-  const OcpTrajectory& ref = scenario_.reference.trajectory;
-  v.reference.resize(3, Eigen::Index(ref.x.size()));
-  for (std::size_t i = 0; i < ref.x.size(); ++i) v.reference.col(Eigen::Index(i)) = ref.x[i].head<3>();
+  v.reference = positions_of(scenario_.reference.trajectory);
   fit_arena(v, v.reference, 1.0);
   return v;
 }

@@ -474,9 +474,7 @@ Metrics TrackingMode::metrics() const {
 
 ModeView TrackingMode::view() const {
   ModeView v;
-  const OcpTrajectory& ref = scenario_.reference_trajectory;
-  v.reference.resize(3, Eigen::Index(ref.x.size()));
-  for (std::size_t i = 0; i < ref.x.size(); ++i) v.reference.col(Eigen::Index(i)) = ref.x[i].head<3>();
+  v.reference = positions_of(scenario_.reference_trajectory);
   fit_arena(v, v.reference, 0.75);
   return v;
 }
