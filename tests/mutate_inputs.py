@@ -426,6 +426,11 @@ def main():
     base = work / "base"
     base.mkdir()
     base.chmod(0o755)
+    # The scenarios are read from a copy in the work folder: the unreadable kind runs as user
+    # nobody, who may not reach the source tree (a clone in a mode-700 temporary folder).
+    shutil.copytree(scen_dir, work / "scenarios")
+    scen_dir = work / "scenarios"
+    subprocess.run(["chmod", "-R", "a+rX", str(scen_dir)])
     p = subprocess.run([str(binary), "fly", "--scenario", str(scen_dir / "mi_helix.toml"),
                         "--pilot", "novice", "--headless", "--duration", "0.3", "--record",
                         str(base / "rec.mcap")], capture_output=True, text=True, timeout=120)
