@@ -11,14 +11,21 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 
 namespace mixpilot::cli {
 
 void usage_error(const char* command, const std::string& message) {
-  std::fprintf(stderr, "mixpilot %s: %s (see 'mixpilot %s --help')\n", command, message.c_str(),
-               command);
-  std::exit(kExitUsage);
+  throw UsageError{command, message};
+}
+
+std::string usage_message(const char* command, const std::string& message) {
+  return message + " (see 'mixpilot " + command + " --help')";
+}
+
+void print_usage_error(const UsageError& e) {
+  std::fprintf(stderr, "mixpilot %s: %s\n", e.command.c_str(),
+               usage_message(e.command.c_str(), e.message).c_str());
 }
 
 std::string option_value(const char* command, int argc, char** argv, int& i) {

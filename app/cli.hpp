@@ -18,10 +18,19 @@ enum ExitCode : int {
   kExitInterrupted = 130,   // SIGINT or SIGTERM ended the flight (what shells report for ^C)
 };
 
-// Prints "mixpilot COMMAND: MESSAGE (see 'mixpilot COMMAND --help')" and exits with kExitUsage.
-// Every command checks its whole command line before it opens any output, so nothing is left
-// behind by this exit.
+// A bad command line: main() prints "mixpilot COMMAND: MESSAGE (see 'mixpilot COMMAND --help')"
+// and exits with kExitUsage. Nothing below main exits: the error unwinds through the command,
+// whose outputs close on the way (every command checks its whole command line before it opens
+// any output, so none is left behind).
+struct UsageError {
+  std::string command;
+  std::string message;
+};
 [[noreturn]] void usage_error(const char* command, const std::string& message);
+// What main() prints for it.
+void print_usage_error(const UsageError& e);
+// "MESSAGE (see 'mixpilot COMMAND --help')": a usage error returned rather than thrown.
+std::string usage_message(const char* command, const std::string& message);
 
 // The value of the option argv[i] (i moves past it). A missing value, or an empty one, is a
 // usage error naming the option: an empty file name would otherwise read as "none", the
@@ -40,7 +49,7 @@ void check_not_an_input(const char* command, const std::string& option, const st
 std::optional<double> parse_seconds(std::string_view text, double max);
 
 // Writes `text` to `path` through a unique temporary in the same directory, moved into place
-// (core/recording/output_file.hpp: never over a special file or an input, over an existing file
+// (core/base/output_file.hpp: never over a special file or an input, over an existing file
 // only with `overwrite`). A failed write leaves nothing; a complete file that cannot be moved
 // into place stays in its temporary, and the message says where.
 bool write_file(const std::string& path, const std::string& text, bool overwrite,

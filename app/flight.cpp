@@ -10,7 +10,7 @@
 #include "core/recording/replay.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/mapping.hpp"
 #include "models/crazyflie.hpp"
@@ -81,7 +81,9 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
     f.scenario_source = embedded_scenario_source(*f.recording, o.pilot);
     f.scenario_file = f.recording->metadata["scenario_path"];
   } else {
-    usage_error(o.command, "--scenario FILE is required");
+    error = usage_message(o.command, "--scenario FILE is required");
+    status = kExitUsage;
+    return std::nullopt;
   }
   return f;
 }
@@ -268,9 +270,12 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     if (f->recording && o.scenario_path.empty()) error = in_embedded_scenario(o.pilot, error);
     return std::nullopt;
   }
-  if (*kind_name != "mixed_initiative" && !o.pilot.empty() && !o.replay)
-    usage_error(o.command, "--pilot is for mixed_initiative scenarios, " + f->scenario_source +
-                           " is " + *kind_name);
+  if (*kind_name != "mixed_initiative" && !o.pilot.empty() && !o.replay) {
+    error = usage_message(o.command, "--pilot is for mixed_initiative scenarios, " +
+                                         f->scenario_source + " is " + *kind_name);
+    status = kExitUsage;
+    return std::nullopt;
+  }
   if (f->recording) {
     f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
                           o.duration, error);

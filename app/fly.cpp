@@ -22,7 +22,7 @@
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/data_files.hpp"

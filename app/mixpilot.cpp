@@ -116,7 +116,9 @@ int models_command() {
 
 }  // namespace mixpilot::cli
 
-int main(int argc, char** argv) {
+namespace {
+
+int dispatch(int argc, char** argv) {
   using namespace mixpilot::cli;
   if (argc < 2) {
     std::fputs(kUsage, stderr);
@@ -151,4 +153,15 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "mixpilot: unknown command '%s' (see 'mixpilot --help')\n", argv[1]);
   return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return dispatch(argc, argv);
+  } catch (const mixpilot::cli::UsageError& e) {
+    mixpilot::cli::print_usage_error(e);
+    return mixpilot::cli::kExitUsage;
+  }
 }

@@ -13,9 +13,9 @@
 #include "app/commands.hpp"
 #include "core/recording/replay.hpp"
 #include "core/modes/report.hpp"
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/modes/session.hpp"
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/recording/recording.hpp"
 
 namespace mixpilot::cli {

@@ -33,7 +33,7 @@
 #include "core/scenario/tracking_scenario.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/vehicle_endpoint.hpp"
-#include "input/realtime_priority.hpp"
+#include "core/base/realtime_priority.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 
@@ -101,7 +101,7 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
   net::use_loopback_unless_configured();
   // A vehicle's firmware is real time: this loop and the DDS threads it starts run under
   // SCHED_FIFO where the system allows (the scope lasts the flight).
-  const input::RealtimeThreadsScope realtime;
+  const RealtimeThreadsScope realtime;
   net::VehicleEndpoint link;
   if (!link.open(o.domain, net::CommandCheck::Limits{Model::nu, spec.dt, spec.u_min, spec.u_max,
                                                      VehicleFeed::kMaxRtt},

@@ -1,8 +1,6 @@
 #include "input/gamepad.hpp"
 
 #include <SDL2/SDL.h>
-#include <pthread.h>
-#include <sched.h>
 #include <time.h>
 
 #include <algorithm>
@@ -10,7 +8,8 @@
 #include <filesystem>
 #include <string_view>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
+#include "core/base/realtime_priority.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot::input {
@@ -230,10 +229,8 @@ void Gamepad::update_watch() {
 }
 
 void Gamepad::run() {
-  // Just below the control thread (which asks for priority 10) when the system allows it.
-  sched_param p{};
-  p.sched_priority = 9;
-  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+  // Just below the control thread when the system allows it.
+  (void)ask_realtime_priority(kInputPriority);
 
   const std::int64_t interval_ns = std::max<std::int64_t>(10'000, std::int64_t(options_.poll_interval_s * 1e9));
   const std::int64_t lead_ns = std::int64_t(options_.read_lead_s * 1e9);

@@ -16,7 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "input/latest.hpp"
+#include "core/base/latest.hpp"
 #include "input/mapping_wizard.hpp"
 #include "input/source.hpp"
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/mapping.hpp"
 #include "input/settings.hpp"

@@ -7,9 +7,9 @@
 #include <cstring>
 #include <filesystem>
 
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/scenario/data_files.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/base/toml_read.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot::input {

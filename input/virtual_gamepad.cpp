@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/source.hpp"
 

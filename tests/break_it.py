@@ -96,7 +96,7 @@ MUTATIONS = [
     ("a restore leaves the replay cursors out", "core/modes/mode.cpp",
      "  next_forced_ = s.next_forced_;\n", "",
      "test_snapshot", "Shipped/Restore.IntoTheModeThatFlewOn*"),
-    ("no TOML nesting bound", "core/scenario/toml_read.hpp",
+    ("no TOML nesting bound", "core/base/toml_read.hpp",
      "  if (const std::optional<Pos> at = too_deep(text)) {",
      "  if (const std::optional<Pos> at = std::optional<Pos>{}) {",
      "test_scenario", "Scenario.Nesting*"),

@@ -1,6 +1,6 @@
 #pragma once
 // Files of the tests: fresh paths in a folder of the test process, the unique temporaries an output
-// leaves beside its target ("<target>.XXXXXX.tmp", core/recording/output_file.hpp), contents.
+// leaves beside its target ("<target>.XXXXXX.tmp", core/base/output_file.hpp), contents.
 #include <cstdint>
 #include <filesystem>
 #include <fstream>

@@ -25,7 +25,7 @@
 #include "input/gamepad.hpp"
 #include "input/mapping_wizard.hpp"
 #include "input/keyboard.hpp"
-#include "input/latest.hpp"
+#include "core/base/latest.hpp"
 #include "input/mapping.hpp"
 #include "input/settings.hpp"
 #include "input/virtual_gamepad.hpp"

@@ -405,7 +405,7 @@ TEST(Mcap, WriterRejectsMisuse) {
   EXPECT_FALSE(w3.is_open());
 }
 
-// The writer goes through OutputFile (core/recording/output_file.hpp): it never replaces a
+// The writer goes through OutputFile (core/base/output_file.hpp): it never replaces a
 // device or an existing file it was not allowed to, and of two writers of one path the second
 // to finish fails and keeps its data.
 TEST(Mcap, WriterNeverClobbers) {

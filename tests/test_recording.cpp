@@ -3,7 +3,7 @@
 // keeps its temporary, corrupt or truncated recordings give errors naming a byte offset, a
 // recording cut at any byte is recovered as a prefix of the original
 // (core/recording/recover.hpp), and output files never clobber anything
-// (core/recording/output_file.hpp).
+// (core/base/output_file.hpp).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -21,9 +21,9 @@
 
 #include "core/modes/make_mode.hpp"
 #include "core/modes/session.hpp"
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/numerics/version.hpp"
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/recording/recording.hpp"
 #include "core/recording/recover.hpp"
 #include "core/recording/session_recording.hpp"

@@ -7,7 +7,7 @@
 
 #include "core/modes/make_mode.hpp"
 #include "core/runtime/realtime_runner.hpp"
-#include "core/runtime/spsc_ring.hpp"
+#include "core/base/spsc_ring.hpp"
 
 namespace mixpilot {
 namespace {

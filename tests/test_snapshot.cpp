@@ -377,7 +377,9 @@ TEST(Snapshot, SavingIntoASizedSnapshotRestoringAndSteppingAllocateNothing) {
       first_bytes = AllocationCount::bytes();
     }
     // The first save sizes the snapshot (under AddressSanitizer nothing is counted).
-    if (MIXPILOT_COUNT_MALLOC) EXPECT_GT(first_allocations, 0) << c.name;
+    if (MIXPILOT_COUNT_MALLOC) {
+      EXPECT_GT(first_allocations, 0) << c.name;
+    }
     for (int k = 0; k < 5; ++k) ASSERT_TRUE(mode->step());
     long allocations = 0;
     double save_us = 0.0, restore_us = 0.0;

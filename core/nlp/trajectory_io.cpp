@@ -8,7 +8,7 @@
 #include <sstream>
 #include <vector>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 
 namespace mixpilot {
 namespace {

@@ -14,7 +14,7 @@
 #include <set>
 #include <utility>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/numerics/version.hpp"
 
 namespace mixpilot {

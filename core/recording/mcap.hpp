@@ -18,7 +18,7 @@
 // scan (the TypeScript McapStreamReader, `mcap cat`), which is fine for training sessions.
 //
 // Crash safety: the writer streams to a temporary beside <path>, "<path>.XXXXXX.tmp"
-// (core/recording/output_file.hpp), and moves it to <path> only in close(), so <path> is either
+// (core/base/output_file.hpp), and moves it to <path> only in close(), so <path> is either
 // absent (or its old contents, when overwriting) or a complete file. A session that fails keeps
 // its temporary, which read_mcap with allow_truncated reads up to the last complete record.
 #include <cstdint>
@@ -30,7 +30,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 
 namespace mixpilot {
 

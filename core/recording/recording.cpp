@@ -7,7 +7,7 @@
 #include <limits>
 #include <utility>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/numerics/version.hpp"
 
 namespace mixpilot {

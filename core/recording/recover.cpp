@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <map>
 
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/recording/recording.hpp"
 
 namespace mixpilot {

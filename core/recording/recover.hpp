@@ -1,6 +1,6 @@
 #pragma once
 // Recovering a recording cut short by a crash, `kill -9` or a full disk: the temporary
-// "<name>.mcap.XXXXXX.tmp" that the writer leaves (core/recording/output_file.hpp) holds every
+// "<name>.mcap.XXXXXX.tmp" that the writer leaves (core/base/output_file.hpp) holds every
 // record written up to the cut. recover_recording() reads it with
 // McapReadOptions::allow_truncated and writes a complete, valid recording of its whole control
 // steps, closed by a "mixpilot_end" record marked recovered (docs/recording-format.md).

@@ -6,7 +6,7 @@
 
 #include "core/modes/make_mode.hpp"
 #include "core/modes/report.hpp"
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
 

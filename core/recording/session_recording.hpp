@@ -38,7 +38,7 @@ class RecordingSink final : public TelemetrySink {
 
   // Opens `path` for a session of `mode`, whose current telemetry gives the slot sizes, and
   // starts the writer thread. The file is written as a temporary beside `path` until close()
-  // (core/recording/output_file.hpp); an existing file at `path` is replaced only with
+  // (core/base/output_file.hpp); an existing file at `path` is replaced only with
   // `overwrite`, and never one that is not a regular file.
   bool open(const std::string& path, const Mode& mode, const SessionInfo& info,
             std::string& error, const Settings& settings, bool overwrite = false);

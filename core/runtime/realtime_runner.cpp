@@ -1,9 +1,9 @@
 #include "core/runtime/realtime_runner.hpp"
 
+#include "core/base/realtime_priority.hpp"
+
 #include <algorithm>
 
-#include <pthread.h>
-#include <sched.h>
 
 namespace mixpilot {
 
@@ -51,21 +51,9 @@ RealtimeStats RealtimeRunner::stats() const {
   return st;
 }
 
-namespace {
-
-// SCHED_FIFO at a modest priority (above every normal thread, below the kernel's own); false
-// where the system refuses it.
-bool ask_realtime_priority() {
-  sched_param p{};
-  p.sched_priority = std::min(10, sched_get_priority_max(SCHED_FIFO));
-  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
-}
-
-}  // namespace
-
 void RealtimeRunner::loop() {
   using clock = std::chrono::steady_clock;
-  fifo_.store(ask_realtime_priority());
+  fifo_.store(ask_realtime_priority(kControlPriority));
   const double dt = session_->mode().dt();
   auto next = clock::now();
   double overshoot_us = 0.0;

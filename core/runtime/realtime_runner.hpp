@@ -23,7 +23,7 @@
 #include <thread>
 
 #include "core/modes/session.hpp"
-#include "core/runtime/spsc_ring.hpp"
+#include "core/base/spsc_ring.hpp"
 
 namespace mixpilot {
 

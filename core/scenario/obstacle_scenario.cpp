@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "core/scenario/scenario_toml.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/base/toml_read.hpp"
 
 namespace mixpilot {
 

@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "core/scenario/scenario_toml.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/base/toml_read.hpp"
 
 namespace mixpilot {
 

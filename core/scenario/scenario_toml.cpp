@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/numerics/input_file.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/base/input_file.hpp"
+#include "core/base/toml_read.hpp"
 
 namespace mixpilot {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "core/nlp/trajectory_io.hpp"
 #include "core/scenario/scenario_toml.hpp"
-#include "core/scenario/toml_read.hpp"
+#include "core/base/toml_read.hpp"
 
 namespace mixpilot {
 

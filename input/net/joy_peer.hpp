@@ -20,7 +20,7 @@
 #include <thread>
 #include <vector>
 
-#include "input/latest.hpp"
+#include "core/base/latest.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/peer_checks.hpp"
 #include "input/source.hpp"
@@ -76,7 +76,7 @@ class JoyPeer final : public input::StickSource {
   std::int32_t reader_ = 0, waitset_ = 0;
   std::thread thread_;
   std::atomic<bool> running_{false}, heard_{false};
-  input::Latest<input::StickReading> for_control_;
+  Latest<input::StickReading> for_control_;
 
   // Reader thread.
   input::StickReading reading_;

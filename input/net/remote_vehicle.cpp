@@ -8,7 +8,7 @@
 
 #include "core/modes/vehicle_feed.hpp"
 #include "input/net/vehicle_topics.hpp"
-#include "input/realtime_priority.hpp"
+#include "core/base/realtime_priority.hpp"
 
 namespace mixpilot::net {
 
@@ -26,7 +26,7 @@ bool RemoteVehicle::start(const Options& options, std::string& error) {
   }
   // A state that waits for a thread is predicted over the wrong horizon: the link's threads
   // (Cyclone's and the reader) run at the control thread's priority where allowed.
-  const input::RealtimeThreadsScope realtime;
+  const RealtimeThreadsScope realtime;
   if (!participant_.open(options.domain, error)) return false;
   VehicleTopics t;
   if (!open_vehicle_topics(participant_.handle(), false, kTake, t, error)) return false;

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "core/modes/vehicle_link.hpp"
-#include "input/latest.hpp"
+#include "core/base/latest.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/peer_checks.hpp"
 
@@ -88,7 +88,7 @@ class RemoteVehicle final : public VehicleLink {
   std::int32_t reader_ = 0, writer_ = 0, waitset_ = 0;
   std::thread thread_;
   std::atomic<bool> running_{false}, heard_{false}, finished_{false};
-  input::Latest<VehicleSample> for_control_;
+  Latest<VehicleSample> for_control_;
   SentCommands sent_;  // for the echo check
 
   // Reader thread.

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/modes/session.hpp"
-#include "core/runtime/spsc_ring.hpp"
+#include "core/base/spsc_ring.hpp"
 #include "input/net/dds.hpp"
 
 namespace mixpilot::net {

@@ -1,19 +1,23 @@
-#include "input/realtime_priority.hpp"
+#include "core/base/realtime_priority.hpp"
 
 #include <pthread.h>
 #include <sched.h>
 
 #include <algorithm>
 
-namespace mixpilot::input {
+namespace mixpilot {
+
+bool ask_realtime_priority(int priority) {
+  sched_param p{};
+  p.sched_priority = std::min(priority, sched_get_priority_max(SCHED_FIFO));
+  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+}
 
 RealtimeThreadsScope::RealtimeThreadsScope() {
   sched_param old{};
   if (pthread_getschedparam(pthread_self(), &policy_, &old) != 0) return;
   priority_ = old.sched_priority;
-  sched_param p{};
-  p.sched_priority = std::min(10, sched_get_priority_max(SCHED_FIFO));
-  granted_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+  granted_ = ask_realtime_priority(kControlPriority);
 }
 
 RealtimeThreadsScope::~RealtimeThreadsScope() {
@@ -23,4 +27,4 @@ RealtimeThreadsScope::~RealtimeThreadsScope() {
   pthread_setschedparam(pthread_self(), policy_, &old);
 }
 
-}  // namespace mixpilot::input
+}  // namespace mixpilot

@@ -9,7 +9,7 @@
 // it), so two runs writing one path cannot corrupt each other: the second fails and keeps its
 // temporary. Targets that are not regular files (devices, FIFOs, directories, symbolic links
 // to one of these) are always refused, and so is a file this process has read as an input
-// (core/numerics/input_file.hpp), by whatever name. A name too long for the suffix (at the file
+// (core/base/input_file.hpp), by whatever name. A name too long for the suffix (at the file
 // system's NAME_MAX) gives a temporary named after its first part.
 //
 // A failure never claims more than is true: a temporary is said to be kept only when it is

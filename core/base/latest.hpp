@@ -6,7 +6,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace mixpilot::input {
+namespace mixpilot {
 
 template <class T>
 class Latest {
@@ -34,4 +34,4 @@ class Latest {
   std::uint8_t front_ = 2;  // the reader's
 };
 
-}  // namespace mixpilot::input
+}  // namespace mixpilot

@@ -1,4 +1,4 @@
-#include "core/recording/output_file.hpp"
+#include "core/base/output_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,7 +11,7 @@
 #include <random>
 #include <system_error>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 
 namespace mixpilot {
 

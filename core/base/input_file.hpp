@@ -58,7 +58,7 @@ struct ReadFile {
 };
 
 // The files this process has read as inputs (read_input_file(), recordings): an output never
-// replaces one of them (core/recording/output_file.hpp), whatever name it is given by.
+// replaces one of them (core/base/output_file.hpp), whatever name it is given by.
 inline std::vector<ReadFile>& files_read(std::unique_lock<std::mutex>& lock) {
   static std::mutex mutex;
   static std::vector<ReadFile> files;

@@ -8,7 +8,7 @@
 // catch toml::parse_error themselves.
 #include <toml++/toml.h>
 
-#include "core/numerics/input_file.hpp"
+#include "core/base/input_file.hpp"
 
 #include <Eigen/Core>
 #include <algorithm>
