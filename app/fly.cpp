@@ -11,19 +11,16 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
+#include "app/flight_rig.hpp"
 #include "core/recording/replay.hpp"
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
 #include "app/trainer.hpp"
 #include "app/window.hpp"
 #include "core/runtime/realtime_runner.hpp"
-#include "input/net/telemetry_publisher.hpp"
-#include "core/modes/make_mode.hpp"
-#include "core/modes/mi_mode.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
 #include "core/base/output_file.hpp"
-#include "core/recording/recording.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/data_files.hpp"
 #include "core/scenario/scenario_toml.hpp"
@@ -177,8 +174,8 @@ int run_fly(const FlyOptions& o) {
   int status = kExitOk;
   if (!o.headless) return run_in_window(o);
   if (o.replay) return run_replay_headless(o);
-  std::optional<Flight> flight = prepare_flight(o, error, status);
-  if (!flight) {
+  const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
+  if (!rig) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return status;
   }
@@ -188,66 +185,47 @@ int run_fly(const FlyOptions& o) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return kExitError;
   }
-  Mode& mode = *flight->mode;
-  Session session(mode);
+  Mode& mode = rig->mode();
+  const double end = double(mode.steps_total()) * mode.dt();
   for (const ScreenshotRequest& r : o.screenshots)
-    if (r.t >= double(mode.steps_total()) * mode.dt())
+    if (r.t >= end)
       usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
-                                 " s is beyond the flight's end (" +
-                                 seconds_text(double(mode.steps_total()) * mode.dt()) + " s)");
+                                 " s is beyond the flight's end (" + seconds_text(end) + " s)");
+  const std::string& pilot = rig->flight().pilot;
   const std::string source =
-      flight->pilot.empty() ? std::string("the thesis's controller") : "pilot " + flight->pilot;
+      pilot.empty() ? std::string("the thesis's controller") : "pilot " + pilot;
   std::optional<ScreenshotSink> screenshots;
-  if (!o.screenshots.empty() && o.headless) {
+  if (!o.screenshots.empty()) {
     screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
     if (!screenshots->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
     }
   }
-  std::optional<net::TelemetryPublisher> publisher;
-  if (o.publish) {
-    net::use_loopback_unless_configured();
-    publisher.emplace();
-    if (!publisher->start(o.domain, mode.telemetry(), error)) {
-      std::fprintf(stderr, "mixpilot %s: --publish: %s\n", o.command, error.c_str());
-      return kExitError;
-    }
+  if (o.publish && !rig->publish(error)) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
   }
-  RecordingSink recorder;
   if (!o.record.empty()) {
     // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
     RecordingSink::Settings rs;
-    if (!o.headless || o.realtime) rs.when_full = RecordingSink::FullRing::drop;
-    if (!recorder.open(o.record, mode, session_info(*flight), error, rs, o.force)) {
+    if (o.realtime) rs.when_full = RecordingSink::FullRing::drop;
+    if (!rig->record(o.record, "", rs, o.force, error)) {
       std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       return kExitError;
     }
-    session.add_sink(&recorder);
   }
   // Rendered on this thread (its GL context's): a real-time flight hands the telemetry over
   // through the runner's ring, so the control thread never renders.
-  if (screenshots && !o.realtime) session.add_sink(&*screenshots);
-  std::optional<ReplayCheck> check;
-  if (flight->recording) {
-    check.emplace(*flight->recording);
-    session.add_sink(&*check);
-  }
-  if (publisher) session.add_sink(&*publisher);
-
-  std::optional<HapticSink> haptic;
-  if (flight->devices) {
-    haptic.emplace(*flight->devices);
-    session.add_sink(&*haptic);
-  }
+  if (screenshots && !o.realtime) rig->watch(*screenshots);
 
   catch_interrupts();
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<RealtimeStats> realtime;
   if (o.realtime) {
-    RealtimeRunner runner(session, 1024);
-    if (flight->devices) flight->devices->started();
-    runner.start();
+    rig->pace(1024);
+    RealtimeRunner& runner = *rig->runner();
+    rig->start();
     Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
     Telemetry drained = mode.telemetry();
     const auto drain = [&] {
@@ -259,18 +237,20 @@ int run_fly(const FlyOptions& o) {
       drain();
       progress.update(mode.steps_done());
     }
-    runner.stop();
+    rig->stop();
     drain();
     realtime = runner.stats();
   } else {
+    rig->start();
     Progress progress("fly " + mode.scenario_name(), mode.steps_total());
-    while (!interrupted() && session.step()) progress.update(mode.steps_done());
+    while (!interrupted() && rig->step()) progress.update(mode.steps_done());
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const bool stopped = interrupted() && !mode.finished();
 
-  if (!o.record.empty() && !recorder.close(error, stopped)) {
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+  const FlightRig::Closed closed = rig->close(stopped);
+  if (!closed.error.empty()) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, closed.error.c_str());
     status = kExitError;
   }
   std::printf("mixpilot %s: %s", o.command, mode.summary().c_str());
@@ -278,22 +258,16 @@ int run_fly(const FlyOptions& o) {
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
   if (realtime) print_realtime(*realtime, mode.dt());
-  if (flight->devices && flight->devices->peer) print_peer(*flight->devices->peer);
-  if (flight->vehicle) {
-    flight->vehicle->finish();
-    print_vehicle(*flight->vehicle);
-  }
-  if (publisher) {
-    publisher->stop();
+  const Flight& flight = rig->flight();
+  if (flight.devices && flight.devices->peer) print_peer(*flight.devices->peer);
+  if (flight.vehicle) print_vehicle(*flight.vehicle);
+  if (closed.published)
     std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
-                (unsigned long long)publisher->published(), unsigned(o.domain),
-                (unsigned long long)publisher->dropped());
-  }
+                (unsigned long long)closed.published_steps, unsigned(o.domain),
+                (unsigned long long)closed.publish_dropped);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
-    const Metrics metrics = flight->recording ? replay_metrics(mode, *flight->recording)
-                                              : with_lost_fields(mode.metrics(), mode);
-    const std::string json = to_json(report_labels(*flight, stopped), metrics) + "\n";
+    const std::string json = to_json(rig->labels(stopped), rig->metrics()) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
       std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
@@ -306,14 +280,14 @@ int run_fly(const FlyOptions& o) {
     }
     for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
   }
-  if (!o.record.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
+  if (!closed.recorded.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
   if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
   if (stopped) {
     std::printf("  interrupted at t = %.3f s\n", flown);
     return kExitInterrupted;
   }
-  if (check && status == kExitOk) {
-    const std::string diff = check->first_difference(mode.steps_done());
+  if (flight.recording && status == kExitOk) {
+    const std::string diff = rig->replay_difference();
     if (!diff.empty()) {
       std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n", o.command,
                    o.pilot.c_str(), diff.c_str());

@@ -1,0 +1,141 @@
+#include "app/flight_rig.hpp"
+
+#include <cstdio>
+
+#include "input/net/dds.hpp"
+
+namespace mixpilot::cli {
+
+FlightRig::FlightRig(FlyOptions o, Flight f) : options_(std::move(o)), flight_(std::move(f)) {
+  session_ = std::make_unique<Session>(*flight_.mode);
+  if (flight_.recording) {
+    check_.emplace(*flight_.recording);
+    session_->add_sink(&*check_);
+  }
+  if (flight_.devices) {
+    haptic_.emplace(*flight_.devices);
+    session_->add_sink(&*haptic_);
+  }
+}
+
+FlightRig::~FlightRig() {
+  if (!closed_) (void)close(!flight_.mode->finished());
+}
+
+std::unique_ptr<FlightRig> FlightRig::assemble(const FlyOptions& o, std::string& error,
+                                               int& status,
+                                               std::shared_ptr<input::Gamepad> gamepad,
+                                               VehicleWait wait) {
+  std::optional<Flight> f = prepare_flight(o, error, status, std::move(gamepad), wait);
+  if (!f) return nullptr;
+  std::unique_ptr<FlightRig> rig(new FlightRig(o, std::move(*f)));
+  if (rig->flight_.vehicle) {
+    if (wait == VehicleWait::later) {
+      rig->vehicle_ = VehicleStatus::waiting;
+      rig->vehicle_deadline_ = std::chrono::steady_clock::now() +
+                               std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                   std::chrono::duration<double>(o.vehicle_wait_s));
+    } else {
+      rig->vehicle_ = VehicleStatus::ready;  // prepare_flight waited and attached it
+    }
+  }
+  return rig;
+}
+
+FlightRig::VehicleStatus FlightRig::poll_vehicle(std::string& error) {
+  if (vehicle_ != VehicleStatus::waiting) return vehicle_;
+  if (flight_.vehicle->heard()) {
+    vehicle_ = attach_vehicle(flight_, error) ? VehicleStatus::ready : VehicleStatus::failed;
+  } else if (std::chrono::steady_clock::now() >= vehicle_deadline_) {
+    error = vehicle_not_heard(options_, flight_);
+    vehicle_ = VehicleStatus::failed;
+  }
+  return vehicle_;
+}
+
+double FlightRig::vehicle_wait_left() const {
+  if (vehicle_ != VehicleStatus::waiting) return 0.0;
+  return std::max(0.0, std::chrono::duration<double>(vehicle_deadline_ -
+                                                     std::chrono::steady_clock::now())
+                           .count());
+}
+
+void FlightRig::cancel_vehicle_wait() {
+  if (vehicle_ == VehicleStatus::waiting) vehicle_deadline_ = std::chrono::steady_clock::now();
+}
+
+bool FlightRig::publish(std::string& error) {
+  net::use_loopback_unless_configured();
+  publisher_.emplace();
+  if (!publisher_->start(options_.domain, flight_.mode->telemetry(), error)) {
+    publisher_.reset();
+    error = "--publish: " + error;
+    return false;
+  }
+  session_->add_sink(&*publisher_);
+  return true;
+}
+
+bool FlightRig::record(const std::string& path, const std::string& trainee,
+                       const RecordingSink::Settings& settings, bool overwrite,
+                       std::string& error) {
+  if (!recorder_.open(path, *flight_.mode, session_info(flight_, trainee), error, settings,
+                      overwrite))
+    return false;
+  record_path_ = path;
+  session_->add_sink(&recorder_);
+  return true;
+}
+
+void FlightRig::pace(std::size_t ring_slots) {
+  runner_ = std::make_unique<RealtimeRunner>(*session_, ring_slots);
+}
+
+void FlightRig::start() {
+  if (started_) return;
+  if (flight_.devices) flight_.devices->started();
+  if (runner_) runner_->start();
+  started_ = true;
+}
+
+bool FlightRig::running() const {
+  if (runner_) return !started_ || runner_->running();
+  return !flight_.mode->finished();
+}
+
+void FlightRig::stop() {
+  if (runner_) runner_->stop();
+}
+
+FlightRig::Closed FlightRig::close(bool interrupted) {
+  Closed c;
+  if (closed_) return c;
+  closed_ = true;
+  stop();
+  if (publisher_) {
+    publisher_->stop();
+    c.published = true;
+    c.published_steps = publisher_->published();
+    c.publish_dropped = publisher_->dropped();
+  }
+  if (flight_.vehicle) flight_.vehicle->finish();
+  if (!record_path_.empty()) {
+    if (recorder_.close(c.error, interrupted)) {
+      c.recorded = record_path_;
+      c.dropped = recorder_.dropped();
+    }
+  }
+  return c;
+}
+
+Metrics FlightRig::metrics() const {
+  const Mode& mode = *flight_.mode;
+  return flight_.recording ? replay_metrics(mode, *flight_.recording)
+                           : with_lost_fields(mode.metrics(), mode);
+}
+
+std::string FlightRig::replay_difference() const {
+  return check_ ? check_->first_difference(flight_.mode->steps_done()) : std::string();
+}
+
+}  // namespace mixpilot::cli

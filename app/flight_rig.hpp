@@ -1,0 +1,138 @@
+#pragma once
+// One flight, assembled once (SPEC §8): the mode of the scenario or recording the options name,
+// its session, the person's device or network pilot, the remote vehicle's link, every sink
+// (recording, replay check, haptic cue, telemetry publisher, and what a front end adds, such as
+// screenshots or a replay's tape) and the real-time runner. Every way a flight is run builds it
+// here: the window's live flights (app/trainer.cpp), `fly --headless` (app/fly.cpp), a replay's
+// tape (app/replay_tape.cpp, the window's and `replay --headless`'s) and `score`
+// (app/score.cpp); the tests drive the same class. Errors come back as values with an exit
+// status; nothing here exits.
+//
+// The threads mixpilot starts, and who owns them (each is joined by its owner's stop or
+// destructor; the UI thread, main's, never waits on any of them for longer than a join):
+//   control       RealtimeRunner (core/runtime), SCHED_FIFO 10   the rig of a paced flight
+//   recorder      RecordingSink's writer (core/recording)        the rig, while recording
+//   publisher     net::TelemetryPublisher (input/net)            the rig, with --publish
+//   vehicle link  net::RemoteVehicle's reader (input/net), and   the rig's Flight, with
+//                 Cyclone's receive threads, SCHED_FIFO 10 where  --vehicle dds
+//                 allowed (core/base/realtime_priority.hpp)
+//   joy peer      net::JoyPeer's reader (input/net)              the rig's Devices, --pilot dds
+//   script pad    input::VirtualGamepad's player                 the rig's Devices, with
+//                                                                --gamepad-script
+//   gamepad       input::Gamepad's poller, SCHED_FIFO 9          the app, one per process
+//                                                                (SDL's joystick state has one
+//                                                                owner); a rig holds a share
+//   replay tape   ReplayTape's loader (app/replay_tape.hpp)      the window's replay
+//   score jobs    score's worker pool (app/score.cpp)            `mixpilot score`
+//   vehicle       `mixpilot vehicle`'s plant loop runs on main; its DDS link's threads are
+//                 Cyclone's, under RealtimeThreadsScope
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/flight.hpp"
+#include "core/modes/report.hpp"
+#include "core/modes/session.hpp"
+#include "core/recording/replay.hpp"
+#include "core/recording/session_recording.hpp"
+#include "core/runtime/realtime_runner.hpp"
+#include "input/net/telemetry_publisher.hpp"
+
+namespace mixpilot::cli {
+
+class FlightRig {
+ public:
+  // The flight `o` names, assembled: scenario (or the recording to fly again), mode, the
+  // pilot's device, the replay check, the haptic cue, and with --vehicle dds the link, which
+  // `wait` says whether to wait for here (block: up to --vehicle-wait) or to poll_vehicle()
+  // frame by frame (later: the window, which never blocks). `gamepad`: the app's running
+  // gamepad (one per process). nullptr with the reason and the exit status.
+  [[nodiscard]] static std::unique_ptr<FlightRig> assemble(
+      const FlyOptions& o, std::string& error, int& status,
+      std::shared_ptr<input::Gamepad> gamepad = nullptr, VehicleWait wait = VehicleWait::block);
+  ~FlightRig();
+  FlightRig(const FlightRig&) = delete;
+  FlightRig& operator=(const FlightRig&) = delete;
+
+  // --vehicle dds with VehicleWait::later, polled without waiting: `none` without a remote
+  // vehicle, `waiting` until it is heard, `ready` once it flies the mode, `failed` with the
+  // reason (it answered with something this mode cannot fly).
+  enum class VehicleStatus { none, waiting, ready, failed };
+  [[nodiscard]] VehicleStatus poll_vehicle(std::string& error);
+  // Seconds left of --vehicle-wait while waiting.
+  double vehicle_wait_left() const;
+  // Stops waiting (Esc): the next poll fails with "no vehicle heard".
+  void cancel_vehicle_wait();
+
+  // Sinks, added before start(). publish(): the telemetry over DDS (--publish);
+  // record(): the flight into `path` (a paced flight drops steps rather than wait for the
+  // disk: `settings`). False with the reason.
+  [[nodiscard]] bool publish(std::string& error);
+  [[nodiscard]] bool record(const std::string& path, const std::string& trainee,
+                            const RecordingSink::Settings& settings, bool overwrite,
+                            std::string& error);
+  // Another sink (screenshots, a replay's tape), called on the thread that steps the session.
+  void watch(TelemetrySink& sink) { session_->add_sink(&sink); }
+
+  // The flight will be paced by the wall clock on the control thread, its telemetry handed
+  // over through a ring of `ring_slots` steps (readable at once: runner()->telemetry()).
+  // Without it the caller steps the flight with step(), as fast as it likes.
+  void pace(std::size_t ring_slots);
+  // The flight starts: the devices' clock (a script's t = 0) and, when paced, the runner.
+  void start();
+  bool step() { return session_->step(); }
+  RealtimeRunner* runner() { return runner_.get(); }  // nullptr unless paced
+  bool started() const { return started_; }
+  // A paced flight has not ended yet (an unpaced one: not finished).
+  bool running() const;
+  // Stops the control thread (a paced flight): what it produced is in the ring to drain.
+  void stop();
+
+  // What closing the flight did, for the front end to say.
+  struct Closed {
+    std::string recorded;        // the recording's path ("" when none was written)
+    std::int64_t dropped = 0;    // steps the recording lost (a paced flight on a slow disk)
+    std::string error;           // the recording could not be completed ("" when fine)
+    bool published = false;      // --publish: the publisher's counts
+    std::uint64_t published_steps = 0, publish_dropped = 0;
+  };
+  // Stops the runner, the publisher and the vehicle link, and completes the recording
+  // (`interrupted`: the flight stopped before its end). Once; later calls return {}.
+  Closed close(bool interrupted);
+  bool closed() const { return closed_; }
+
+  // After the flight: its metrics (a replay's timing fields are the recorded flight's), the
+  // report's labels, and what a replay did differently from its recording ("" when nothing).
+  Metrics metrics() const;
+  Labels labels(bool interrupted) const { return report_labels(flight_, interrupted); }
+  std::string replay_difference() const;
+  std::string recording_path() const { return record_path_; }
+
+  Mode& mode() { return *flight_.mode; }
+  const Mode& mode() const { return *flight_.mode; }
+  Session& session() { return *session_; }
+  const Flight& flight() const { return flight_; }
+  Flight& flight() { return flight_; }
+  const FlyOptions& options() const { return options_; }
+  net::TelemetryPublisher* publisher() { return publisher_ ? &*publisher_ : nullptr; }
+
+ private:
+  FlightRig(FlyOptions o, Flight f);
+
+  FlyOptions options_;
+  Flight flight_;
+  std::unique_ptr<Session> session_;
+  std::optional<ReplayCheck> check_;             // flying a recording's pilot commands
+  std::optional<HapticSink> haptic_;             // a gamepad pilot: λ to the rumble
+  std::optional<net::TelemetryPublisher> publisher_;
+  RecordingSink recorder_;
+  std::string record_path_;                      // "" when not recording
+  std::unique_ptr<RealtimeRunner> runner_;
+  VehicleStatus vehicle_ = VehicleStatus::none;
+  std::chrono::steady_clock::time_point vehicle_deadline_;
+  bool started_ = false, closed_ = false;
+};
+
+}  // namespace mixpilot::cli
