@@ -60,7 +60,7 @@ net::RemoteVehicle::StateBounds state_bounds(ModeKind kind) {
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
   Flight f;
-  if (o.pilot.ends_with(".mcap")) {
+  if (o.replay || o.pilot.ends_with(".mcap")) {
     f.recording = read_recording(o.pilot, error);
     if (!f.recording) return std::nullopt;
     if (!embedded_scenario(*f.recording, o.pilot, error)) return std::nullopt;

@@ -11,6 +11,7 @@
 
 #include "app/cli.hpp"
 #include "app/commands.hpp"
+#include "app/flight_rig.hpp"
 #include "core/recording/replay.hpp"
 #include "core/modes/report.hpp"
 #include "core/base/input_file.hpp"
@@ -63,25 +64,30 @@ double metric_of(const ScoreRow& row, std::string_view name) {
 ScoreRow score_recording(const std::string& path) {
   ScoreRow row;
   row.file = path;
+  FlyOptions o;
+  o.pilot = path;
+  o.replay = true;
+  o.command = "score";
   std::string error;
-  const auto rec = read_recording(path, error);
-  if (!rec) {
+  int status = kExitOk;
+  const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
+  if (!rig) {
     row.error = error;
     return row;
   }
-  auto replayed = replay_recording(*rec, path, error);
-  if (!replayed) {
-    row.error = error;
-    return row;
+  rig->start();
+  while (rig->step()) {
   }
-  const auto pilot_meta = rec->metadata.find("pilot");
+  const RecordingContents& rec = *rig->flight().recording;
+  const auto pilot_meta = rec.metadata.find("pilot");
   // Printed in the table: as the recording says it, made printable.
-  row.pilot = pilot_meta != rec->metadata.end() ? escape_controls(pilot_meta->second) : "";
-  row.mode = to_string(replayed->mode->kind());
-  row.scenario = replayed->mode->scenario_name();
-  row.metrics = std::move(replayed->metrics);
-  row.difference = std::move(replayed->difference);
-  row.ended_early = std::move(replayed->ended_early);
+  row.pilot = pilot_meta != rec.metadata.end() ? escape_controls(pilot_meta->second) : "";
+  const Mode& mode = rig->mode();
+  row.mode = to_string(mode.kind());
+  row.scenario = mode.scenario_name();
+  row.metrics = rig->metrics();
+  row.difference = rig->replay_difference();
+  row.ended_early = recording_ended_early(rec, mode);
   row.ok = true;
   return row;
 }

@@ -145,28 +145,13 @@ std::string ReplayCheck::first_difference(std::int64_t steps) const {
   return "";
 }
 
-std::optional<ReplayResult> replay_recording(const RecordingContents& rec, const std::string& path,
-                                             std::string& error, TelemetrySink* extra) {
-  const std::string* text = embedded_scenario(rec, path, error);
-  if (!text) return std::nullopt;
-  ReplayResult r;
-  r.mode = replay_mode(rec, path, *text, embedded_scenario_source(rec, path), {}, error);
-  if (!r.mode) return std::nullopt;
-  Session session(*r.mode);
-  ReplayCheck check(rec);
-  session.add_sink(&check);
-  if (extra) session.add_sink(extra);
-  session.run();
-  r.metrics = replay_metrics(*r.mode, rec);
-  r.difference = check.first_difference(r.mode->steps_done());
-  if (rec.end && rec.end->interrupted) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "interrupted at t = %.1f s of %.1f s",
-                  double(r.mode->steps_done()) * r.mode->dt(),
-                  double(r.mode->steps_total()) * r.mode->dt());
-    r.ended_early = buf;
-  }
-  return r;
+std::string recording_ended_early(const RecordingContents& rec, const Mode& replayed) {
+  if (!rec.end || !rec.end->interrupted) return "";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "interrupted at t = %.1f s of %.1f s",
+                double(replayed.steps_done()) * replayed.dt(),
+                double(replayed.steps_total()) * replayed.dt());
+  return buf;
 }
 
 }  // namespace mixpilot

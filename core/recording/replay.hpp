@@ -1,8 +1,8 @@
 #pragma once
 // Flying a recording again: the same mode from its embedded scenario, checked step by step
-// against what was recorded. Every front end replays through here: `mixpilot score`
-// (replay_recording), `mixpilot fly --pilot REC.mcap` and the window's replay (replay_mode,
-// ReplayCheck and replay_metrics around their own paced or taped session).
+// against what was recorded. Every front end replays through here, by way of the flight
+// assembly (app/flight_rig.hpp): `mixpilot score`, `mixpilot fly --pilot REC.mcap`, `replay`
+// and the window's replay.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -58,19 +58,8 @@ class ReplayCheck final : public TelemetrySink {
   const char* what_ = "";
 };
 
-// A whole recording flown again and checked: what `mixpilot score` reports of it.
-struct ReplayResult {
-  std::unique_ptr<Mode> mode;  // after the run: its telemetry, summary and metrics
-  Metrics metrics;             // replay_metrics()
-  std::string difference;      // what differed first; "": every step replayed bit for bit
-  // The flight stopped before its planned end: "interrupted at t = 3.0 s of 30.0 s" ("" if not).
-  std::string ended_early;
-};
-
-// Flies `rec` (read from `path`, named in messages) again from its embedded scenario, checking
-// every step, with `extra` (when given) also watching. nullopt with the reason when its
-// scenario is missing or no longer valid, or it was flown with a remote vehicle.
-std::optional<ReplayResult> replay_recording(const RecordingContents& rec, const std::string& path,
-                                             std::string& error, TelemetrySink* extra = nullptr);
+// "interrupted at t = 3.0 s of 30.0 s" when `rec` was stopped before its planned end ("" if
+// not), from its replay `replayed`.
+std::string recording_ended_early(const RecordingContents& rec, const Mode& replayed);
 
 }  // namespace mixpilot
