@@ -21,6 +21,7 @@
 #include <imgui_internal.h>
 
 #include "app/flight.hpp"
+#include "app/flight_rig.hpp"
 #include "app/offscreen.hpp"
 #include "core/recording/replay.hpp"
 #include "app/trainer.hpp"
@@ -58,15 +59,16 @@ std::string record(const char* name, double seconds, const char* pilot, const st
   cli::FlyOptions o = live_options(name, seconds, pilot);
   std::string error;
   int status = 0;
-  auto f = cli::prepare_flight(o, error, status);
-  EXPECT_TRUE(f) << error;
+  auto rig = cli::FlightRig::assemble(o, error, status);
+  EXPECT_TRUE(rig) << error;
   const std::string path = test::fresh_path("app", file).string();
-  RecordingSink rec;
-  EXPECT_TRUE(rec.open(path, *f->mode, cli::session_info(*f), error)) << error;
-  Session session(*f->mode);
-  session.add_sink(&rec);
-  session.run();
-  EXPECT_TRUE(rec.close(error)) << error;
+  EXPECT_TRUE(rig->record(path, "", {}, false, error)) << error;
+  rig->start();
+  while (rig->step()) {
+  }
+  const cli::FlightRig::Closed closed = rig->close(false);
+  EXPECT_EQ(closed.error, "");
+  EXPECT_EQ(closed.recorded, path);
   return path;
 }
 
