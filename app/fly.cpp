@@ -161,71 +161,18 @@ int run_replay_headless(const FlyOptions& o) {
   return status != kExitOk ? status : finished;
 }
 
-int run_fly(const FlyOptions& o) {
-  std::string error;
-  if (!o.headless && !window_available(error)) {  // before any output is opened
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return kExitError;
-  }
-  if (!check_outputs(o, error)) {
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return kExitError;
-  }
-  int status = kExitOk;
-  if (!o.headless) return run_in_window(o);
-  if (o.replay) return run_replay_headless(o);
-  const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
-  if (!rig) {
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return status;
-  }
-  // Every check that can fail comes before the recording opens: a run that never flies leaves
-  // no file behind.
-  if (!check_outputs(o, error)) {  // again: the flight's own inputs (reference files) are known
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return kExitError;
-  }
-  Mode& mode = rig->mode();
-  const double end = double(mode.steps_total()) * mode.dt();
-  for (const ScreenshotRequest& r : o.screenshots)
-    if (r.t >= end)
-      usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
-                                 " s is beyond the flight's end (" + seconds_text(end) + " s)");
-  const std::string& pilot = rig->flight().pilot;
-  const std::string source =
-      pilot.empty() ? std::string("the thesis's controller") : "pilot " + pilot;
-  std::optional<ScreenshotSink> screenshots;
-  if (!o.screenshots.empty()) {
-    screenshots.emplace(ui::scene_of(mode, source), o.screenshots, o.force);
-    if (!screenshots->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
-      std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
-      return kExitError;
-    }
-  }
-  if (o.publish && !rig->publish(error)) {
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return kExitError;
-  }
-  if (!o.record.empty()) {
-    // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
-    RecordingSink::Settings rs;
-    if (o.realtime) rs.when_full = RecordingSink::FullRing::drop;
-    if (!rig->record(o.record, "", rs, o.force, error)) {
-      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-      return kExitError;
-    }
-  }
-  // Rendered on this thread (its GL context's): a real-time flight hands the telemetry over
-  // through the runner's ring, so the control thread never renders.
-  if (screenshots && !o.realtime) rig->watch(*screenshots);
-
+// `fly --headless`'s flight, flown: as fast as possible on this thread, or paced on the control
+// thread with the telemetry drained here (where screenshots render: their GL context's thread).
+// The wall time [s] it took; the real-time statistics when paced.
+double fly_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screenshots,
+                    std::optional<RealtimeStats>& realtime) {
+  Mode& mode = rig.mode();
   catch_interrupts();
   const auto t0 = std::chrono::steady_clock::now();
-  std::optional<RealtimeStats> realtime;
   if (o.realtime) {
-    rig->pace(1024);
-    RealtimeRunner& runner = *rig->runner();
-    rig->start();
+    rig.pace(1024);
+    RealtimeRunner& runner = *rig.runner();
+    rig.start();
     Progress progress("fly " + mode.scenario_name() + " (real time)", mode.steps_total());
     Telemetry drained = mode.telemetry();
     const auto drain = [&] {
@@ -237,18 +184,27 @@ int run_fly(const FlyOptions& o) {
       drain();
       progress.update(mode.steps_done());
     }
-    rig->stop();
+    rig.stop();
     drain();
     realtime = runner.stats();
   } else {
-    rig->start();
+    if (screenshots) rig.watch(*screenshots);
+    rig.start();
     Progress progress("fly " + mode.scenario_name(), mode.steps_total());
-    while (!interrupted() && rig->step()) progress.update(mode.steps_done());
+    while (!interrupted() && rig.step()) progress.update(mode.steps_done());
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const bool stopped = interrupted() && !mode.finished();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
-  const FlightRig::Closed closed = rig->close(stopped);
+// The summary on stdout after the flight, the report and the screenshots written; the exit
+// status.
+int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screenshots,
+                    double wall, const std::optional<RealtimeStats>& realtime) {
+  const Mode& mode = rig.mode();
+  const bool stopped = interrupted() && !mode.finished();
+  int status = kExitOk;
+  std::string error;
+  const FlightRig::Closed closed = rig.close(stopped);
   if (!closed.error.empty()) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, closed.error.c_str());
     status = kExitError;
@@ -258,7 +214,7 @@ int run_fly(const FlyOptions& o) {
   std::printf("  %.1f s flown in %.2f s of wall time (%.0fx real time)\n", flown, wall,
               flown / std::max(wall, 1e-9));
   if (realtime) print_realtime(*realtime, mode.dt());
-  const Flight& flight = rig->flight();
+  const Flight& flight = rig.flight();
   if (flight.devices && flight.devices->peer) print_peer(*flight.devices->peer);
   if (flight.vehicle) print_vehicle(*flight.vehicle);
   if (closed.published)
@@ -267,7 +223,7 @@ int run_fly(const FlyOptions& o) {
                 (unsigned long long)closed.publish_dropped);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (!o.report.empty()) {
-    const std::string json = to_json(rig->labels(stopped), rig->metrics()) + "\n";
+    const std::string json = to_json(rig.labels(stopped), rig.metrics()) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
       std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
@@ -287,7 +243,7 @@ int run_fly(const FlyOptions& o) {
     return kExitInterrupted;
   }
   if (flight.recording && status == kExitOk) {
-    const std::string diff = rig->replay_difference();
+    const std::string diff = rig.replay_difference();
     if (!diff.empty()) {
       std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n", o.command,
                    o.pilot.c_str(), diff.c_str());
@@ -297,6 +253,66 @@ int run_fly(const FlyOptions& o) {
     }
   }
   return status;
+}
+
+int run_fly(const FlyOptions& o) {
+  std::string error;
+  if (!o.headless && !window_available(error)) {  // before any output is opened
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
+  if (!check_outputs(o, error)) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
+  if (!o.headless) return run_in_window(o);
+  if (o.replay) return run_replay_headless(o);
+  int status = kExitOk;
+  const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
+  if (!rig) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return status;
+  }
+  // Every check that can fail comes before the recording opens: a run that never flies leaves
+  // no file behind.
+  if (!check_outputs(o, error)) {  // again: the flight's own inputs (reference files) are known
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
+  const Mode& mode = rig->mode();
+  const double end = double(mode.steps_total()) * mode.dt();
+  for (const ScreenshotRequest& r : o.screenshots)
+    if (r.t >= end)
+      usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
+                                 " s is beyond the flight's end (" + seconds_text(end) + " s)");
+  const std::string& pilot = rig->flight().pilot;
+  std::optional<ScreenshotSink> screenshots;
+  if (!o.screenshots.empty()) {
+    screenshots.emplace(
+        ui::scene_of(mode, pilot.empty() ? std::string("the thesis's controller") : "pilot " + pilot),
+        o.screenshots, o.force);
+    if (!screenshots->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
+      std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+  }
+  if (o.publish && !rig->publish(error)) {
+    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+    return kExitError;
+  }
+  if (!o.record.empty()) {
+    // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
+    RecordingSink::Settings rs;
+    if (o.realtime) rs.when_full = RecordingSink::FullRing::drop;
+    if (!rig->record(o.record, "", rs, o.force, error)) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+  }
+  ScreenshotSink* shots = screenshots ? &*screenshots : nullptr;
+  std::optional<RealtimeStats> realtime;
+  const double wall = fly_headless(*rig, o, shots, realtime);
+  return finish_headless(*rig, o, shots, wall, realtime);
 }
 
 // --screenshot, --size, --scale and --exit-at-end, shared by fly and replay: true when `a` is one of them
