@@ -1,8 +1,9 @@
 #pragma once
 // What a linked vehicle (core/modes/linked_vehicle.hpp) does with the states of the vehicle
-// behind a link (core/modes/vehicle_link.hpp) each step: take the newest state, turn each new one into a round-trip
-// sample (core/control/rtt_estimator.hpp), give the horizon over which the state is to be
-// predicted (SPEC §5.2, §9), and judge whether the vehicle is still worth flying.
+// behind a link (core/modes/vehicle_link.hpp) each step: take the newest state, turn each new
+// one into a round-trip sample (core/control/rtt_estimator.hpp), give the horizon over which
+// the state is to be predicted (SPEC §5.2, §9), and judge whether the vehicle is still worth
+// flying.
 //
 // A vehicle is lost (Reading::lost, lost_reason()) when it
 //  - says its flight has ended;
