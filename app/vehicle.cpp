@@ -2,7 +2,8 @@
 // `mixpilot fly --vehicle dds` (SPEC §9): a stand-in for a real quadrotor on a radio link.
 //
 // The plant runs on the wall clock. A command received at t is applied at t + latency (the
-// command link's one-way delay); the plant is integrated exactly to that instant with the
+// command link's one-way delay); the plant (the modes' simulated one, core/modes/
+// simulated_vehicle.hpp's VehiclePlant) is integrated exactly to that instant with the
 // command before it, and its state measured there goes out at t_apply + latency (the measurement
 // link's delay), echoing the command's step and stamp with age 0. Without new commands a state
 // goes out every other control period (every period before the first command), echoing the
@@ -25,9 +26,9 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
+#include "core/modes/simulated_vehicle.hpp"
 #include "core/modes/vehicle_feed.hpp"
 #include "core/modes/vehicle_link.hpp"
-#include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/types.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/scenario/tracking_scenario.hpp"
@@ -109,8 +110,8 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
     std::fprintf(stderr, "mixpilot vehicle: %s\n", error.c_str());
     return kExitError;
   }
-  IntegratorErk4<Model> erk4(model);
-  State x = model.hover_state(spec.start), xn;
+  const VehiclePlant<Model> plant(model);
+  State x = model.hover_state(spec.start);
   Input u = model.hover_input();
   std::int64_t cmd_step = -1, cmd_stamp = 0, applied_ns = 0;
   std::uint8_t status = 0;
@@ -139,20 +140,11 @@ int fly_vehicle(const Model& model, const VehicleSpec& spec, const Options& o) {
       t_plant = std::max(t_plant, to);
       return;
     }
-    while (t_plant < to) {
-      const std::int64_t dt = std::min(h, to - t_plant);
-      erk4.template step<double>(x, u, 1e-9 * double(dt), xn);
-      t_plant += dt;
-      const char* outside = xn.allFinite() ? spec.world.outside(xn.template head<3>())
-                                            : "its state stopped being finite";
-      if (outside) {
-        status = 1;  // left its world: the last state inside stays
-        left_how = outside;
-        left_at = t_plant;
-        t_plant = to;
-        return;
-      }
-      x = xn;
+    if (const char* outside = plant.advance(x, u, t_plant, to, h, spec.world)) {
+      status = 1;  // left its world: the last state inside stays
+      left_how = outside;
+      left_at = t_plant;
+      t_plant = to;
     }
   };
   const auto measure = [&](std::int64_t at) {

@@ -1,10 +1,11 @@
 #pragma once
 // A remote vehicle inside the test process, on a simulated clock (core/modes/vehicle_link.hpp):
 // command k leaves at t_k = k·Δt and acts from t_k + τ_c; the state measured when it starts
-// acting (the plant integrated as the modes' own plants are: s RK4 substeps of h per period)
-// arrives τ_m later, echoing k and its stamp with age 0. The controller's clock is the time of
-// the step in progress. With it a mode's remote path can be compared with its simulated plant
-// step for step, and checked for allocations. setup() sizes; the rest allocates nothing.
+// acting (the modes' plant, core/modes/simulated_vehicle.hpp's VehiclePlant: s RK4 substeps of
+// h per period) arrives τ_m later, echoing k and its stamp with age 0. The controller's clock
+// is the time of the step in progress. With it a mode's remote path can be compared with its
+// simulated plant step for step, and checked for allocations. setup() sizes; the rest allocates
+// nothing.
 //
 // A hostile vehicle is the same link with `mutate` set: it may rewrite each state (what the
 // vehicle claims) before it is sent; `timeout` is the link's silence limit.
@@ -14,8 +15,8 @@
 #include <functional>
 #include <vector>
 
+#include "core/modes/simulated_vehicle.hpp"
 #include "core/modes/vehicle_link.hpp"
-#include "core/numerics/integrator_erk4.hpp"
 
 namespace mixpilot::test {
 
@@ -27,7 +28,7 @@ class DelayedPlantLink final : public VehicleLink {
 
   DelayedPlantLink(const Model& model, const State& x0, double dt, int substeps, double tau_c,
                    double tau_m, std::size_t capacity)
-      : erk4_(model), x_(x0), dt_ns_(std::llround(dt * 1e9)), s_(substeps), h_(dt / substeps),
+      : plant_(model), x_(x0), dt_ns_(std::llround(dt * 1e9)), s_(substeps), h_(dt / substeps),
         rtt_ns_(std::llround((tau_c + tau_m) * 1e9)) {
     pending_.reserve(capacity);
     current_.x.setZero(Model::nx);
@@ -41,7 +42,7 @@ class DelayedPlantLink final : public VehicleLink {
     if (k > 0) {  // the plant from command k−1's start to command k's
       State xn;
       for (int j = 0; j < s_; ++j) {
-        erk4_.template step<double>(x_, u_, h_, xn);
+        plant_.substep(x_, u_, h_, xn);
         x_ = xn;
       }
     }
@@ -71,7 +72,7 @@ class DelayedPlantLink final : public VehicleLink {
   std::int64_t paused_ns = 0;  // the controller's clock ran on this long without a step
 
  private:
-  IntegratorErk4<Model> erk4_;
+  VehiclePlant<Model> plant_;
   State x_;
   Input u_ = Input::Zero();
   std::int64_t dt_ns_;

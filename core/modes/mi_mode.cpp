@@ -42,7 +42,6 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   if (substeps_ < 1 || std::abs(substeps - substeps_) > 1e-9)
     return SetupResult::failure("plant.rate_hz × controller.dt must be a whole number of substeps");
   model_ = models::MikroKopter{};
-  plant_ = IntegratorErk4<models::MikroKopter>(model_);
   if (SetupResult r = controller_.setup(model_, scenario_.controller, scenario_.arena,
                                         scenario_.reference);
       !r)
@@ -53,18 +52,24 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   run_.command = model_.hover_input();
   run_.x = model_.hover_state(scenario_.reference.position(0.0));
   controller_.reset(run_.x);
-  const int delay_steps = int(std::lround(scenario_.plant.input_delay / dt_));
-  run_.u_delay.assign(std::size_t(delay_steps) + 1, model_.hover_input());
-  run_.rng.seed(scenario_.plant.seed);
-  run_.noise.reset();
+  // The input delay in whole control periods; hover until the first command acts.
+  using Simulated = SimulatedVehicle<models::MikroKopter>;
+  Simulated::Settings plant;
+  plant.substeps = substeps_;
+  plant.h = dt_ / substeps_;
+  plant.command_delay = std::lround(scenario_.plant.input_delay / dt_) * substeps_;
+  plant.idle = Simulated::Idle::hovers;
+  plant.position_noise = scenario_.plant.position_noise;
+  plant.seed = scenario_.plant.seed;
+  simulated_.setup(model_, plant, models::MikroKopter::State(run_.x));
   scorer_.setup(scenario_);
   run_.step = 0;
   steps_total_ = std::int64_t(std::lround(scenario_.duration / dt_));
-  const double h = dt_ / substeps_;
-  const int max_substeps = int(std::lround(VehicleFeed::kMaxRtt / h));
-  predictor_.setup(model_, substeps_, h, 0, max_substeps);
-  feed_.setup(models::MikroKopter::nx, dt_, h, max_substeps, 2 * std::size_t(steps_total_) + 2);
-  link_ = nullptr;
+  const int max_substeps = int(std::lround(VehicleFeed::kMaxRtt / (dt_ / substeps_)));
+  remote_.setup(model_, dt_, substeps_, max_substeps, 2 * std::size_t(steps_total_) + 2,
+                VehicleWorld::box(scenario_.arena.min, scenario_.arena.max,
+                                  mi_defaults::kLostMargin),
+                "it left the arena");
   run_.lost_reason = "";
   run_.finished = steps_total_ <= 0;
   run_.lost = false;
@@ -85,18 +90,6 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   s.applied = s.pilot;
   set_channels();
   return {};
-}
-
-// RK4 at the plant rate with the input held (ZOH) over the control period.
-void MiMode::plant_step(const Eigen::VectorXd& u) {
-  models::MikroKopter::State x = run_.x, xn;
-  const models::MikroKopter::Input us = u;
-  const double h = dt_ / substeps_;
-  for (int s = 0; s < substeps_; ++s) {
-    plant_.step(x, us, h, xn);
-    x = xn;
-  }
-  run_.x = x;
 }
 
 // Lost: a non-finite state, or farther than mi_defaults::kLostMargin outside the arena.
@@ -120,39 +113,33 @@ void MiMode::measure(double t) {
   s.step = run_.step;
   s.t = t;
   s.x = run_.x;
-  s.x_measured = run_.x;
-  if (scenario_.plant.position_noise > 0.0) {
-    for (int i = 0; i < 3; ++i)
-      s.x_measured(i) += scenario_.plant.position_noise * run_.noise(run_.rng);
-  }
+  models::MikroKopter::State y;
+  simulated_.measure(run_.step, y);
+  for (int i = 0; i < models::MikroKopter::nx; ++i) s.x_measured(i) = y(i);
 }
 
-// A remote vehicle's newest state, predicted over the estimated round-trip time; lost when it
-// left the world or went silent.
+// A remote vehicle's newest state (the last one known until one arrives), predicted over the
+// estimated round-trip time; lost when it left the world (the arena's margin as
+// left_the_world() measures it too) or the feed gave up on it.
 void MiMode::measure_remote(double t) {
+  using Remote = LinkedVehicle<models::MikroKopter>;
   Telemetry& s = run_.telemetry;
   s.step = run_.step;
   s.t = t;
-  now_ns_ = link_->now_ns();
-  const VehicleFeed::Reading r = feed_.read(*link_, run_.step, now_ns_, substeps_);
-  if (r.heard) {
-    const VehicleSample& v = *r.sample;
-    for (int i = 0; i < models::MikroKopter::nx; ++i) run_.x(i) = v.x(i);
-  }
-  const VehicleWorld world = VehicleWorld::box(scenario_.arena.min, scenario_.arena.max,
-                                               mi_defaults::kLostMargin);
-  const char* outside = r.heard ? world.outside(run_.x.head<3>()) : nullptr;
-  if (left_the_world() || outside || (r.heard && r.sample->left_world)) {
+  models::MikroKopter::State y = run_.x;
+  const Remote::Reading r = remote_.read(run_.step, y);
+  for (int i = 0; i < models::MikroKopter::nx; ++i) run_.x(i) = y(i);
+  if (r.status == Remote::Status::left_world || left_the_world()) {
     run_.x = s.x;  // the last state known inside it
-    run_.lost_reason = outside ? outside : "it left the arena";
-  } else if (r.lost) {
-    run_.lost_reason = feed_.lost_reason();
+    run_.lost_reason = r.status == Remote::Status::left_world ? r.reason : "it left the arena";
+  } else if (r.status == Remote::Status::lost) {
+    run_.lost_reason = r.reason;
   }
   // What is known of the vehicle now: the state predicted to t_k, which the pilot sees, the
   // controller starts from and the score takes.
-  const models::MikroKopter::State y = run_.x;
+  y = run_.x;
   models::MikroKopter::State predicted;
-  predictor_.predict(y, predicted, r.horizon_substeps);
+  remote_.predict(y, predicted, r);
   for (int i = 0; i < models::MikroKopter::nx; ++i) run_.x(i) = predicted(i);
   s.x = run_.x;
   s.x_measured = run_.x;
@@ -171,9 +158,9 @@ void MiMode::set_channels() {
   s.set_channel(kRotorSpeedMax, "rotor speed max", "kHz", s.x.tail<4>().maxCoeff());
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "kHz", model_.p.omega_max);
   s.set_channel(kRtiTime, "RTI time", "us", s.stats.total_us);
-  if (link_) {
-    s.set_channel(kRttEstimate, "RTT estimate", "s", feed_.rtt().estimate());
-    s.set_channel(kRttSample, "RTT sample", "s", feed_.rtt().last_sample());
+  if (remote_.attached()) {
+    s.set_channel(kRttEstimate, "RTT estimate", "s", remote_.rtt().estimate());
+    s.set_channel(kRttSample, "RTT sample", "s", remote_.rtt().last_sample());
   }
 }
 
@@ -182,13 +169,13 @@ bool MiMode::step() {
   const auto started = std::chrono::steady_clock::now();
   const double t = double(run_.step) * dt_;
   Telemetry& s = run_.telemetry;
-  if (link_) {
+  if (remote_.attached()) {
     measure_remote(t);
     if (*run_.lost_reason != '\0') {
       run_.lost = run_.finished = true;
       run_.lost_at = t;
       s.events = kEventLost;
-      link_->finish();
+      remote_.finish();
       ++run_.step;
       return true;
     }
@@ -228,17 +215,14 @@ bool MiMode::step() {
   const double compute_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
 
-  if (link_) {
+  if (remote_.attached()) {
     // The command leaves at once: the link is the delay line.
     s.u = run_.command;
-    const models::MikroKopter::Input u = s.u;
-    predictor_.record_sent(u);
-    feed_.send(*link_, run_.step, now_ns_, u.data(), models::MikroKopter::nu);
+    remote_.send(run_.step, models::MikroKopter::Input(s.u));
   } else {
     // The command enters the delay line; the rotors get the one sent input_delay ago.
-    const std::size_t n = run_.u_delay.size();
-    run_.u_delay[std::size_t(run_.step) % n] = run_.command;
-    s.u = run_.u_delay[std::size_t(run_.step + 1) % n];
+    simulated_.send(run_.step, models::MikroKopter::Input(run_.command));
+    s.u = simulated_.acting(long(run_.step) * substeps_);
   }
   s.events = s.stats.status == RtiStatus::fallback ? kEventFallback : 0u;
   if (s.stats.overrun) s.events |= kEventOverrun;
@@ -249,15 +233,18 @@ bool MiMode::step() {
   if (scorer_.add(s)) s.events |= kEventCollision;
   set_channels();
 
-  if (link_) {
+  if (remote_.attached()) {
     ++run_.step;
     if (run_.step >= steps_total_) {
       run_.finished = true;
-      link_->finish();
+      remote_.finish();
     }
     return true;
   }
-  plant_step(s.u);
+  // The plant over the period, the input held (RK4 at the plant rate).
+  const long end = long(run_.step + 1) * substeps_;
+  simulated_.integrate_to(end);
+  run_.x = simulated_.at(end);
   ++run_.step;
   if (left_the_world()) {
     if (!run_.x.allFinite()) run_.x = s.x;  // never hand a non-finite state to anyone
@@ -274,6 +261,7 @@ struct MiMode::Saved final : ModeSnapshot::State {
   MiController::Outputs controller;  // λ for the next step, the last plan's outputs
   ScoreAccumulator::Sums score;
   Run run;
+  SimulatedVehicle<models::MikroKopter>::Data vehicle;
   std::unique_ptr<PilotState> pilot;  // null: the source keeps nothing, or cannot go back
   bool remote = false;
 };
@@ -285,14 +273,15 @@ void MiMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
   s.controller = controller_.outputs();
   s.score = scorer_.sums();
   s.run = run_;
+  s.vehicle = simulated_.data();
   if (pilot_) pilot_->save(s.pilot);
-  s.remote = link_ != nullptr;
+  s.remote = remote_.attached();
 }
 
 RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
   const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
-  if (s.remote || link_) return RestoreStatus::remote_vehicle;
-  if (!controller_.rti().fits(s.rti) || s.run.u_delay.size() != run_.u_delay.size() ||
+  if (s.remote || remote_.attached()) return RestoreStatus::remote_vehicle;
+  if (!controller_.rti().fits(s.rti) || !simulated_.fits(s.vehicle) ||
       s.controller.predicted.cols() != controller_.outputs().predicted.cols())
     return RestoreStatus::other_scenario;
   if (!pilot_ || !pilot_->restore(s.pilot.get())) return RestoreStatus::pilot;
@@ -300,14 +289,15 @@ RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
   controller_.restore(s.controller);
   scorer_.restore(s.score);
   run_ = s.run;
+  simulated_.restore(s.vehicle);
   return RestoreStatus::ok;
 }
 
 Metrics MiMode::metrics() const {
   Metrics m = to_metrics(score());
-  if (link_) {
-    m.emplace_back("rtt_s", feed_.measured_median());
-    m.emplace_back("rtt_estimated_s", feed_.rtt().estimate());
+  if (remote_.attached()) {
+    m.emplace_back("rtt_s", remote_.feed().measured_median());
+    m.emplace_back("rtt_estimated_s", remote_.rtt().estimate());
   }
   return m;
 }
@@ -373,7 +363,7 @@ std::string MiMode::summary() const {
     out += buf;
   }
   out += safe_hold_summary(run_.safety, dt_, "a hover-hold controller");
-  if (run_.lost && link_) {
+  if (run_.lost && remote_.attached()) {
     std::snprintf(buf, sizeof buf, "  the remote vehicle was lost at t = %.3f s: %s\n",
                   run_.lost_at, run_.lost_reason);
     out += buf;
@@ -384,11 +374,12 @@ std::string MiMode::summary() const {
                   run_.lost_at, mi_defaults::kLostMargin);
     out += buf;
   }
-  if (link_ && feed_.sample_count() == 0) {
+  const VehicleFeed& feed = remote_.feed();
+  if (remote_.attached() && feed.sample_count() == 0) {
     out += "  remote vehicle: no round trip measured\n";
-  } else if (link_) {
+  } else if (remote_.attached()) {
     std::snprintf(buf, sizeof buf, "  remote vehicle: RTT %.1f ms measured, %.1f ms estimated\n",
-                  1e3 * feed_.measured_median(), 1e3 * feed_.rtt().estimate());
+                  1e3 * feed.measured_median(), 1e3 * feed.rtt().estimate());
     out += buf;
   }
   return out;

@@ -1,31 +1,30 @@
 #pragma once
 // The mixed-initiative mode (SPEC §5.4): the MikroKopter plant (RK4 at plant.rate_hz, input held
-// over the control period, optional input delay and position noise), the mixed-initiative
+// over the control period, optional input delay and position noise: core/modes/
+// simulated_vehicle.hpp, hovering until the first command acts), the mixed-initiative
 // controller at Δt, and one pilot-input source (emulated pilot, recording, device). Its metrics
 // are the score (core/modes/score.hpp), kept up to date step by step.
 //
-// With a remote vehicle (set_vehicle(), core/modes/vehicle_link.hpp) the plant runs elsewhere:
+// With a remote vehicle (set_vehicle(), core/modes/linked_vehicle.hpp) the plant runs elsewhere:
 // each step starts from the vehicle's newest state predicted over the estimated round-trip
-// time (SPEC §5.2 with the MikroKopter model, core/modes/vehicle_feed.hpp), the command goes
-// out at once (the link is the delay line). The prediction is what is known of the vehicle at
-// t_k: the pilot sees it and the score takes it.
+// time (SPEC §5.2 with the MikroKopter model), the command goes out at once (the link is the
+// delay line). The prediction is what is known of the vehicle at t_k: the pilot sees it and
+// the score takes it.
 #include <cstdint>
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "core/control/delay_predictor.hpp"
 #include "core/control/hover_lqr.hpp"
 #include "core/control/mi_controller.hpp"
 #include "core/control/pilot.hpp"
+#include "core/modes/linked_vehicle.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/safety_net.hpp"
 #include "core/modes/score.hpp"
-#include "core/modes/vehicle_feed.hpp"
-#include "core/numerics/integrator_erk4.hpp"
+#include "core/modes/simulated_vehicle.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/scenario.hpp"
 
@@ -62,10 +61,10 @@ class MiMode final : public Mode {
   Metrics replayed_metrics(const std::vector<double>& recorded_solve_us) const override;
 
   [[nodiscard]] bool set_vehicle(VehicleLink* link) override {
-    link_ = link;
+    remote_.attach(link);
     return true;
   }
-  const VehicleFeed& vehicle_feed() const { return feed_; }
+  const VehicleFeed& vehicle_feed() const { return remote_.feed(); }
 
   Score score() const { return scorer_.finish(); }
   const Scenario& scenario() const { return scenario_; }
@@ -77,7 +76,7 @@ class MiMode final : public Mode {
 
  protected:
   // Snapshots (Mode::save, Mode::restore): the MPC's RTI state and outputs, the score's sums,
-  // Run and the pilot source's state. With a remote vehicle they refuse.
+  // Run, the simulated vehicle and the pilot source's state. With a remote vehicle they refuse.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
@@ -88,12 +87,10 @@ class MiMode final : public Mode {
   void measure_remote(double t);
   void set_reference(double t);
   void set_channels();
-  void plant_step(const Eigen::VectorXd& u);
 
   Scenario scenario_;
   std::unique_ptr<PilotSource> pilot_;
   models::MikroKopter model_{};
-  IntegratorErk4<models::MikroKopter> plant_{};
   MiController controller_;
   // The safe controller: hover-hold at run_.hold while the MPC's plan is spent.
   HoverLqr hover_;
@@ -102,14 +99,11 @@ class MiMode final : public Mode {
   int substeps_ = 15;
   std::int64_t steps_total_ = 0;
 
-  // What the flight changes step by step, besides the states of the controller, the score
-  // and the pilot: a snapshot copies it.
+  // What the flight changes step by step, besides the states of the controller, the score,
+  // the pilot and the simulated vehicle: a snapshot copies it.
   struct Run {
     Telemetry telemetry;
-    Eigen::VectorXd x;                     // nx: true state
-    std::vector<Eigen::VectorXd> u_delay;  // ring of commands in flight, each nu
-    std::mt19937_64 rng;                   // position noise
-    std::normal_distribution<double> noise{0.0, 1.0};
+    Eigen::VectorXd x;  // nx: the vehicle's state at t_k (simulated: true; remote: predicted)
     SafetyNet safety;
     Eigen::Vector3d hold = Eigen::Vector3d::Zero();  // where the safe controller holds
     models::MikroKopter::Input u_safe = models::MikroKopter::Input::Zero();  // nu
@@ -122,11 +116,8 @@ class MiMode final : public Mode {
   };
   Run run_;
 
-  // Remote vehicle.
-  VehicleLink* link_ = nullptr;
-  VehicleFeed feed_;
-  DelayPredictor<models::MikroKopter> predictor_;
-  std::int64_t now_ns_ = 0;  // the step's stamp
+  SimulatedVehicle<models::MikroKopter> simulated_;  // flown unless a remote one is attached
+  LinkedVehicle<models::MikroKopter> remote_;        // flown when attached (set_vehicle())
 };
 
 // The scenario's emulated pilot of that name: a profile of the scenario's [pilots], or

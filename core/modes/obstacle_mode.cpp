@@ -51,6 +51,10 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   substeps_ = int(std::lround(settings_.dt * scenario_.plant_rate_hz));
   steps_total_ = std::lround(scenario_.duration / settings_.dt);
   run_.x = ref.x[0];
+  SimulatedVehicle<models::Crazyflie>::Settings plant;
+  plant.substeps = substeps_;
+  plant.h = settings_.dt / substeps_;
+  simulated_.setup(model_, plant, run_.x);
   warm_start();
   run_.rti_us.clear();
   run_.rti_us.reserve(std::size_t(std::max<std::int64_t>(steps_total_, 0)));
@@ -188,13 +192,13 @@ bool ObstacleMode::step() {
 // RK4 at the plant rate with u held over [t, t + Δt], the distances checked after every
 // substep. Returns the smallest distance of the step; `violated` when one is below d_C − 1 mm.
 double ObstacleMode::plant_step(const models::Crazyflie::Input& u, double t, bool& violated) {
-  const IntegratorErk4<models::Crazyflie>& erk4 = problem_->integrator();
   const double h = settings_.dt / substeps_;
-  models::Crazyflie::State xn;
+  const long j0 = long(run_.step) * substeps_;
+  simulated_.send(run_.step, u);
   double distance = kInf;
   for (int s = 0; s < substeps_; ++s) {
-    erk4.step(run_.x, u, h, xn);
-    run_.x = xn;
+    simulated_.integrate_to(j0 + s + 1);
+    run_.x = simulated_.at(j0 + s + 1);
     distance = std::min(distance, check_distances(t + (s + 1) * h, violated));
   }
   return distance;
@@ -255,6 +259,7 @@ void ObstacleMode::set_channels(double step_min_distance, double tracking_error)
 
 struct ObstacleMode::Saved final : ModeSnapshot::State {
   RtiState rti;  // the NMPC's warm start
+  SimulatedVehicle<models::Crazyflie>::Data vehicle;
   Run run;
 };
 
@@ -262,15 +267,17 @@ void ObstacleMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const
   if (!state) state = std::make_unique<Saved>();
   Saved& s = static_cast<Saved&>(*state);  // Mode::save() replaced a state of another kind
   s.rti = rti_.state();
+  s.vehicle = simulated_.data();
   s.run = run_;
 }
 
 RestoreStatus ObstacleMode::restore_state(const ModeSnapshot::State& state) {
   const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
-  if (!ready_ || !rti_.fits(s.rti) ||
+  if (!ready_ || !rti_.fits(s.rti) || !simulated_.fits(s.vehicle) ||
       s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
     return RestoreStatus::other_scenario;
   rti_.restore(s.rti);
+  simulated_.restore(s.vehicle);
   run_ = s.run;
   return RestoreStatus::ok;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The obstacle-avoidance mode (SPEC §5.3): the NMPC of core/control/obstacle_avoidance.hpp
 // flies a scenario's reference past its spheres and thrown balls. One RTI per Δt; the plant is
-// the same Crazyflie model with RK4 at plant_rate_hz (≥ 1 kHz) substeps, the input held over Δt.
+// the same Crazyflie model with RK4 at plant_rate_hz (≥ 1 kHz) substeps, the input held over Δt
+// (core/modes/simulated_vehicle.hpp, without delays or noise).
 // Distances to every obstacle are checked at every plant substep (thesis §6.3.2: between
 // shooting nodes the path may cut the clearance sphere slightly) and at the control instants,
 // where the constraint is imposed.
@@ -16,6 +17,7 @@
 #include "core/control/tracking.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/safety_net.hpp"
+#include "core/modes/simulated_vehicle.hpp"
 #include "core/nlp/rti.hpp"
 #include "core/numerics/reserved_vector.hpp"
 #include "core/numerics/setup_result.hpp"
@@ -100,7 +102,7 @@ class ObstacleMode final : public Mode {
   ObstacleRunResult result() const;
 
  protected:
-  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state and Run.
+  // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state, the simulated vehicle and Run.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
@@ -123,15 +125,17 @@ class ObstacleMode final : public Mode {
   // The safe controller: hover-hold at run_.hold while the NMPC's plan is spent.
   models::Crazyflie model_{};
   TrackingLqr safe_lqr_;
+  SimulatedVehicle<models::Crazyflie> simulated_;  // the plant
   int substeps_ = 15;           // plant RK4 steps per Δt
   int last_x_ = 0;              // last index of the reference states
   std::int64_t steps_total_ = 0;
   bool ready_ = false;  // setup() succeeded
 
-  // What the flight changes step by step, besides the NMPC's state: a snapshot copies it.
+  // What the flight changes step by step, besides the NMPC's state and the simulated
+  // vehicle: a snapshot copies it.
   struct Run {
     Telemetry telemetry;
-    models::Crazyflie::State x;  // 13: true plant state
+    models::Crazyflie::State x;  // 13: true plant state (the simulated vehicle's, at t_k)
     SafetyNet safety;
     models::Crazyflie::State hold = models::Crazyflie::State::Zero();  // 13
     ReservedVector<double> rti_us;  // per step, RTI prepare + feedback [us]

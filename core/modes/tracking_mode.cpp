@@ -66,7 +66,6 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   last_u_ = long(ref.u.size()) - 1;
 
   model_ = models::Crazyflie{};
-  plant_ = IntegratorErk4<models::Crazyflie>(model_);
   if (c.kind == TrackingControllerKind::nmpc) {
     problem_ = std::make_unique<CrazyflieTracking>(c.N, c.dt, model_);
     rti_ = std::make_unique<RtiSolver>();
@@ -79,18 +78,23 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   if (SetupResult r = lqr_.setup(model_, c.dt); !r) return r;
   run_.safety.reset();
   predictor_.setup(model_, int(s_), h_, int(n_r_), int(std::lround(VehicleFeed::kMaxRtt / h_)));
-  link_ = nullptr;
-  feed_.setup(models::Crazyflie::nx, c.dt, h_, predictor_.max_substeps(),
-              2 * std::size_t(steps_total_) + 2);
+  // A remote vehicle's predictions reach as far as the simulated delay's do.
+  remote_.setup(model_, c.dt, int(s_), predictor_.max_substeps(),
+                2 * std::size_t(steps_total_) + 2,
+                VehicleWorld::ball(pl.start, tracking_defaults::kLostRadius),
+                "it left the world");
   run_.lost_reason = "";
 
-  // Ring sizes. States: step k reads boundary k·s − n_m and then integrates at most to
-  // (k+1)·s + n_c while boundaries from k·s on are still needed: n_r + s + 1 boundaries.
-  // Commands: the substeps integrated in step k use commands k − ⌈n_c/s⌉ .. k.
   x_init_ = model_.hover_state(pl.start);
-  run_.states.assign(std::size_t(n_r_ + s_ + 1), x_init_);
-  run_.cmds.assign(std::size_t((n_c_ + s_ - 1) / s_ + 2), Input::Zero());
-  run_.j_sim = run_.j = 0;
+  using Simulated = SimulatedVehicle<models::Crazyflie>;
+  Simulated::Settings plant;
+  plant.substeps = int(s_);
+  plant.h = h_;
+  plant.command_delay = n_c_;
+  plant.measurement_delay = n_m_;
+  plant.idle = Simulated::Idle::rests;
+  simulated_.setup(model_, plant, x_init_);
+  run_.j = 0;
   run_.j_lost = -1;
   run_.y = run_.x0 = x_init_;
   run_.u = model_.hover_input();
@@ -140,8 +144,7 @@ void TrackingMode::init_telemetry() {
 // y = the state of boundary k·s − n_m (the initial state before the start), then x0: its
 // prediction over τ_r, or y itself.
 void TrackingMode::measure() {
-  const long b = long(run_.step) * s_ - n_m_;
-  run_.y = b <= 0 ? x_init_ : run_.states[ring(b)];
+  simulated_.measure(run_.step, run_.y);
   const auto t0 = std::chrono::steady_clock::now();
   if (scenario_.controller.compensation) {
     predictor_.predict(run_.y, run_.x0);
@@ -188,29 +191,13 @@ void TrackingMode::control() {
   }
 }
 
-// u_k leaves: into the predictor's and the plant's command rings.
+// u_k leaves: into the predictor's and the simulated vehicle's command rings.
 void TrackingMode::send() {
   run_.max_input_violation =
       std::max({run_.max_input_violation, model_.p.omega_min - run_.u.minCoeff(),
                 run_.u.maxCoeff() - model_.p.omega_max});
   predictor_.record_sent(run_.u);
-  run_.cmds[std::size_t(run_.step % std::int64_t(run_.cmds.size()))] = run_.u;
-}
-
-// RK4 substeps up to boundary `end`, each with the command on the rotors during it (none before
-// the first command arrives at boundary n_c: the vehicle rests).
-void TrackingMode::integrate_to(long end) {
-  while (run_.j_sim < end) {
-    const long m = floor_div(run_.j_sim - n_c_, s_);
-    const State& x = run_.states[ring(run_.j_sim)];
-    State& xn = run_.states[ring(run_.j_sim + 1)];
-    if (m >= 0) {
-      plant_.step<double>(x, run_.cmds[std::size_t(m % long(run_.cmds.size()))], h_, xn);
-    } else {
-      xn = x;
-    }
-    ++run_.j_sim;
-  }
+  simulated_.send(run_.step, run_.u);
 }
 
 // Checks and samples the boundaries up to `end` (integrated already); false at the first one
@@ -219,7 +206,7 @@ bool TrackingMode::process_to(long end) {
   const Eigen::Vector3d& start = scenario_.plant.start;
   while (run_.j < end) {
     ++run_.j;
-    const State& x = run_.states[ring(run_.j)];
+    const State& x = simulated_.at(run_.j);
     if (!x.allFinite() || (x.head<3>() - start).norm() > tracking_defaults::kLostRadius) {
       run_.j_lost = run_.j;
       return false;
@@ -259,7 +246,7 @@ void TrackingMode::add_sample(long m, const Eigen::Vector3d& p, const Eigen::Vec
 }
 
 bool TrackingMode::set_vehicle(VehicleLink* link) {
-  link_ = link;
+  remote_.attach(link);
   return true;
 }
 
@@ -271,7 +258,7 @@ void TrackingMode::lose(double at, const char* reason) {
 
 bool TrackingMode::step() {
   if (run_.finished || stopped_at(run_.step)) return false;
-  if (link_) return step_remote();
+  if (remote_.attached()) return step_remote();
   const long k = long(run_.step);
   const auto started = std::chrono::steady_clock::now();
   measure();
@@ -280,7 +267,7 @@ bool TrackingMode::step() {
   send();
   // The plant to the next control boundary; after the last step on to K·s + n_c (sample K).
   const long end = (k + 1) * s_ + (k + 1 == steps_total_ ? n_c_ : 0);
-  integrate_to(std::max(end, k * s_ + n_c_));
+  simulated_.integrate_to(std::max(end, k * s_ + n_c_));
   const bool alive = process_to(end);
   if (!alive) lose(double(run_.j_lost - n_c_) * h_, "it left the world");
   set_telemetry();
@@ -295,26 +282,22 @@ bool TrackingMode::step() {
 // Step k with a remote vehicle: the newest state (a round-trip and an error sample when it is
 // new), the prediction over the estimated round-trip time, the controller, the command out.
 bool TrackingMode::step_remote() {
+  using Remote = LinkedVehicle<models::Crazyflie>;
   const long k = long(run_.step);
-  const std::int64_t now = link_->now_ns();
-  const VehicleFeed::Reading r = feed_.read(*link_, k, now, int(s_));
-  const VehicleSample& v = *r.sample;
   const double t = double(k) * scenario_.controller.dt;
-  run_.y = r.heard ? State(v.x) : x_init_;
-  const VehicleWorld world =
-      VehicleWorld::ball(scenario_.plant.start, tracking_defaults::kLostRadius);
-  const char* outside = r.heard ? world.outside(run_.y.head<3>()) : nullptr;
-  if (r.heard && (v.left_world || !run_.y.allFinite() || outside)) {
-    lose(t, outside ? outside : "it left the world");
+  run_.y = x_init_;  // before any state arrives
+  const Remote::Reading r = remote_.read(k, run_.y);
+  if (r.status == Remote::Status::left_world) {
+    lose(t, r.reason);
     run_.y = x_init_;
-  } else if (r.lost) {
-    lose(t, feed_.lost_reason());
+  } else if (r.status == Remote::Status::lost) {
+    lose(t, r.reason);
   } else if (r.fresh) {
-    sample_at(r.sigma, State(v.x));  // only states inside the world are scored
+    sample_at(r.sigma, run_.y);  // only states inside the world are scored
   }
   if (run_.lost) {
     run_.finished = true;
-    link_->finish();
+    remote_.finish();
     set_telemetry();
     run_.telemetry.x = run_.y;
     ++run_.step;
@@ -325,13 +308,13 @@ bool TrackingMode::step_remote() {
   // controller starts from it only with compensation, the telemetry always shows it (the
   // newest state itself is a round trip old: its error would be the delay's, not the loop's).
   const auto t0 = std::chrono::steady_clock::now();
-  predictor_.predict(run_.y, run_.predicted, r.horizon_substeps);
+  remote_.predict(run_.y, run_.predicted, r);
   run_.x0 = scenario_.controller.compensation ? run_.predicted : run_.y;
   run_.predict_us.push_back(scenario_.controller.compensation ? microseconds_since(t0) : 0.0);
   control();
   run_.compute_us = microseconds_since(t0);
   send();
-  feed_.send(*link_, k, now, run_.u.data(), int(run_.u.size()));
+  remote_.send(k, run_.u);
 
   set_telemetry();
   Telemetry& s = run_.telemetry;
@@ -340,7 +323,7 @@ bool TrackingMode::step_remote() {
   set_channels(run_.predict_us.back(), run_.solve_us.back());
   ++run_.step;
   run_.finished = run_.step >= steps_total_;
-  if (run_.finished) link_->finish();
+  if (run_.finished) remote_.finish();
   return true;
 }
 
@@ -353,7 +336,7 @@ void TrackingMode::set_telemetry() {
   s.t = double(k) * scenario_.controller.dt;
   long jx = k * s_ + n_c_;
   if (run_.j_lost >= 0 && jx >= run_.j_lost) jx = run_.j_lost - 1;
-  s.x = run_.states[ring(jx)];
+  s.x = simulated_.at(jx);
   s.x_measured = run_.x0;
   s.u = run_.u;
   const Eigen::VectorXd& xr = scenario_.reference_trajectory.x[std::size_t(std::min(k, last_x_))];
@@ -370,16 +353,16 @@ void TrackingMode::set_channels(double predictor_us, double controller_us) {
   Telemetry& s = run_.telemetry;
   const Eigen::Vector3d p = s.x.head<3>(), pr = s.reference.head<3>();
   s.set_channel(kTrackingError, "tracking error", "m", position_error(p, pr));
-  s.set_channel(kRtt, link_ ? "RTT estimate" : "RTT", "s",
-                link_ ? feed_.rtt().estimate() : scenario_.plant.rtt);
+  s.set_channel(kRtt, remote() ? "RTT estimate" : "RTT", "s",
+                remote() ? remote_.rtt().estimate() : scenario_.plant.rtt);
   s.set_channel(kPredictorTime, "predictor time", "us", predictor_us);
   s.set_channel(kControllerTime, nmpc() ? "RTI time" : "LQR time", "us", controller_us);
   for (int i = 0; i < 4; ++i) s.set_channel(kRotorSpeed1 + i, kRotorSpeedNames[i], "krpm", s.u(i));
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "krpm", model_.p.omega_max);
   s.set_channel(kCompensation, "compensation", "", scenario_.controller.compensation ? 1.0 : 0.0);
-  if (link_) {
-    s.set_channel(kRttSample, "RTT sample", "s", feed_.rtt().last_sample());
-    s.set_channel(kHorizon, "prediction horizon", "s", feed_.horizon_s());
+  if (remote()) {
+    s.set_channel(kRttSample, "RTT sample", "s", remote_.rtt().last_sample());
+    s.set_channel(kHorizon, "prediction horizon", "s", remote_.feed().horizon_s());
   }
 }
 
@@ -387,6 +370,7 @@ struct TrackingMode::Saved final : ModeSnapshot::State {
   bool nmpc = false;
   RtiState rti;  // the NMPC's warm start (empty for the LQR)
   CrazyflieDelayPredictor::Sent predictor;
+  SimulatedVehicle<models::Crazyflie>::Data vehicle;
   Run run;
   bool remote = false;
 };
@@ -397,20 +381,21 @@ void TrackingMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const
   s.nmpc = rti_ != nullptr;
   if (rti_) s.rti = rti_->state();
   s.predictor = predictor_.sent();
+  s.vehicle = simulated_.data();
   s.run = run_;
-  s.remote = link_ != nullptr;
+  s.remote = remote();
 }
 
 RestoreStatus TrackingMode::restore_state(const ModeSnapshot::State& state) {
   const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
-  if (s.remote || link_) return RestoreStatus::remote_vehicle;
+  if (s.remote || remote()) return RestoreStatus::remote_vehicle;
   if (!ok_ || s.nmpc != (rti_ != nullptr) || (rti_ && !rti_->fits(s.rti)) ||
-      !predictor_.fits(s.predictor) || s.run.states.size() != run_.states.size() ||
-      s.run.cmds.size() != run_.cmds.size() ||
+      !predictor_.fits(s.predictor) || !simulated_.fits(s.vehicle) ||
       s.run.telemetry.predicted.cols() != run_.telemetry.predicted.cols())
     return RestoreStatus::other_scenario;
   if (rti_) rti_->restore(s.rti);
   predictor_.restore(s.predictor);
+  simulated_.restore(s.vehicle);
   run_ = s.run;
   return RestoreStatus::ok;
 }
@@ -440,10 +425,10 @@ TrackingResult TrackingMode::result() const {
   r.rtt_substeps = int(n_r_);
   r.measurement_substeps = int(n_m_);
   r.command_substeps = int(n_c_);
-  r.remote = link_ != nullptr;
-  r.rtt_measured_s = feed_.measured_median();
-  r.rtt_estimated_s = feed_.rtt().estimate();
-  r.rtt_samples = long(feed_.sample_count());
+  r.remote = remote();
+  r.rtt_measured_s = remote_.feed().measured_median();
+  r.rtt_estimated_s = remote_.rtt().estimate();
+  r.rtt_samples = long(remote_.feed().sample_count());
   return r;
 }
 

@@ -18,7 +18,7 @@
 // far as the commands already sent determine it (to k·s + n_c at least), so that x(σ = t_k) is
 // known when step k ends; integrating ahead changes no state.
 //
-// A remote vehicle (set_vehicle(), core/modes/vehicle_link.hpp): the plant runs elsewhere and
+// A remote vehicle (set_vehicle(), core/modes/linked_vehicle.hpp): the plant runs elsewhere and
 // nothing is simulated here. Step k starts from the vehicle's newest state, which echoes the
 // command j in effect when it was measured and how long that command had acted (a); each new
 // state is one round-trip sample for the estimator (core/control/rtt_estimator.hpp) and one
@@ -37,12 +37,11 @@
 
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/control/tracking.hpp"
+#include "core/modes/linked_vehicle.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/safety_net.hpp"
-#include "core/modes/vehicle_feed.hpp"
-#include "core/modes/vehicle_link.hpp"
+#include "core/modes/simulated_vehicle.hpp"
 #include "core/nlp/rti.hpp"
-#include "core/numerics/integrator_erk4.hpp"
 #include "core/numerics/reserved_vector.hpp"
 #include "core/numerics/setup_result.hpp"
 #include "core/scenario/tracking_scenario.hpp"
@@ -115,8 +114,8 @@ class TrackingMode final : public Mode {
   // Flies the vehicle behind `link` instead of the simulated plant (after setup(), before the
   // first step; nullptr: the simulated plant). The link outlives the flight.
   [[nodiscard]] bool set_vehicle(VehicleLink* link) override;
-  bool remote() const { return link_ != nullptr; }
-  const RttEstimator& rtt_estimator() const { return feed_.rtt(); }
+  bool remote() const { return remote_.attached(); }
+  const RttEstimator& rtt_estimator() const { return remote_.rtt(); }
   // Why the vehicle was lost ("" while it is not): left the world, or silent.
   const char* lost_reason() const { return run_.lost_reason; }
 
@@ -127,17 +126,15 @@ class TrackingMode final : public Mode {
 
  protected:
   // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state, the predictor's sent
-  // commands and Run. With a remote vehicle they refuse.
+  // commands, the simulated vehicle and Run. With a remote vehicle they refuse.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
 
  private:
   struct Saved;
-  std::size_t ring(long j) const { return std::size_t(j % long(run_.states.size())); }
   void measure();
   void control();
   void send();
-  void integrate_to(long end);
   bool process_to(long end);
   void sample(long m, const State& x);
   void sample_at(double sigma, const State& x);
@@ -150,7 +147,6 @@ class TrackingMode final : public Mode {
 
   TrackingScenario scenario_;
   models::Crazyflie model_{};
-  IntegratorErk4<models::Crazyflie> plant_{};
   std::unique_ptr<CrazyflieTracking> problem_;  // NMPC only
   std::unique_ptr<RtiSolver> rti_;              // NMPC only
   TrackingLqr lqr_;  // the LQR law, or the NMPC's safe controller
@@ -169,21 +165,17 @@ class TrackingMode final : public Mode {
   Eigen::Vector3d step_dir_ = Eigen::Vector3d::Zero();    // unit (target − start), or 0
   double step_len_ = 0;
 
-  // Remote vehicle.
-  VehicleLink* link_ = nullptr;
-  VehicleFeed feed_;
+  // The plant with its delay lines (n_c, n_m), at rest until the first command acts.
+  SimulatedVehicle<models::Crazyflie> simulated_;
+  LinkedVehicle<models::Crazyflie> remote_;  // flown when attached (set_vehicle())
 
   std::int64_t steps_total_ = 0;
   bool ok_ = false;  // setup succeeded
 
-  // What the flight changes step by step, besides the states of the NMPC and the predictor:
-  // a snapshot copies it.
+  // What the flight changes step by step, besides the states of the NMPC, the predictor and
+  // the simulated vehicle: a snapshot copies it.
   struct Run {
-    // Plant: states at substep boundaries j (ring, index j mod size), integrated up to j_sim
-    // and checked and sampled up to j; the commands sent (ring, index k mod size).
-    std::vector<State> states;
-    std::vector<Input> cmds;
-    long j_sim = 0;
+    // The simulated vehicle's boundaries checked and sampled up to j.
     long j = 0;
     long j_lost = -1;  // boundary found lost
 

@@ -1,8 +1,9 @@
 #pragma once
-// What a mode does with a remote vehicle's states each step (core/modes/vehicle_link.hpp),
-// shared by the modes that fly one: take the newest state, turn each new one into a round-trip
-// sample (core/control/rtt_estimator.hpp), give the horizon over which the state is to be
-// predicted (SPEC §5.2, §9), and judge whether the vehicle is still worth flying.
+// What a linked vehicle (core/modes/linked_vehicle.hpp) does with the states of the vehicle
+// behind a link (core/modes/vehicle_link.hpp) each step: take the newest state, turn each new
+// one into a round-trip sample (core/control/rtt_estimator.hpp), give the horizon over which
+// the state is to be predicted (SPEC §5.2, §9), and judge whether the vehicle is still worth
+// flying.
 //
 // A vehicle is lost (Reading::lost, lost_reason()) when it
 //  - says its flight has ended;
@@ -18,7 +19,7 @@
 //  - jumps: its position moves faster than kMaxSpeed between two states (plus kJumpSlack);
 //  - echoes a command never sent, or claims one acted longer than since it left (which
 //    input/net's link rejects already; here for any link).
-// Where its world ends is the mode's to say (VehicleWorld for the tracking mode).
+// Where its world ends is the mode's to say (a VehicleWorld, which LinkedVehicle judges).
 //
 // setup() sizes; read() and send() allocate nothing.
 #include <algorithm>
