@@ -242,9 +242,7 @@ TEST_F(App, TheSessionPanelPicksTheScenario) {
   ASSERT_NE(std::find(c.pilots.begin(), c.pilots.end(), "experienced"), c.pilots.end());
   EXPECT_EQ(c.pilots[std::size_t(c.pilot)], "novice");
   // The request a pick in the combo makes, acted on by the app.
-  ui::UiRequest pick;
-  pick.scenario = int(it - c.scenarios.begin());
-  app.act(pick);
+  app.act(ui::PickScenario{int(it - c.scenarios.begin())});
   frame(app);
   EXPECT_EQ(app.live()->flight.mode->kind(), ModeKind::pendubot_swingup);
   EXPECT_FALSE(app.live()->started);

@@ -67,6 +67,12 @@ Flown fly(const char* scenario, double seconds, const char* pilot = nullptr) {
   return f;
 }
 
+// One frame of the screen; what it asks for is dropped (these tests look at what it draws).
+void draw(const ui::Scene& scene, const ui::History& h, const ui::RunInfo& run, ui::UiState& st) {
+  ui::Requests ignored;
+  ui::draw_screen(scene, h, run, st, ignored);
+}
+
 class Ui : public testing::Test {
  protected:
   void SetUp() override {
@@ -76,7 +82,7 @@ class Ui : public testing::Test {
   std::vector<std::uint8_t> render(const ui::Scene& scene, const ui::History& h, ui::UiState& st) {
     ui::RunInfo run;
     run.state = ui::RunState::flying;
-    for (int f = 0; f < 2; ++f) screen_.frame([&] { (void)ui::draw_screen(scene, h, run, st); });
+    for (int f = 0; f < 2; ++f) screen_.frame([&] { draw(scene, h, run, st); });
     return screen_.pixels();
   }
   cli::Offscreen screen_;
@@ -177,7 +183,7 @@ TEST_F(Ui, KeyThreeSwitchesToTopCamera) {
   ASSERT_EQ(st.camera, ui::Camera::chase);
   ImGui::GetIO().KeysDown[int('3')] = true;
   ui::RunInfo run;
-  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+  screen_.frame([&] { draw(scene, f.history, run, st); });
   ImGui::GetIO().KeysDown[int('3')] = false;
   EXPECT_EQ(st.camera, ui::Camera::top);
   EXPECT_NE(render(scene, f.history, st), chase);
@@ -191,7 +197,7 @@ TEST_F(Ui, ScoreCardAtTheEnd) {
   ui::UiState st;
   ui::RunInfo run;
   run.state = ui::RunState::flying;
-  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+  screen_.frame([&] { draw(scene, f.history, run, st); });
   const ImGuiWindow* card = ImGui::FindWindowByName("Score card");
   EXPECT_TRUE(card == nullptr || !card->Active);
   run.state = ui::RunState::finished;
@@ -199,7 +205,7 @@ TEST_F(Ui, ScoreCardAtTheEnd) {
   ASSERT_FALSE(run.metrics.empty());
   bool active = false;
   screen_.frame([&] {
-    (void)ui::draw_screen(scene, f.history, run, st);
+    draw(scene, f.history, run, st);
     card = ImGui::FindWindowByName("Score card");
     active = card && card->Active;
   });
@@ -313,7 +319,7 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
       ui::UiState st;
       ui::RunInfo run;
       run.state = ui::RunState::flying;
-      for (int i = 0; i < 3; ++i) screen.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+      for (int i = 0; i < 3; ++i) screen.frame([&] { draw(scene, f.history, run, st); });
       for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
       // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
       if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
