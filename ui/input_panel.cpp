@@ -53,7 +53,7 @@ unsigned held_flight_keys() {
   if (io.WantCaptureKeyboard || io.KeyCtrl) return 0;
   unsigned keys = 0;
   for (int k = 0; k < int(input::Key::count); ++k)
-    if (ImGui::IsKeyDown(kFlightKeys[k])) keys |= 1u << k;
+    if (key_down(kFlightKeys[k])) keys |= 1u << k;
   return keys;
 }
 
@@ -249,8 +249,7 @@ void draw_mapping_wizard(const RunInfo& run, Requests& out) {
   if (ImGui::Button("Save")) out.push_back(WizardSave{});
   ImGui::EndDisabled();
   ImGui::SameLine();
-  if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
-    out.push_back(WizardCancel{});
+  if (ImGui::Button("Cancel") || key_pressed(Key::escape)) out.push_back(WizardCancel{});
   ImGui::End();
 }
 

@@ -422,9 +422,6 @@ void help_sheet(UiState& ui, ImVec2 display) {
   ImGui::End();
 }
 
-bool pressed(int key) { return ImGui::IsKeyPressed(key); }
-bool pressed(ImGuiKey_ key) { return ImGui::IsKeyPressed(ImGui::GetKeyIndex(key)); }
-
 // The replay speeds, slowest first (↑ / ↓ move along them).
 constexpr double kReplaySpeeds[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
 
@@ -432,54 +429,54 @@ void replay_keys(const RunInfo& run, Requests& out) {
   const ReplayInfo& r = *run.replay;
   const ImGuiIO& io = ImGui::GetIO();
   const double step = io.KeyShift ? 0.01 : io.KeyAlt ? 0.5 : 0.1;
-  if (pressed(ImGuiKey_LeftArrow)) out.push_back(Seek{std::max(0.0, r.t - step)});
-  if (pressed(ImGuiKey_RightArrow)) out.push_back(Seek{std::min(r.loaded * r.duration, r.t + step)});
-  if (pressed(ImGuiKey_Home)) out.push_back(Seek{0.0});
-  if (pressed(ImGuiKey_End)) out.push_back(Seek{r.loaded * r.duration});
+  if (key_pressed(Key::left)) out.push_back(Seek{std::max(0.0, r.t - step)});
+  if (key_pressed(Key::right)) out.push_back(Seek{std::min(r.loaded * r.duration, r.t + step)});
+  if (key_pressed(Key::home)) out.push_back(Seek{0.0});
+  if (key_pressed(Key::end)) out.push_back(Seek{r.loaded * r.duration});
   const auto at = std::find(std::begin(kReplaySpeeds), std::end(kReplaySpeeds), run.speed);
   const bool known = at != std::end(kReplaySpeeds);
   const double faster = known && at + 1 != std::end(kReplaySpeeds) ? *(at + 1) : 8.0;
   const double slower = known && at != std::begin(kReplaySpeeds) ? *(at - 1) : 0.25;
-  if (pressed(ImGuiKey_UpArrow)) out.push_back(SetPlaySpeed{faster});
-  if (pressed(ImGuiKey_DownArrow)) out.push_back(SetPlaySpeed{slower});
-  if (pressed('[')) out.push_back(JumpToEvent{-1});
-  if (pressed(']')) out.push_back(JumpToEvent{+1});
-  if (pressed(ImGuiKey_Escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
+  if (key_pressed(Key::up)) out.push_back(SetPlaySpeed{faster});
+  if (key_pressed(Key::down)) out.push_back(SetPlaySpeed{slower});
+  if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
+  if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
+  if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
     out.push_back(LeaveReplay{});
 }
 
 void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
   const ImGuiIO& io = ImGui::GetIO();
   if (io.WantCaptureKeyboard || ui.open_dialog.open) return;
-  if (pressed(kKeyF1)) ui.show_help = !ui.show_help;
+  if (key_pressed(Key::f1)) ui.show_help = !ui.show_help;
   for (int i = 0; i < io.InputQueueCharacters.Size; ++i)
     if (io.InputQueueCharacters[i] == '?') ui.show_help = !ui.show_help;
   if (io.KeyCtrl) {
-    if (pressed('O')) ui.open_dialog.open = true;
-    if (pressed('R') && run.session) out.push_back(SetRecord{!run.session->record});
+    if (key_pressed(Key::o)) ui.open_dialog.open = true;
+    if (key_pressed(Key::r) && run.session) out.push_back(SetRecord{!run.session->record});
     return;
   }
-  if (pressed(ImGuiKey_Escape) && ui.show_help) ui.show_help = false;
+  if (key_pressed(Key::escape) && ui.show_help) ui.show_help = false;
   else if (run.replay) replay_keys(run, out);
-  else if (pressed(ImGuiKey_Escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
+  else if (key_pressed(Key::escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
   // Space is the transport's: a replay plays or pauses, a live flight starts, pauses or resumes.
-  if (pressed(ImGuiKey_Space) && run.state != RunState::waiting) {
+  if (key_pressed(Key::space) && run.state != RunState::waiting) {
     if (run.replay) out.push_back(TogglePlay{});
     else if (run.state == RunState::ready) out.push_back(StartFlight{});
     else out.push_back(TogglePause{});
   }
-  if (pressed('R') && run.can_restart && !run.replay) out.push_back(RestartFlight{});
-  if (pressed('1')) ui.camera = Camera::chase;
-  if (pressed('2')) ui.camera = Camera::orbit;
-  if (pressed('3')) ui.camera = Camera::top;
-  if (pressed('4')) ui.camera = Camera::side;
+  if (key_pressed(Key::r) && run.can_restart && !run.replay) out.push_back(RestartFlight{});
+  if (key_pressed(Key::digit1)) ui.camera = Camera::chase;
+  if (key_pressed(Key::digit2)) ui.camera = Camera::orbit;
+  if (key_pressed(Key::digit3)) ui.camera = Camera::top;
+  if (key_pressed(Key::digit4)) ui.camera = Camera::side;
   const bool keyboard_flies = run.input && run.input->pilot == "keyboard" && !run.replay;
-  if (pressed('D') && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
-  if (pressed('I') && run.input) {
+  if (key_pressed(Key::d) && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
+  if (key_pressed(Key::i) && run.input) {
     ui.show_settings = !ui.show_settings;
     ui.draft_loaded = false;
   }
-  if (pressed('P')) set_plots_paused(ui, h, !ui.plots_paused);
+  if (key_pressed(Key::p)) set_plots_paused(ui, h, !ui.plots_paused);
 }
 
 }  // namespace

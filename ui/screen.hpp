@@ -3,7 +3,7 @@
 // the session buttons and the authority bar; the session panel; the arena (3D) or Pendubot (2D)
 // view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A
 // function of the scene, the telemetry history and the UI's own state; what the user asked for
-// comes back as requests (ui/requests.hpp).
+// comes back as requests (ui/requests.hpp). Keys by the UI's own names (ui/keys.hpp).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -14,6 +14,7 @@
 #include "input/mapping.hpp"
 #include "input/mapping_wizard.hpp"
 #include "input/settings.hpp"
+#include "ui/keys.hpp"
 #include "ui/requests.hpp"
 #include "ui/scene.hpp"
 
@@ -167,14 +168,5 @@ void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max);
 
 // Freezes the plots at the newest time of `h` (or lets them roll again).
 void set_plots_paused(UiState& ui, const History& h, bool paused);
-
-// The keys that fly with the keyboard pilot (input/keyboard.hpp), as GLFW key codes, indexed
-// by input::Key: W S A D and the arrows.
-inline constexpr int kFlightKeys[] = {'W', 'S', 'A', 'D', 265 /*up*/, 264 /*down*/,
-                                      263 /*left*/, 262 /*right*/};
-
-// GLFW's key code for F1: the window's backend and the headless renderer both use GLFW's key
-// codes (ImGui 1.86 has no ImGuiKey for F1).
-inline constexpr int kKeyF1 = 290;
 
 }  // namespace mixpilot::ui

@@ -150,8 +150,7 @@ void draw_open_dialog(UiState& ui, Requests& out) {
   ImGui::SameLine();
   if ((ImGui::Button("Open", ImVec2(button_w, 0)) || typed) && d.path[0] != '\0') open = d.path;
   ImGui::SameLine();
-  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
-    d.open = false;
+  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || key_pressed(Key::escape)) d.open = false;
   if (!open.empty()) {
     out.push_back(OpenFile{std::move(open)});
     d.open = false;
