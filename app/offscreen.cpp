@@ -4,18 +4,16 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <utility>
 
 #include <epoxy/egl.h>  // EGL and GL entry points, both through libepoxy
 #include <epoxy/gl.h>
 
-#define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>  // key codes only
 #include <imgui.h>
 #include <backends/imgui_impl_opengl3.h>
 
 #include <stb/stb_image_write.h>  // implemented in Debian's libstb, which ImGui links
 
+#include "ui/keys.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::cli {
@@ -92,20 +90,9 @@ bool Offscreen::open(int width, int height, std::string& error, float scale) {
   imgui_ = true;
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // nothing written behind the user's back
-  // The window's key codes (GLFW's, as ImGui's GLFW backend maps them), so that keys injected
-  // into a headless frame mean what they mean in the window.
-  const std::pair<ImGuiKey_, int> keys[] = {
-      {ImGuiKey_Tab, GLFW_KEY_TAB},           {ImGuiKey_LeftArrow, GLFW_KEY_LEFT},
-      {ImGuiKey_RightArrow, GLFW_KEY_RIGHT},  {ImGuiKey_UpArrow, GLFW_KEY_UP},
-      {ImGuiKey_DownArrow, GLFW_KEY_DOWN},    {ImGuiKey_PageUp, GLFW_KEY_PAGE_UP},
-      {ImGuiKey_PageDown, GLFW_KEY_PAGE_DOWN}, {ImGuiKey_Home, GLFW_KEY_HOME},
-      {ImGuiKey_End, GLFW_KEY_END},           {ImGuiKey_Insert, GLFW_KEY_INSERT},
-      {ImGuiKey_Delete, GLFW_KEY_DELETE},     {ImGuiKey_Backspace, GLFW_KEY_BACKSPACE},
-      {ImGuiKey_Space, GLFW_KEY_SPACE},       {ImGuiKey_Enter, GLFW_KEY_ENTER},
-      {ImGuiKey_Escape, GLFW_KEY_ESCAPE},     {ImGuiKey_KeyPadEnter, GLFW_KEY_KP_ENTER},
-      {ImGuiKey_A, GLFW_KEY_A}, {ImGuiKey_C, GLFW_KEY_C}, {ImGuiKey_V, GLFW_KEY_V},
-      {ImGuiKey_X, GLFW_KEY_X}, {ImGuiKey_Y, GLFW_KEY_Y}, {ImGuiKey_Z, GLFW_KEY_Z}};
-  for (const auto& [k, code] : keys) io.KeyMap[k] = code;
+  // Keys by the UI's names (ui/keys.hpp), as the window maps them: keys injected into a
+  // headless frame mean what they mean in the window.
+  mixpilot::ui::use_key_names(io);
   io.DisplaySize = ImVec2(float(width), float(height));
   mixpilot::ui::apply_style(scale);
   font_ = mixpilot::ui::load_fonts(scale);

@@ -57,9 +57,10 @@ void ScreenshotSink::on_sample(const Telemetry& s) {
     done_[i] = true;
     ui::RunInfo run = counts_;
     run.state = ui::RunState::flying;
-    // Two frames: ImGui sizes some items in the first.
+    // Two frames: ImGui sizes some items in the first. Nobody asks for anything here.
+    ui::Requests none;
     for (int f = 0; f < 2; ++f)
-      offscreen_->frame([&] { (void)ui::draw_screen(scene_, history_, run, ui_); });
+      offscreen_->frame([&] { ui::draw_screen(scene_, history_, run, ui_, none); });
     std::string error;
     if (!write_file(requests_[i].path, offscreen_->png(), overwrite_, error)) {
       if (error_.empty()) error_ = error;

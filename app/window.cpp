@@ -12,8 +12,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "app/cli.hpp"
+#include "ui/keys.hpp"
 #include "ui/screen.hpp"
 #include "ui/theme.hpp"
 
@@ -55,6 +57,60 @@ float ui_scale(GLFWwindow* window) {
   return std::isfinite(s) && s > 0.0f ? std::clamp(s, 0.5f, 4.0f) : 1.0f;
 }
 
+// GLFW's key code as the UI names the key (ui/keys.hpp); nullopt for a key the UI has no name
+// for (ImGui 1.86 reads none but those: text arrives as characters).
+std::optional<ui::Key> ui_key(int key) {
+  using ui::Key;
+  if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) return Key(int(Key::a) + (key - GLFW_KEY_A));
+  if (key >= GLFW_KEY_0 && key <= GLFW_KEY_9) return Key(int(Key::digit0) + (key - GLFW_KEY_0));
+  if (key >= GLFW_KEY_F1 && key <= GLFW_KEY_F12) return Key(int(Key::f1) + (key - GLFW_KEY_F1));
+  switch (key) {
+    case GLFW_KEY_SPACE: return Key::space;
+    case GLFW_KEY_ENTER: return Key::enter;
+    case GLFW_KEY_KP_ENTER: return Key::keypad_enter;
+    case GLFW_KEY_ESCAPE: return Key::escape;
+    case GLFW_KEY_TAB: return Key::tab;
+    case GLFW_KEY_BACKSPACE: return Key::backspace;
+    case GLFW_KEY_INSERT: return Key::insert;
+    case GLFW_KEY_DELETE: return Key::del;
+    case GLFW_KEY_LEFT: return Key::left;
+    case GLFW_KEY_RIGHT: return Key::right;
+    case GLFW_KEY_UP: return Key::up;
+    case GLFW_KEY_DOWN: return Key::down;
+    case GLFW_KEY_PAGE_UP: return Key::page_up;
+    case GLFW_KEY_PAGE_DOWN: return Key::page_down;
+    case GLFW_KEY_HOME: return Key::home;
+    case GLFW_KEY_END: return Key::end;
+    case GLFW_KEY_LEFT_BRACKET: return Key::left_bracket;
+    case GLFW_KEY_RIGHT_BRACKET: return Key::right_bracket;
+    case GLFW_KEY_LEFT_SHIFT: return Key::left_shift;
+    case GLFW_KEY_RIGHT_SHIFT: return Key::right_shift;
+    case GLFW_KEY_LEFT_CONTROL: return Key::left_ctrl;
+    case GLFW_KEY_RIGHT_CONTROL: return Key::right_ctrl;
+    case GLFW_KEY_LEFT_ALT: return Key::left_alt;
+    case GLFW_KEY_RIGHT_ALT: return Key::right_alt;
+    case GLFW_KEY_LEFT_SUPER: return Key::left_super;
+    case GLFW_KEY_RIGHT_SUPER: return Key::right_super;
+    default: return std::nullopt;
+  }
+}
+
+// In place of ImGui's GLFW key callback, which writes GLFW's key codes into io.KeysDown: the
+// same, by the UI's key names (ImGui's other GLFW callbacks stay).
+void key_callback(GLFWwindow*, int key, int, int action, int) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (const std::optional<ui::Key> k = ui_key(key); k && action != GLFW_REPEAT)
+    ui::set_key(io, *k, action == GLFW_PRESS);
+  // As ImGui's callback: the modifiers from the keys held (GLFW's mods are not reliable
+  // across systems).
+  using ui::Key;
+  const auto held = [&](Key l, Key r) { return io.KeysDown[int(l)] || io.KeysDown[int(r)]; };
+  io.KeyCtrl = held(Key::left_ctrl, Key::right_ctrl);
+  io.KeyShift = held(Key::left_shift, Key::right_shift);
+  io.KeyAlt = held(Key::left_alt, Key::right_alt);
+  io.KeySuper = held(Key::left_super, Key::right_super);
+}
+
 }  // namespace
 
 bool window_available(std::string& error) {
@@ -90,6 +146,8 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
   ui::apply_style(scale);
   ui::load_fonts(scale);
   ImGui_ImplGlfw_InitForOpenGL(window, true);
+  glfwSetKeyCallback(window, key_callback);  // ImGui's backend kept no callback of ours to chain
+  ui::use_key_names(ImGui::GetIO());
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
   std::vector<bool> shot(o.screenshots.size(), false);

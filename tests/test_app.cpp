@@ -88,17 +88,16 @@ class App : public testing::Test {
     // ImGui needs a positive frame time; the app's playhead moves by `dt` alone.
     screen_.frame([&] { app.build_frame(dt); }, std::max(float(dt), 1e-4f));
   }
-  // A key held for one frame, then released (ImGui's key indices are GLFW's key codes).
-  void key(cli::Trainer& app, int k, bool ctrl = false) {
+  // A key held for one frame, then released (by the UI's key names, as the window passes them).
+  void key(cli::Trainer& app, ui::Key k, bool ctrl = false) {
     ImGuiIO& io = ImGui::GetIO();
     io.KeyCtrl = ctrl;
-    io.KeysDown[k] = true;
+    ui::set_key(io, k, true);
     frame(app, 0.0);
-    io.KeysDown[k] = false;
+    ui::set_key(io, k, false);
     io.KeyCtrl = false;
     frame(app, 0.0);
   }
-  void key(cli::Trainer& app, ImGuiKey_ k) { key(app, ImGui::GetIO().KeyMap[k]); }
   // Where the item `label` of `window` lies: the mouse moves over the window until ImGui says
   // it hovers that item (layout-only frames, nothing rendered).
   std::optional<ImVec2> locate(cli::Trainer& app, const char* window, const char* label) {
@@ -178,10 +177,10 @@ TEST_F(App, ClickStartThenSpacePausesAndResumes) {
   ASSERT_TRUE(app.live()->started);
   frame(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::flying);
-  key(app, ImGuiKey_Space);
+  key(app, ui::Key::space);
   EXPECT_TRUE(app.live()->runner->paused());
   EXPECT_EQ(app.run_info().state, ui::RunState::paused);
-  key(app, ImGuiKey_Space);
+  key(app, ui::Key::space);
   EXPECT_FALSE(app.live()->runner->paused());
   until_over(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::finished);
@@ -225,7 +224,7 @@ TEST_F(App, RestartFliesANewFlight) {
   frame(app);
   const cli::LiveFlight* first = app.live();
   ASSERT_GT(app.shown_time(), 0.2);
-  key(app, 'R');
+  key(app, ui::Key::r);
   EXPECT_NE(app.live(), first);
   EXPECT_TRUE(app.live()->started);
   EXPECT_LT(app.shown_time(), 0.2);
@@ -244,13 +243,16 @@ TEST_F(App, TheSessionPanelPicksTheScenario) {
   ASSERT_NE(std::find(c.pilots.begin(), c.pilots.end(), "experienced"), c.pilots.end());
   EXPECT_EQ(c.pilots[std::size_t(c.pilot)], "novice");
   // The request a pick in the combo makes, acted on by the app.
-  ui::UiRequest pick;
-  pick.scenario = int(it - c.scenarios.begin());
-  app.act(pick);
+  app.act(ui::PickScenario{int(it - c.scenarios.begin())});
   frame(app);
   EXPECT_EQ(app.live()->flight.mode->kind(), ModeKind::pendubot_swingup);
   EXPECT_FALSE(app.live()->started);
   EXPECT_TRUE(app.run_info().session->pilots.empty()) << "the Pendubot mode has no pilot";
+  // Ctrl+R: the next flight is recorded, and the panel says where.
+  ASSERT_FALSE(app.run_info().session->record);
+  key(app, ui::Key::r, true);
+  EXPECT_TRUE(app.run_info().session->record);
+  EXPECT_FALSE(app.run_info().session->record_to.empty());
 }
 
 // A replay: ] jumps to the next event, Home / End, a click on the timeline seeks there, ↑ speeds
@@ -270,13 +272,13 @@ TEST_F(App, ReplayTimelineSeeksJumpsAndPlays) {
   const ui::ReplayInfo& r = *app.run_info().replay;
   ASSERT_FALSE(r.events.empty()) << "the reckless pilot's takeover is no event";
   EXPECT_EQ(app.replay()->mismatch(), "");
-  key(app, ']');
+  key(app, ui::Key::right_bracket);
   EXPECT_DOUBLE_EQ(r.t, r.events.front().t);
-  key(app, ImGuiKey_End);
+  key(app, ui::Key::end);
   EXPECT_NEAR(r.t, r.duration - app.replay()->dt(), 1e-9);
-  key(app, '[');
+  key(app, ui::Key::left_bracket);
   EXPECT_DOUBLE_EQ(r.t, r.events.back().t);
-  key(app, ImGuiKey_Home);
+  key(app, ui::Key::home);
   EXPECT_EQ(r.t, 0.0);
   // The timeline spans the transport bar's width: its middle is the recording's middle.
   ImGuiWindow* bar = ImGui::FindWindowByName("##transport");
@@ -284,15 +286,29 @@ TEST_F(App, ReplayTimelineSeeksJumpsAndPlays) {
   const ImVec2 mid(0.5f * (bar->InnerRect.Min.x + bar->InnerRect.Max.x), bar->InnerRect.Min.y + 12);
   click(app, mid);
   EXPECT_NEAR(r.t, 0.5 * r.duration, 0.02 * r.duration);
-  key(app, ImGuiKey_UpArrow);
+  key(app, ui::Key::up);
   EXPECT_EQ(app.run_info().speed, 2.0);
-  key(app, ImGuiKey_Space);
+  key(app, ui::Key::space);
   ASSERT_TRUE(r.playing);
   const double before = r.t;
   frame(app, 0.5);
   EXPECT_NEAR(r.t - before, 1.0, 1e-9) << "0.5 s of wall time at 2x";
   // The frame shows the step under the playhead.
   EXPECT_NEAR(app.shown_time(), r.t, 1e-9);
+  // ↓ slows it down again; → steps 100 ms; Esc leaves the replay for a live flight of the
+  // recording's pilot.
+  key(app, ui::Key::space);
+  ASSERT_FALSE(r.playing);
+  key(app, ui::Key::down);
+  EXPECT_EQ(app.run_info().speed, 1.0);
+  const double at = r.t;
+  key(app, ui::Key::right);
+  EXPECT_NEAR(r.t, at + 0.1, 1e-9);
+  key(app, ui::Key::escape);
+  EXPECT_FALSE(app.replaying());
+  ASSERT_TRUE(app.live());
+  EXPECT_FALSE(app.live()->started);
+  EXPECT_EQ(app.run_info().state, ui::RunState::ready);
 }
 
 // A recording of every mode replays in the app, bit for bit, and draws.
@@ -400,15 +416,15 @@ TEST_F(App, HelpAndOpenDialogFromTheKeyboard) {
   int status = 0;
   ASSERT_TRUE(app.open_live(error, status)) << error;
   frame(app);
-  key(app, ui::kKeyF1);
+  key(app, ui::Key::f1);
   EXPECT_TRUE(app.ui_state().show_help);
   frame(app);
   save_shot(screen_, "help");
   const ImGuiWindow* sheet = ImGui::FindWindowByName("Keyboard and mouse (F1)");
   EXPECT_TRUE(sheet && sheet->Active);
-  key(app, ImGuiKey_Escape);
+  key(app, ui::Key::escape);
   EXPECT_FALSE(app.ui_state().show_help);
-  key(app, 'O', true);
+  key(app, ui::Key::o, true);
   EXPECT_TRUE(app.ui_state().open_dialog.open);
   EXPECT_FALSE(app.ui_state().open_dialog.entries.empty());
   frame(app);  // a popup shows from its second frame
@@ -508,14 +524,14 @@ TEST_F(App, TheKeyboardFliesFromInjectedKeys) {
                                                                           : 0;
       presses += want != 0 && want != a.held;
       a.held = want;
-      io.KeysDown[ui::kFlightKeys[int(a.plus)]] = want > 0;
-      io.KeysDown[ui::kFlightKeys[int(a.minus)]] = want < 0;
+      ui::set_key(io, ui::kFlightKeys[int(a.plus)], want > 0);
+      ui::set_key(io, ui::kFlightKeys[int(a.minus)], want < 0);
     }
     last_t = t;
     frame(app);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  for (const int key : ui::kFlightKeys) io.KeysDown[key] = false;
+  for (const ui::Key k : ui::kFlightKeys) ui::set_key(io, k, false);
   ASSERT_TRUE(app.over());
   EXPECT_GT(presses, 3) << "the novice's commands gave hardly any key presses";
   const Metrics live = app.live()->metrics;
@@ -555,7 +571,7 @@ TEST_F(App, TheInputSettingsPanel) {
   int status = 0;
   ASSERT_TRUE(app.open_live(error, status)) << error;
   frame(app);
-  key(app, 'I');
+  key(app, ui::Key::i);
   EXPECT_TRUE(app.ui_state().show_settings);
   frame(app);
   frame(app);
@@ -569,7 +585,7 @@ TEST_F(App, TheInputSettingsPanel) {
   click(app, *apply);
   ASSERT_TRUE(app.run_info().input && app.run_info().input->settings);
   EXPECT_EQ(app.run_info().input->settings->mode, 1);
-  key(app, 'I');
+  key(app, ui::Key::i);
   EXPECT_FALSE(app.ui_state().show_settings);
 }
 
@@ -589,7 +605,7 @@ TEST_F(App, ABrokenSettingsFileGivesTheDefaultsAndSaysWhy) {
             std::string::npos)
       << app.run_info().message;
   save_shot(screen_, "input_settings_broken_start");
-  key(app, 'I');
+  key(app, ui::Key::i);
   frame(app, 0.0);
   const ui::InputInfo& in = *app.run_info().input;
   EXPECT_EQ(in.settings->mode, 2);
@@ -663,7 +679,7 @@ TEST_F(App, TheMappingWizardMakesAnUnknownJoystickAGamepad) {
   std::string error;
   int status = 0;
   ASSERT_TRUE(app.open_live(error, status)) << error;
-  key(app, 'I');
+  key(app, ui::Key::i);
   const auto listed = [&] {
     for (int i = 0; i < 100; ++i) {
       frame(app, 0.0);
@@ -776,11 +792,11 @@ TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
       for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
       save_shot(screen, std::string("layout_") + state + "_" + at);
     };
-    const auto press = [&](cli::Trainer& app, int k, bool ctrl = false) {
+    const auto press = [&](cli::Trainer& app, ui::Key k, bool ctrl = false) {
       ImGui::GetIO().KeyCtrl = ctrl;
-      ImGui::GetIO().KeysDown[k] = true;
+      ui::set_key(ImGui::GetIO(), k, true);
       frames(app, 1);
-      ImGui::GetIO().KeysDown[k] = false;
+      ui::set_key(ImGui::GetIO(), k, false);
       ImGui::GetIO().KeyCtrl = false;
       frames(app);
     };
@@ -790,16 +806,16 @@ TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
       ASSERT_TRUE(app.open_live(error, status)) << error;
       frames(app);
       check("ready");
-      press(app, ui::kKeyF1);
+      press(app, ui::Key::f1);
       check("help");
-      press(app, ImGui::GetIO().KeyMap[ImGuiKey_Escape]);
-      press(app, 'O', true);
+      press(app, ui::Key::escape);
+      press(app, ui::Key::o, true);
       check("open");
       app.ui_state().open_dialog.open = false;
       frames(app);
-      press(app, 'I');
+      press(app, ui::Key::i);
       check("settings");
-      press(app, 'I');
+      press(app, ui::Key::i);
       app.start();
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       frames(app);

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include <imgui.h>
@@ -22,6 +24,7 @@
 #include "ui/scene.hpp"
 #include "ui/screen.hpp"
 #include "ui/panels.hpp"
+#include "ui/requests.hpp"
 #include "ui/theme.hpp"
 
 #include "ui_layout.hpp"
@@ -67,6 +70,12 @@ Flown fly(const char* scenario, double seconds, const char* pilot = nullptr) {
   return f;
 }
 
+// One frame of the screen; what it asks for is dropped (these tests look at what it draws).
+void draw(const ui::Scene& scene, const ui::History& h, const ui::RunInfo& run, ui::UiState& st) {
+  ui::Requests ignored;
+  ui::draw_screen(scene, h, run, st, ignored);
+}
+
 class Ui : public testing::Test {
  protected:
   void SetUp() override {
@@ -76,7 +85,7 @@ class Ui : public testing::Test {
   std::vector<std::uint8_t> render(const ui::Scene& scene, const ui::History& h, ui::UiState& st) {
     ui::RunInfo run;
     run.state = ui::RunState::flying;
-    for (int f = 0; f < 2; ++f) screen_.frame([&] { (void)ui::draw_screen(scene, h, run, st); });
+    for (int f = 0; f < 2; ++f) screen_.frame([&] { draw(scene, h, run, st); });
     return screen_.pixels();
   }
   cli::Offscreen screen_;
@@ -175,12 +184,109 @@ TEST_F(Ui, KeyThreeSwitchesToTopCamera) {
   ui::UiState st;
   const auto chase = render(scene, f.history, st);
   ASSERT_EQ(st.camera, ui::Camera::chase);
-  ImGui::GetIO().KeysDown[int('3')] = true;
+  ui::set_key(ImGui::GetIO(), ui::Key::digit3, true);
   ui::RunInfo run;
-  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
-  ImGui::GetIO().KeysDown[int('3')] = false;
+  screen_.frame([&] { draw(scene, f.history, run, st); });
+  ui::set_key(ImGui::GetIO(), ui::Key::digit3, false);
   EXPECT_EQ(st.camera, ui::Camera::top);
   EXPECT_NE(render(scene, f.history, st), chase);
+}
+
+// The request of type T among `requests`, or nullptr.
+template <class T>
+const T* find_request(const ui::Requests& requests) {
+  const T* found = nullptr;
+  for (const ui::Request& r : requests)
+    std::visit([&](const auto& group) {
+      std::visit([&](const auto& one) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(one)>, T>) found = &one;
+      }, group);
+    }, r);
+  return found;
+}
+
+// The shortcut sheet's keys, by the UI's key names, ask for what they name (UI.md §10): each
+// press gives its typed request, in the state where it means something.
+TEST_F(Ui, KeysAskForWhatTheyName) {
+  Flown f = fly("mi_helix.toml", 0.5, "novice");
+  ASSERT_TRUE(f.mode);
+  const ui::Scene scene = ui::scene_of(*f.mode, "novice");
+  ui::UiState st;
+  ui::RunInfo run;
+  ui::SessionChoices session;
+  run.session = &session;
+  ui::Requests out;
+  // One frame with `k` going down (Ctrl, Shift held as asked), then one with it released.
+  const auto press = [&](ui::Key k, bool ctrl = false, bool shift = false) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.KeyCtrl = ctrl;
+    io.KeyShift = shift;
+    ui::set_key(io, k, true);
+    out.clear();
+    screen_.frame([&] { ui::draw_screen(scene, f.history, run, st, out); });
+    ui::set_key(io, k, false);
+    io.KeyCtrl = io.KeyShift = false;
+    screen_.frame([&] { draw(scene, f.history, run, st); });
+  };
+  screen_.frame([&] { draw(scene, f.history, run, st); });
+
+  // Ready: Space starts, Ctrl+R records the next flight, R flies again.
+  run.state = ui::RunState::ready;
+  press(ui::Key::space);
+  EXPECT_TRUE(find_request<ui::StartFlight>(out));
+  press(ui::Key::r, true);
+  ASSERT_TRUE(find_request<ui::SetRecord>(out));
+  EXPECT_TRUE(find_request<ui::SetRecord>(out)->on);
+  run.can_restart = true;
+  press(ui::Key::r);
+  EXPECT_TRUE(find_request<ui::RestartFlight>(out));
+  // Flying: Space pauses. Waiting for the remote vehicle: Esc cancels, Space does nothing.
+  run.state = ui::RunState::flying;
+  press(ui::Key::space);
+  EXPECT_TRUE(find_request<ui::TogglePause>(out));
+  run.state = ui::RunState::waiting;
+  press(ui::Key::escape);
+  EXPECT_TRUE(find_request<ui::CancelVehicleWait>(out));
+  press(ui::Key::space);
+  EXPECT_TRUE(out.empty());
+
+  // The keyboard pilot: the held flight keys, every frame, as input::Key bits.
+  ui::InputInfo keyboard;
+  keyboard.pilot = "keyboard";
+  run.input = &keyboard;
+  run.state = ui::RunState::flying;
+  press(ui::Key::w);
+  ASSERT_TRUE(find_request<ui::HeldFlightKeys>(out));
+  EXPECT_EQ(find_request<ui::HeldFlightKeys>(out)->keys, 1u << int(input::Key::thrust_up));
+  run.input = nullptr;
+
+  // A replay: Space plays, the arrows step and change the speed, brackets jump, Esc leaves.
+  ui::ReplayInfo replay;
+  replay.t = 1.0;
+  replay.duration = 4.0;
+  run.replay = &replay;
+  run.session = nullptr;
+  run.state = ui::RunState::replay;
+  run.speed = 1.0;
+  press(ui::Key::space);
+  EXPECT_TRUE(find_request<ui::TogglePlay>(out));
+  EXPECT_FALSE(find_request<ui::TogglePause>(out)) << "a replay's Space is no live request";
+  press(ui::Key::right);
+  ASSERT_TRUE(find_request<ui::Seek>(out));
+  EXPECT_DOUBLE_EQ(find_request<ui::Seek>(out)->t, 1.1);
+  press(ui::Key::left, false, true);
+  ASSERT_TRUE(find_request<ui::Seek>(out));
+  EXPECT_DOUBLE_EQ(find_request<ui::Seek>(out)->t, 0.99);
+  press(ui::Key::down);
+  ASSERT_TRUE(find_request<ui::SetPlaySpeed>(out));
+  EXPECT_EQ(find_request<ui::SetPlaySpeed>(out)->speed, 0.5);
+  press(ui::Key::left_bracket);
+  ASSERT_TRUE(find_request<ui::JumpToEvent>(out));
+  EXPECT_EQ(find_request<ui::JumpToEvent>(out)->direction, -1);
+  press(ui::Key::escape);
+  EXPECT_TRUE(find_request<ui::LeaveReplay>(out));
+  press(ui::Key::r);
+  EXPECT_FALSE(find_request<ui::RestartFlight>(out)) << "R restarts live flights only";
 }
 
 // At the end of a flight the score card opens with every score field; not before.
@@ -191,7 +297,7 @@ TEST_F(Ui, ScoreCardAtTheEnd) {
   ui::UiState st;
   ui::RunInfo run;
   run.state = ui::RunState::flying;
-  screen_.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+  screen_.frame([&] { draw(scene, f.history, run, st); });
   const ImGuiWindow* card = ImGui::FindWindowByName("Score card");
   EXPECT_TRUE(card == nullptr || !card->Active);
   run.state = ui::RunState::finished;
@@ -199,7 +305,7 @@ TEST_F(Ui, ScoreCardAtTheEnd) {
   ASSERT_FALSE(run.metrics.empty());
   bool active = false;
   screen_.frame([&] {
-    (void)ui::draw_screen(scene, f.history, run, st);
+    draw(scene, f.history, run, st);
     card = ImGui::FindWindowByName("Score card");
     active = card && card->Active;
   });
@@ -313,7 +419,7 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
       ui::UiState st;
       ui::RunInfo run;
       run.state = ui::RunState::flying;
-      for (int i = 0; i < 3; ++i) screen.frame([&] { (void)ui::draw_screen(scene, f.history, run, st); });
+      for (int i = 0; i < 3; ++i) screen.frame([&] { draw(scene, f.history, run, st); });
       for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
       // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
       if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)

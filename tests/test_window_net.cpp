@@ -112,17 +112,14 @@ TEST_F(Net, TheWindowWaitsForTheVehicleWithoutFreezingAndCanCancel) {
   app.start();  // Start while waiting does nothing
   EXPECT_FALSE(app.live()->started);
 
-  ui::UiRequest restart;
-  restart.restart = true;
+  const ui::Request restart = ui::RestartFlight{};
   const auto t0 = std::chrono::steady_clock::now();
   app.act(restart);
   const double restart_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const double again = frames_for(screen, app, 0.8);
   EXPECT_EQ(app.run_info().state, ui::RunState::waiting);
-  ui::UiRequest cancel;
-  cancel.cancel_wait = true;
-  app.act(cancel);
+  app.act(ui::CancelVehicleWait{});
   screen.frame([&] { app.build_frame(0.0); }, 1e-4f);
   EXPECT_EQ(app.run_info().state, ui::RunState::ready);
   EXPECT_NE(app.run_info().message.find("the wait was cancelled"), std::string::npos)

@@ -53,11 +53,11 @@ unsigned held_flight_keys() {
   if (io.WantCaptureKeyboard || io.KeyCtrl) return 0;
   unsigned keys = 0;
   for (int k = 0; k < int(input::Key::count); ++k)
-    if (ImGui::IsKeyDown(kFlightKeys[k])) keys |= 1u << k;
+    if (key_down(kFlightKeys[k])) keys |= 1u << k;
   return keys;
 }
 
-void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
+void draw_input_settings(const RunInfo& run, UiState& ui, Requests& out) {
   if (!ui.show_settings || !run.input || !run.input->settings) return;
   const InputInfo& in = *run.input;
   if (!ui.draft_loaded) {
@@ -100,10 +100,10 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
     if (dev.mapped) {
       ImGui::BeginDisabled(dev.instance == in.active);
       const std::string use = (dev.instance == in.active ? "selected##" : "Select##") + dev.name;
-      if (ImGui::Button(use.c_str())) req.use_gamepad = dev.instance;
+      if (ImGui::Button(use.c_str())) out.push_back(UseGamepad{dev.instance});
       ImGui::EndDisabled();
     } else if (ImGui::Button(("Map it...##" + dev.name).c_str())) {
-      req.map_gamepad = dev.instance;
+      out.push_back(MapGamepad{dev.instance});
     }
     ImGui::SameLine();
     ImGui::TextWrapped("%s%s", dev.name.c_str(), dev.mapped ? "" : "  (SDL has no mapping for it)");
@@ -168,9 +168,9 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   ImGui::EndDisabled();
   ImGui::Separator();
   ImGui::TextDisabled("Changes apply from the next flight.");
-  if (ImGui::Button("Apply")) req.apply_settings = true;
+  if (ImGui::Button("Apply")) out.push_back(ApplySettings{s, false});
   ImGui::SameLine();
-  if (ImGui::Button("Save")) req.apply_settings = req.save_settings = true;
+  if (ImGui::Button("Save")) out.push_back(ApplySettings{s, true});
   ImGui::SameLine();
   if (ImGui::Button("Defaults")) s = input::InputSettings{};
   // Where Save writes: after the buttons, wrapping where the path is long.
@@ -186,7 +186,7 @@ void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req) {
   }
 }
 
-void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
+void draw_mapping_wizard(const RunInfo& run, Requests& out) {
   if (!run.input || !run.input->wizard) return;
   const WizardView& w = *run.input->wizard;
   const ImVec2 d = ImGui::GetIO().DisplaySize;
@@ -238,19 +238,18 @@ void draw_mapping_wizard(const RunInfo& run, UiRequest& req) {
   ImGui::TextWrapped("bound: %s", bound.empty() ? "nothing yet" : bound.c_str());
   if (!w.mapping.empty() && w.done) ImGui::TextWrapped("%s", w.mapping.c_str());
   ImGui::BeginDisabled(w.done || !w.optional);
-  if (ImGui::Button("Skip")) req.wizard_skip = true;
+  if (ImGui::Button("Skip")) out.push_back(WizardSkip{});
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(w.step == 0);
-  if (ImGui::Button("Back")) req.wizard_back = true;
+  if (ImGui::Button("Back")) out.push_back(WizardBack{});
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(w.mapping.empty());
-  if (ImGui::Button("Save")) req.wizard_save = true;
+  if (ImGui::Button("Save")) out.push_back(WizardSave{});
   ImGui::EndDisabled();
   ImGui::SameLine();
-  if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
-    req.wizard_cancel = true;
+  if (ImGui::Button("Cancel") || key_pressed(Key::escape)) out.push_back(WizardCancel{});
   ImGui::End();
 }
 

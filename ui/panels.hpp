@@ -30,18 +30,18 @@ void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
 // Rolling plots of the mode's channels (frozen while ui.plots_paused).
 void draw_plots(const Scene& scene, const History& history, UiState& ui);
 // The session panel: scenario, pilot, trainee, record, start / restart (run.session).
-void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req);
+void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out);
 // A replay's transport bar: timeline with event ticks, play / pause, events, speeds (run.replay).
-void draw_transport(const RunInfo& run, UiRequest& req);
+void draw_transport(const RunInfo& run, Requests& out);
 // File → Open: a modal browser of scenarios and recordings while ui.open_dialog.open.
-void draw_open_dialog(UiState& ui, UiRequest& req);
+void draw_open_dialog(UiState& ui, Requests& out);
 // Fills the dialog's entries from its folder.
 void list_folder(OpenDialog& dialog);
 // The input settings panel (ui.show_settings, run.input): stick mode, tilt and thrust, each
 // axis's curve with the live stick on it, input loss, haptic cue; Apply / Save.
-void draw_input_settings(const RunInfo& run, UiState& ui, UiRequest& req);
+void draw_input_settings(const RunInfo& run, UiState& ui, Requests& out);
 // The mapping wizard (while InputInfo::wizard is set): the prompt, the raw device, the line.
-void draw_mapping_wizard(const RunInfo& run, UiRequest& req);
+void draw_mapping_wizard(const RunInfo& run, Requests& out);
 // The input-loss banner over the view while the pilot's device is lost or not yet back.
 void draw_input_banner(const History& history, const RunInfo& run, ImVec2 min, ImVec2 max);
 // The flight keys held now (bit k: input::Key k).

@@ -83,14 +83,14 @@ void begin_pane(const char* name, ImVec2 pos, float width, ImVec2 pivot = ImVec2
 // The top bar: the pill, the title, Open and Help; then the flight's controls and time, the
 // recording mark and the app's message, wrapping onto further rows where the width runs out.
 // Returns its height.
-float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui, UiRequest& req,
+float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui, Requests& out,
               float width) {
   begin_pane("##top", ImVec2(0, 0), width);
   pill(to_string(run.state), state_colour(run.state));
   ImGui::SameLine();
   // A replay has its controls and its time in the transport bar: here only the way back.
   if (run.replay) {
-    if (ImGui::Button("Back to live (Esc)")) req.leave_replay = true;
+    if (ImGui::Button("Back to live (Esc)")) out.push_back(LeaveReplay{});
     ImGui::SameLine();
   }
   // File and help at the right end; the title gives way to them (elided, full text on hover).
@@ -119,20 +119,21 @@ float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui
       return ImGui::Button(label);
     };
     if (run.state == RunState::ready) {
-      if (button("Start (Space)")) req.start = true;
+      if (button("Start (Space)")) out.push_back(StartFlight{});
     } else if (run.state == RunState::waiting) {
-      if (button("Cancel (Esc)")) req.cancel_wait = true;
+      if (button("Cancel (Esc)")) out.push_back(CancelVehicleWait{});
     } else if (run.state == RunState::flying || run.state == RunState::paused) {
       if (button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
-        req.toggle_pause = true;
+        out.push_back(TogglePause{});
     }
-    if (run.can_restart && run.state != RunState::ready && button("Restart (R)")) req.restart = true;
+    if (run.can_restart && run.state != RunState::ready && button("Restart (R)"))
+      out.push_back(RestartFlight{});
     for (double sp : {0.25, 0.5, 1.0}) {
       char label[16];
       std::snprintf(label, sizeof label, "%gx", sp);
       if (!first) same_line_or_wrap(radio_width(label));
       first = false;
-      if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
+      if (ImGui::RadioButton(label, run.speed == sp)) out.push_back(SetFlightSpeed{sp});
     }
     const Telemetry* s = h.empty() ? nullptr : &h.newest();
     ImGui::PushFont(mono_font());
@@ -421,58 +422,61 @@ void help_sheet(UiState& ui, ImVec2 display) {
   ImGui::End();
 }
 
-bool pressed(int key) { return ImGui::IsKeyPressed(key); }
-bool pressed(ImGuiKey_ key) { return ImGui::IsKeyPressed(ImGui::GetKeyIndex(key)); }
-
 // The replay speeds, slowest first (↑ / ↓ move along them).
 constexpr double kReplaySpeeds[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
 
-void replay_keys(const RunInfo& run, UiRequest& req) {
+void replay_keys(const RunInfo& run, Requests& out) {
   const ReplayInfo& r = *run.replay;
   const ImGuiIO& io = ImGui::GetIO();
   const double step = io.KeyShift ? 0.01 : io.KeyAlt ? 0.5 : 0.1;
-  if (pressed(ImGuiKey_LeftArrow)) req.seek = std::max(0.0, r.t - step);
-  if (pressed(ImGuiKey_RightArrow)) req.seek = std::min(r.loaded * r.duration, r.t + step);
-  if (pressed(ImGuiKey_Home)) req.seek = 0.0;
-  if (pressed(ImGuiKey_End)) req.seek = r.loaded * r.duration;
+  if (key_pressed(Key::left)) out.push_back(Seek{std::max(0.0, r.t - step)});
+  if (key_pressed(Key::right)) out.push_back(Seek{std::min(r.loaded * r.duration, r.t + step)});
+  if (key_pressed(Key::home)) out.push_back(Seek{0.0});
+  if (key_pressed(Key::end)) out.push_back(Seek{r.loaded * r.duration});
   const auto at = std::find(std::begin(kReplaySpeeds), std::end(kReplaySpeeds), run.speed);
-  if (pressed(ImGuiKey_UpArrow))
-    req.speed = at == std::end(kReplaySpeeds) || at + 1 == std::end(kReplaySpeeds) ? 8.0 : *(at + 1);
-  if (pressed(ImGuiKey_DownArrow))
-    req.speed = at == std::end(kReplaySpeeds) || at == std::begin(kReplaySpeeds) ? 0.25 : *(at - 1);
-  if (pressed('[')) req.jump = -1;
-  if (pressed(']')) req.jump = +1;
-  if (pressed(ImGuiKey_Escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId)) req.leave_replay = true;
+  const bool known = at != std::end(kReplaySpeeds);
+  const double faster = known && at + 1 != std::end(kReplaySpeeds) ? *(at + 1) : 8.0;
+  const double slower = known && at != std::begin(kReplaySpeeds) ? *(at - 1) : 0.25;
+  if (key_pressed(Key::up)) out.push_back(SetPlaySpeed{faster});
+  if (key_pressed(Key::down)) out.push_back(SetPlaySpeed{slower});
+  if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
+  if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
+  if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
+    out.push_back(LeaveReplay{});
 }
 
-void keys(UiState& ui, UiRequest& req, const RunInfo& run, const History& h) {
+void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
   const ImGuiIO& io = ImGui::GetIO();
   if (io.WantCaptureKeyboard || ui.open_dialog.open) return;
-  if (pressed(kKeyF1)) ui.show_help = !ui.show_help;
+  if (key_pressed(Key::f1)) ui.show_help = !ui.show_help;
   for (int i = 0; i < io.InputQueueCharacters.Size; ++i)
     if (io.InputQueueCharacters[i] == '?') ui.show_help = !ui.show_help;
   if (io.KeyCtrl) {
-    if (pressed('O')) ui.open_dialog.open = true;
-    if (pressed('R') && run.session) req.record = run.session->record ? 0 : 1;
+    if (key_pressed(Key::o)) ui.open_dialog.open = true;
+    if (key_pressed(Key::r) && run.session) out.push_back(SetRecord{!run.session->record});
     return;
   }
-  if (pressed(ImGuiKey_Escape) && ui.show_help) ui.show_help = false;
-  else if (run.replay) replay_keys(run, req);
-  else if (pressed(ImGuiKey_Escape) && run.state == RunState::waiting) req.cancel_wait = true;
-  if (pressed(ImGuiKey_Space) && run.state != RunState::waiting)
-    (run.state == RunState::ready ? req.start : req.toggle_pause) = true;
-  if (pressed('R') && run.can_restart && !run.replay) req.restart = true;
-  if (pressed('1')) ui.camera = Camera::chase;
-  if (pressed('2')) ui.camera = Camera::orbit;
-  if (pressed('3')) ui.camera = Camera::top;
-  if (pressed('4')) ui.camera = Camera::side;
+  if (key_pressed(Key::escape) && ui.show_help) ui.show_help = false;
+  else if (run.replay) replay_keys(run, out);
+  else if (key_pressed(Key::escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
+  // Space is the transport's: a replay plays or pauses, a live flight starts, pauses or resumes.
+  if (key_pressed(Key::space) && run.state != RunState::waiting) {
+    if (run.replay) out.push_back(TogglePlay{});
+    else if (run.state == RunState::ready) out.push_back(StartFlight{});
+    else out.push_back(TogglePause{});
+  }
+  if (key_pressed(Key::r) && run.can_restart && !run.replay) out.push_back(RestartFlight{});
+  if (key_pressed(Key::digit1)) ui.camera = Camera::chase;
+  if (key_pressed(Key::digit2)) ui.camera = Camera::orbit;
+  if (key_pressed(Key::digit3)) ui.camera = Camera::top;
+  if (key_pressed(Key::digit4)) ui.camera = Camera::side;
   const bool keyboard_flies = run.input && run.input->pilot == "keyboard" && !run.replay;
-  if (pressed('D') && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
-  if (pressed('I') && run.input) {
+  if (key_pressed(Key::d) && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
+  if (key_pressed(Key::i) && run.input) {
     ui.show_settings = !ui.show_settings;
     ui.draft_loaded = false;
   }
-  if (pressed('P')) set_plots_paused(ui, h, !ui.plots_paused);
+  if (key_pressed(Key::p)) set_plots_paused(ui, h, !ui.plots_paused);
 }
 
 }  // namespace
@@ -548,17 +552,17 @@ void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max) {
   min = frame_min(min, max, run, hud_bottom);
 }
 
-UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState& ui) {
-  UiRequest req;
+void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState& ui,
+                 Requests& out) {
   const ImVec2 d = ImGui::GetIO().DisplaySize;
   const ImGuiStyle& st = ImGui::GetStyle();
   const float em = ImGui::GetFontSize();
   // The panes take their heights from their content (top bar, transport), the view the rest.
-  const float top = top_bar(sc, h, run, ui, req, d.x);
+  const float top = top_bar(sc, h, run, ui, out, d.x);
   float bottom = 0.0f;
   if (run.replay) {
     begin_pane("##transport", ImVec2(0, d.y), d.x, ImVec2(0, 1));
-    draw_transport(run, req);
+    draw_transport(run, out);
     bottom = ImGui::GetWindowHeight();
     ImGui::End();
   }
@@ -581,7 +585,7 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                      ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                      ImGuiWindowFlags_AlwaysAutoResize);
-    draw_session_panel(run, ui, req);
+    draw_session_panel(run, ui, out);
     panel_max = ImVec2(ImGui::GetWindowPos().x + ImGui::GetWindowWidth(),
                        ImGui::GetWindowPos().y + ImGui::GetWindowHeight());
     ImGui::End();
@@ -650,12 +654,12 @@ UiRequest draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiS
   else if (!ui.score_card_closed) score_card(run, ui, d);
   if (ui.show_help) help_sheet(ui, d);
   draw_input_banner(h, run, frame, vmax);
-  draw_input_settings(run, ui, req);
-  draw_mapping_wizard(run, req);
-  draw_open_dialog(ui, req);
-  keys(ui, req, run, h);
-  if (run.input && run.input->pilot == "keyboard" && !run.replay) req.flight_keys = held_flight_keys();
-  return req;
+  draw_input_settings(run, ui, out);
+  draw_mapping_wizard(run, out);
+  draw_open_dialog(ui, out);
+  keys(ui, out, run, h);
+  if (run.input && run.input->pilot == "keyboard" && !run.replay)
+    out.push_back(HeldFlightKeys{held_flight_keys()});
 }
 
 void set_plots_paused(UiState& ui, const History& h, bool paused) {

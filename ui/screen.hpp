@@ -1,8 +1,9 @@
 #pragma once
 // The whole window, one frame at a time (SPEC §8, UI.md §1): a top bar with the status pill,
 // the session buttons and the authority bar; the session panel; the arena (3D) or Pendubot (2D)
-// view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A function of the scene, the telemetry history
-// and the UI's own state; what the user asked for comes back as a UiRequest.
+// view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A
+// function of the scene, the telemetry history and the UI's own state; what the user asked for
+// comes back as requests (ui/requests.hpp). Keys by the UI's own names (ui/keys.hpp).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -13,6 +14,8 @@
 #include "input/mapping.hpp"
 #include "input/mapping_wizard.hpp"
 #include "input/settings.hpp"
+#include "ui/keys.hpp"
+#include "ui/requests.hpp"
 #include "ui/scene.hpp"
 
 namespace mixpilot::ui {
@@ -145,32 +148,6 @@ struct UiState {
   bool draft_loaded = false;
 };
 
-// What the user asked for in this frame (buttons, keys); the app acts on it.
-struct UiRequest {
-  bool start = false;
-  bool toggle_pause = false;   // live: pause / resume; replay: play / pause
-  bool restart = false;
-  bool cancel_wait = false;    // stop waiting for the remote vehicle (Esc)
-  bool quit = false;
-  double speed = 0.0;          // > 0: a new speed (live: 0.25–1; replay: 0.25–8)
-  int scenario = -1;           // ≥ 0: fly this scenario of SessionChoices next
-  int pilot = -1;              // ≥ 0: with this pilot
-  int record = -1;             // 0 / 1: record the next flight or not
-  bool trainee_changed = false;
-  std::string trainee;
-  std::string open;            // a file to open: a scenario (.toml) or a recording (.mcap)
-  bool leave_replay = false;   // back to the live flight (Esc)
-  double seek = -1.0;          // ≥ 0: move the playhead there [s]
-  int jump = 0;                // −1 / +1: previous / next event
-  double lambda_threshold = -1.0;  // ≥ 0: a new threshold for "λ below" events
-  unsigned flight_keys = 0;        // bit k: input::Key k is held (the keyboard pilot)
-  bool apply_settings = false;     // use UiState::draft from the next flight on
-  bool save_settings = false;      // ... and write it to InputInfo::settings_path
-  std::int32_t use_gamepad = -2;   // fly with this SDL instance (-1: the first; -2: no change)
-  std::int32_t map_gamepad = -1;   // start the mapping wizard for this SDL instance
-  bool wizard_skip = false, wizard_back = false, wizard_cancel = false, wizard_save = false;
-};
-
 // The events of a flight for a replay's timeline: collisions, fallbacks (overruns included),
 // the vehicle lost, and λ crossing `lambda_threshold` downwards (mixed initiative).
 std::vector<TimelineEvent> timeline_events(const History& flight, double lambda_threshold);
@@ -179,9 +156,9 @@ std::vector<TimelineEvent> timeline_events(const History& flight, double lambda_
 double event_after(const std::vector<TimelineEvent>& events, double t, int direction);
 
 // Builds one frame's ImGui windows over the whole display (between ImGui::NewFrame() and
-// ImGui::Render()).
-UiRequest draw_screen(const Scene& scene, const History& history, const RunInfo& run,
-                      UiState& ui);
+// ImGui::Render()); appends what the user asked for to `requests`.
+void draw_screen(const Scene& scene, const History& history, const RunInfo& run, UiState& ui,
+                 Requests& requests);
 
 // Where the arena or Pendubot view frames its scene (the chase camera keeps the vehicle at its
 // centre) on a display of size `display` [pixels], as the last frame laid it out: the view pane
@@ -191,14 +168,5 @@ void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max);
 
 // Freezes the plots at the newest time of `h` (or lets them roll again).
 void set_plots_paused(UiState& ui, const History& h, bool paused);
-
-// The keys that fly with the keyboard pilot (input/keyboard.hpp), as GLFW key codes, indexed
-// by input::Key: W S A D and the arrows.
-inline constexpr int kFlightKeys[] = {'W', 'S', 'A', 'D', 265 /*up*/, 264 /*down*/,
-                                      263 /*left*/, 262 /*right*/};
-
-// GLFW's key code for F1: the window's backend and the headless renderer both use GLFW's key
-// codes (ImGui 1.86 has no ImGuiKey for F1).
-inline constexpr int kKeyF1 = 290;
 
 }  // namespace mixpilot::ui

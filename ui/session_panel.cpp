@@ -29,7 +29,7 @@ bool combo(const char* label, const std::vector<std::string>& items, int current
 
 }  // namespace
 
-void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
+void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
   const SessionChoices& c = *run.session;
   // Choices apply to the next flight: fixed while one flies.
   const bool flying = run.state == RunState::flying || run.state == RunState::paused;
@@ -39,10 +39,10 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
   ImGui::PushTextWrapPos(0.0f);
   ImGui::SetNextItemWidth(fields);
   int chosen = -1;
-  if (combo("scenario", c.scenarios, c.scenario, chosen)) req.scenario = chosen;
+  if (combo("scenario", c.scenarios, c.scenario, chosen)) out.push_back(PickScenario{chosen});
   if (!c.pilots.empty()) {
     ImGui::SetNextItemWidth(fields);
-    if (combo("pilot", c.pilots, c.pilot, chosen)) req.pilot = chosen;
+    if (combo("pilot", c.pilots, c.pilot, chosen)) out.push_back(PickPilot{chosen});
   }
   if (run.input && !run.input->pilot.empty()) {
     if (run.input->pilot == "keyboard")
@@ -61,19 +61,17 @@ void draw_session_panel(const RunInfo& run, UiState& ui, UiRequest& req) {
   if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())
     std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
   ImGui::InputTextWithHint("trainee", "your name", ui.trainee, sizeof ui.trainee);
-  if (ImGui::IsItemDeactivatedAfterEdit()) {
-    req.trainee_changed = true;
-    req.trainee = ui.trainee;
-  }
+  if (ImGui::IsItemDeactivatedAfterEdit()) out.push_back(SetTrainee{ui.trainee});
   bool record = c.record;
-  if (ImGui::Checkbox("record (Ctrl+R)", &record)) req.record = record ? 1 : 0;
+  if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());
   ImGui::PopTextWrapPos();
   ImGui::EndDisabled();
   if (run.state == RunState::ready) {
-    if (ImGui::Button("Start flight (Space)", ImVec2(-1, 0))) req.start = true;
+    if (ImGui::Button("Start flight (Space)", ImVec2(-1, 0))) out.push_back(StartFlight{});
   } else if (run.can_restart) {
-    if (ImGui::Button(flying ? "Restart (R)" : "Fly again (R)", ImVec2(-1, 0))) req.restart = true;
+    if (ImGui::Button(flying ? "Restart (R)" : "Fly again (R)", ImVec2(-1, 0)))
+      out.push_back(RestartFlight{});
   }
 }
 
@@ -96,7 +94,7 @@ void list_folder(OpenDialog& d) {
   d.entries.insert(d.entries.end(), files.begin(), files.end());
 }
 
-void draw_open_dialog(UiState& ui, UiRequest& req) {
+void draw_open_dialog(UiState& ui, Requests& out) {
   OpenDialog& d = ui.open_dialog;
   if (d.open && !ImGui::IsPopupOpen("Open a scenario or a recording")) {
     if (d.folder.empty()) {
@@ -129,7 +127,7 @@ void draw_open_dialog(UiState& ui, UiRequest& req) {
   const float footer = ImGui::GetFrameHeightWithSpacing() * 2.2f;
   ImGui::BeginChild("##entries", ImVec2(0, -footer), true);
   if (!d.error.empty()) ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", d.error.c_str());
-  std::string enter;
+  std::string enter, open;  // a folder to enter, a file to open
   for (const std::string& e : d.entries) {
     if (ImGui::Selectable(e.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick)) {
       const std::string full = (std::filesystem::path(d.folder) / e).string();
@@ -137,7 +135,7 @@ void draw_open_dialog(UiState& ui, UiRequest& req) {
         enter = (std::filesystem::path(d.folder) / e.substr(0, e.size() - 1)).string();
       } else {
         std::snprintf(d.path, sizeof d.path, "%s", full.c_str());
-        if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) req.open = full;
+        if (ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) open = full;
       }
     }
   }
@@ -150,11 +148,13 @@ void draw_open_dialog(UiState& ui, UiRequest& req) {
   ImGui::SetNextItemWidth(-2 * (button_w + ImGui::GetStyle().ItemSpacing.x));
   const bool typed = ImGui::InputText("##path", d.path, sizeof d.path, ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
-  if ((ImGui::Button("Open", ImVec2(button_w, 0)) || typed) && d.path[0] != '\0') req.open = d.path;
+  if ((ImGui::Button("Open", ImVec2(button_w, 0)) || typed) && d.path[0] != '\0') open = d.path;
   ImGui::SameLine();
-  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || key_pressed(Key::escape)) d.open = false;
+  if (!open.empty()) {
+    out.push_back(OpenFile{std::move(open)});
     d.open = false;
-  if (!req.open.empty()) d.open = false;
+  }
   if (!d.open) ImGui::CloseCurrentPopup();
   ImGui::EndPopup();
 }

@@ -89,7 +89,7 @@ void tick(ImDrawList* dl, float x, float top, float bottom, EventKind k) {
 
 }  // namespace
 
-void draw_transport(const RunInfo& run, UiRequest& req) {
+void draw_transport(const RunInfo& run, Requests& out) {
   const ReplayInfo& r = *run.replay;
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const float w = ImGui::GetContentRegionAvail().x;
@@ -103,7 +103,7 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
   const auto t_at_mouse = [&] {
     return double(std::clamp((ImGui::GetIO().MousePos.x - min.x) / w, 0.0f, 1.0f)) * span;
   };
-  if (ImGui::IsItemActive()) req.seek = std::min(t_at_mouse(), r.loaded * span);
+  if (ImGui::IsItemActive()) out.push_back(Seek{std::min(t_at_mouse(), r.loaded * span)});
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%.2f s", t_at_mouse());
   const float ty = min.y + 0.5f * height, th = scaled(3.0f);
   dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(max.x, ty + th), colour::rgb(0x30, 0x34, 0x3A), th);
@@ -115,11 +115,11 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
   dl->AddCircleFilled(ImVec2(x_of(r.t), ty), scaled(7.0f), colour::kText, 16);
 
   // The controls, wrapping onto more rows where the bar is narrow.
-  if (ImGui::Button(r.playing ? "Pause (Space)" : "Play (Space)")) req.toggle_pause = true;
+  if (ImGui::Button(r.playing ? "Pause (Space)" : "Play (Space)")) out.push_back(TogglePlay{});
   same_line_or_wrap(button_width("< previous event ["));
-  if (ImGui::Button("< previous event [")) req.jump = -1;
+  if (ImGui::Button("< previous event [")) out.push_back(JumpToEvent{-1});
   same_line_or_wrap(button_width("] next event >"));
-  if (ImGui::Button("] next event >")) req.jump = +1;
+  if (ImGui::Button("] next event >")) out.push_back(JumpToEvent{+1});
   ImGui::PushFont(mono_font());
   char time[48];
   std::snprintf(time, sizeof time, "%7.2f / %.2f s", r.t, r.duration);
@@ -130,14 +130,14 @@ void draw_transport(const RunInfo& run, UiRequest& req) {
     char label[16];
     std::snprintf(label, sizeof label, "%gx", sp);
     same_line_or_wrap(radio_width(label));
-    if (ImGui::RadioButton(label, run.speed == sp)) req.speed = sp;
+    if (ImGui::RadioButton(label, run.speed == sp)) out.push_back(SetPlaySpeed{sp});
   }
   const float slider_w = 7.5f * ImGui::GetFontSize();
   same_line_or_wrap(slider_w);
   ImGui::SetNextItemWidth(slider_w);
   float threshold = float(r.lambda_threshold);
   if (ImGui::SliderFloat("##lambda", &threshold, 0.05f, 0.95f, "λ below %.2f"))
-    req.lambda_threshold = threshold;
+    out.push_back(SetLambdaThreshold{threshold});
   // The legend: each tick's shape and colour.
   const float lh = ImGui::GetTextLineHeight();
   const float mark = scaled(14.0f);

@@ -43,7 +43,11 @@ void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera
   st.camera = camera;
   ui::RunInfo run;
   run.state = ui::RunState::flying;
-  for (auto _ : state) screen.frame([&] { (void)ui::draw_screen(scene, history, run, st); });
+  ui::Requests requests;
+  for (auto _ : state) {
+    requests.clear();
+    screen.frame([&] { ui::draw_screen(scene, history, run, st, requests); });
+  }
 }
 
 BENCHMARK_CAPTURE(BM_UiFrame, mi_chase, "mi_helix.toml", ui::Camera::chase)

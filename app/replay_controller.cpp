@@ -1,0 +1,127 @@
+#include "app/replay_controller.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "app/cli.hpp"
+
+namespace mixpilot::cli {
+
+ReplayController::ReplayController(const char* command, bool allow_mismatch, StatusLine& status)
+    : command_(command), allow_mismatch_(allow_mismatch), status_(status) {}
+
+ReplayController::~ReplayController() {
+  if (tape_) tape_->stop();
+}
+
+std::optional<Flight> ReplayController::prepare(const std::string& path, std::string& error) const {
+  FlyOptions o;
+  o.pilot = path;
+  o.replay = true;
+  o.command = command_;
+  int status = 0;
+  return prepare_flight(o, error, status);
+}
+
+void ReplayController::open(Flight flight, const std::string& path) {
+  tape_ = std::make_unique<ReplayTape>(std::move(flight), path);
+  tape_->start();
+  info_ = ui::ReplayInfo{};
+  info_.duration = double(tape_->steps()) * tape_->dt();
+  events_final_ = false;
+}
+
+void ReplayController::close() { tape_.reset(); }
+
+void ReplayController::load() {
+  if (tape_) tape_->fly();
+}
+
+void ReplayController::handle(const ui::ReplayRequest& r) {
+  if (!tape_) return;
+  ui::ReplayInfo& info = info_;
+  // The playhead stays on a step that is ready: the last one is at (ready − 1) Δt.
+  const auto last = [&] { return tape_->ready() ? double(tape_->ready() - 1) * tape_->dt() : 0.0; };
+  std::visit(ui::overloaded{
+                 [&](const ui::TogglePlay&) {
+                   if (!info.playing && tape_->done() && info.t >= last())
+                     info.t = 0.0;  // played to the end: Play starts it again
+                   info.playing = !info.playing;
+                 },
+                 [&](const ui::SetPlaySpeed& s) { speed_ = std::clamp(s.speed, 0.25, 8.0); },
+                 [&](const ui::Seek& s) { info.t = std::clamp(s.t, 0.0, last()); },
+                 [&](const ui::JumpToEvent& j) {
+                   const double t = ui::event_after(info.events, info.t, j.direction);
+                   if (t >= 0) info.t = t;
+                 },
+                 [&](const ui::SetLambdaThreshold& l) {
+                   info.lambda_threshold = l.lambda;
+                   events_final_ = false;  // found again on the next frame
+                 },
+             },
+             r);
+}
+
+void ReplayController::update(double wall_dt, ui::RunInfo& run) {
+  ReplayTape& r = *tape_;
+  ui::ReplayInfo& info = info_;
+  const std::size_t ready = r.ready();
+  info.duration = double(r.steps()) * r.dt();
+  info.loaded = r.steps() ? double(ready) / double(r.steps()) : 1.0;
+  if (r.done()) info.loaded = 1.0;
+  const double last = ready ? double(ready - 1) * r.dt() : 0.0;
+  if (info.playing) {
+    info.t += wall_dt * speed_;
+    if (info.t >= last) {
+      info.t = last;
+      if (r.done()) info.playing = false;  // at the end
+    }
+  }
+  if (r.done() && !events_final_) {
+    info.events = ui::timeline_events(ui::History::view(r.tape(), ready), info.lambda_threshold);
+    events_final_ = true;
+    if (!r.mismatch().empty() && r.mismatch() != "interrupted")
+      status_.say("the replay differs from the recording: " + r.mismatch(), true);
+  }
+  run.state = r.done() ? ui::RunState::replay : ui::RunState::loading;
+  run.speed = speed_;
+  run.deadline_misses = 0;
+  run.fallbacks = 0;
+  const std::size_t k = tape_index(r, info.t);
+  // The replay marks the recorded flight's overruns and deadline misses (Mode::replay_timing):
+  // the tape counts what the flight counted.
+  for (std::size_t i = 0; i < ready && i <= k; ++i) ui::count_step(r.tape()[i], run);
+  run.recording = false;
+  run.can_restart = false;
+  run.metrics = r.done() && ready > 0 && k + 1 >= ready ? r.metrics() : Metrics{};
+  run.replay = &info;
+  run.session = nullptr;
+}
+
+ui::History ReplayController::shown() const {
+  const std::size_t n = tape_->ready();
+  return ui::History::view(tape_->tape(), n ? tape_index(*tape_, info_.t) + 1 : 0);
+}
+
+bool ReplayController::over() const {
+  const std::size_t n = tape_->ready();
+  return tape_->done() && (n == 0 || tape_index(*tape_, info_.t) + 1 >= n);
+}
+
+double ReplayController::shown_time() const { return tape_->ready() ? info_.t : -1.0; }
+
+int ReplayController::finish(int status) {
+  tape_->stop();
+  std::printf("mixpilot %s: %s", command_, tape_->mode().summary().c_str());
+  const std::string& diff = tape_->mismatch();
+  if (diff.empty()) {
+    std::printf("  replay exact: every recorded step reproduced bit for bit\n");
+  } else if (diff != "interrupted") {
+    std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n",
+                 command_, tape_->path().c_str(), diff.c_str());
+    if (!allow_mismatch_ && status == kExitOk) status = kExitReplayMismatch;
+  }
+  return status;
+}
+
+}  // namespace mixpilot::cli

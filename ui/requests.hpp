@@ -1,0 +1,99 @@
+#pragma once
+// What the user asked for in a frame (a button, a key), one small type per thing asked, grouped
+// by the lifecycle that acts on it: the live flight with the session's choices for the next one,
+// a replay, the input settings, the mapping wizard, and the app itself for what crosses them
+// (opening a file, leaving a replay). Panels push them; the app hands each group to its
+// controller. A panel asks for the transport of what it shows: a replay's buttons and keys push
+// replay requests, the live flight's push live ones.
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "input/settings.hpp"
+
+namespace mixpilot::ui {
+
+// The live flight, and the session panel's choices for the next one.
+struct StartFlight {};
+struct TogglePause {};        // pause / resume the flight
+struct SetFlightSpeed {
+  double speed;               // real-time factor: 0.25–1 (slow motion)
+};
+struct RestartFlight {};
+struct CancelVehicleWait {};  // stop waiting for the remote vehicle (Esc)
+struct HeldFlightKeys {       // the keyboard pilot's keys, every frame it flies
+  unsigned keys;              // bit k: input::Key k is held
+};
+struct PickScenario {
+  int index;                  // into SessionChoices::scenarios
+};
+struct PickPilot {
+  int index;                  // into SessionChoices::pilots
+};
+struct SetRecord {
+  bool on;                    // record the next flight
+};
+struct SetTrainee {
+  std::string name;
+};
+using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
+                                 CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
+                                 SetRecord, SetTrainee>;
+
+// A replay's transport.
+struct TogglePlay {};
+struct SetPlaySpeed {
+  double speed;               // 0.25–8
+};
+struct Seek {
+  double t;                   // [s] the playhead
+};
+struct JumpToEvent {
+  int direction;              // −1 previous, +1 next
+};
+struct SetLambdaThreshold {
+  double lambda;              // "λ below" events cross it downwards
+};
+using ReplayRequest = std::variant<TogglePlay, SetPlaySpeed, Seek, JumpToEvent, SetLambdaThreshold>;
+
+// The input settings panel.
+struct ApplySettings {
+  input::InputSettings settings;  // from the next flight on
+  bool save = false;              // and written to InputInfo::settings_path
+};
+struct UseGamepad {
+  std::int32_t instance;          // SDL's instance id (-1: the first connected)
+};
+using InputRequest = std::variant<ApplySettings, UseGamepad>;
+
+// The mapping wizard.
+struct MapGamepad {
+  std::int32_t instance;          // start mapping this SDL joystick
+};
+struct WizardSkip {};
+struct WizardBack {};
+struct WizardSave {};             // save the mapping and end the wizard
+struct WizardCancel {};
+using WizardRequest = std::variant<MapGamepad, WizardSkip, WizardBack, WizardSave, WizardCancel>;
+
+// Across the lifecycles.
+struct OpenFile {
+  std::string path;               // a scenario (.toml) or a recording (.mcap)
+};
+struct LeaveReplay {};            // back to the live flight (Esc)
+using AppRequest = std::variant<OpenFile, LeaveReplay>;
+
+// Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
+using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;
+// One frame's requests in the order asked. The app keeps one and clears it every frame: its
+// capacity stays, so frames allocate nothing for requests that carry no text.
+using Requests = std::vector<Request>;
+
+// Visits a request with one lambda per type: `std::visit(overloaded{...}, r)`.
+template <class... F>
+struct overloaded : F... {
+  using F::operator()...;
+};
+
+}  // namespace mixpilot::ui
