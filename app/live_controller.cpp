@@ -51,28 +51,13 @@ std::string file_name_part(std::string name) {
   return name == "." || name == ".." ? "_" : name;
 }
 
-bool is_flying(const LiveFlight& f) { return f.started && f.runner->running(); }
-
-// The recording of the flight `f` opened at `path` and added to its sinks; false with the
-// reason.
-bool open_recording(LiveFlight& f, const std::string& path, const std::string& trainee,
-                    bool overwrite, std::string& error) {
-  RecordingSink::Settings rs;
-  rs.when_full = RecordingSink::FullRing::drop;  // the control thread never waits on the disk
-  rs.slots = 4096;
-  if (!f.recorder.open(path, *f.flight.mode, session_info(f.flight, trainee), error, rs, overwrite))
-    return false;
-  f.record_path = path;
-  f.session->add_sink(&f.recorder);
-  return true;
-}
+bool is_flying(const LiveFlight& f) { return f.started() && f.runner().running(); }
 
 }  // namespace
 
 // ---- The flight's assembly ---------------------------------------------------------------
-// What knows how a live flight is put together from app/flight.hpp (prepare_flight, the sinks,
-// the runner, the remote vehicle) and taken apart again; the rest of the controller sees a
-// LiveFlight.
+// A live flight is a FlightRig (app/flight_rig.hpp) paced on the control thread, with what the
+// screen keeps of it.
 
 std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& status) {
   auto f = std::make_unique<LiveFlight>();
@@ -84,107 +69,80 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
     // A script's virtual pad must exist before SDL's pads are listed: the flight plugs it.
     if (o.gamepad_script.empty() && !(pad = input_.gamepad(error))) return nullptr;
   }
-  // The window never waits for a remote vehicle: update_vehicle_wait() listens frame by frame.
-  std::optional<Flight> flight = prepare_flight(o, error, status, pad, VehicleWait::later);
-  if (!flight) return nullptr;
-  f->flight = std::move(*flight);
-  if (f->flight.vehicle) {
-    f->awaiting_vehicle = true;
-    f->vehicle_deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                              std::chrono::duration<double>(o.vehicle_wait_s));
+  // The window never waits for a remote vehicle: update_vehicle_wait() polls it frame by frame.
+  f->rig = FlightRig::assemble(o, error, status, pad, VehicleWait::later);
+  if (!f->rig) return nullptr;
+  f->awaiting_vehicle = f->rig->poll_vehicle(error) == FlightRig::VehicleStatus::waiting;
+  const Flight& flight = f->rig->flight();
+  if (flight.devices && flight.devices->gamepad) input_.adopt(flight.devices->gamepad);
+  if (o.publish && !f->rig->publish(error)) {
+    status = kExitError;
+    return nullptr;
   }
-  if (f->flight.devices && f->flight.devices->gamepad) input_.adopt(f->flight.devices->gamepad);
-  Mode& mode = *f->flight.mode;
-  f->session = std::make_unique<Session>(mode);
-  if (f->flight.devices) {
-    f->haptic.emplace(*f->flight.devices);
-    f->session->add_sink(&*f->haptic);
-  }
-  if (f->flight.recording) {
-    f->check.emplace(*f->flight.recording);
-    f->session->add_sink(&*f->check);
-  }
-  if (o.publish) {
-    f->publisher.emplace();
-    if (!f->publisher->start(o.domain, mode.telemetry(), error)) {
-      error = "--publish: " + error;
-      status = kExitError;
-      return nullptr;
-    }
-    f->session->add_sink(&*f->publisher);
-  }
-  f->runner = std::make_unique<RealtimeRunner>(*f->session, 8192);
-  const std::string source =
-      f->flight.pilot.empty() ? std::string("the thesis's controller") : "pilot " + f->flight.pilot;
-  f->scene = ui::scene_of(mode, source);
+  f->rig->pace(8192);
+  const Mode& mode = f->rig->mode();
+  f->scene = ui::scene_of(mode, flight.pilot.empty() ? std::string("the thesis's controller")
+                                                     : "pilot " + flight.pilot);
   f->sample = mode.telemetry();
   return f;
 }
 
 void LiveController::update_vehicle_wait(LiveFlight& f) {
-  const auto now = std::chrono::steady_clock::now();
   std::string error;
-  if (f.flight.vehicle->heard()) {
-    f.awaiting_vehicle = false;
-    if (attach_vehicle(f.flight, error)) {
-      status_line_.say("the vehicle is there: Start (Space) flies it");
-    } else {
-      f.no_vehicle = true;
-      status_line_.say(error, true);
+  switch (f.rig->poll_vehicle(error)) {
+    case FlightRig::VehicleStatus::waiting: {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "waiting for the vehicle in DDS domain %u (mixpilot vehicle): %.0f s left, "
+                    "Esc cancels",
+                    unsigned(options_.domain), std::ceil(f.rig->vehicle_wait_left()));
+      status_line_.say(text);
+      return;
     }
-  } else if (now >= f.vehicle_deadline) {
-    f.awaiting_vehicle = false;
-    f.no_vehicle = true;
-    status_line_.say(vehicle_not_heard(options_, f.flight) + "; Restart (R) waits again", true);
-  } else {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "waiting for the vehicle in DDS domain %u (mixpilot vehicle): %.0f s left, Esc "
-                  "cancels",
-                  unsigned(options_.domain),
-                  std::ceil(std::chrono::duration<double>(f.vehicle_deadline - now).count()));
-    status_line_.say(text);
+    case FlightRig::VehicleStatus::ready:
+      f.awaiting_vehicle = false;
+      status_line_.say("the vehicle is there: Start (Space) flies it");
+      return;
+    case FlightRig::VehicleStatus::none:
+    case FlightRig::VehicleStatus::failed:
+      f.awaiting_vehicle = false;
+      f.no_vehicle = true;
+      status_line_.say(error + "; Restart (R) waits again", true);
+      return;
   }
 }
 
 void LiveController::close_live(LiveFlight& f) {
-  f.runner->stop();
-  while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
-  if (f.publisher) {
-    f.publisher->stop();
-    if (f.started)
-      status_line_.say("published " + std::to_string(f.publisher->published()) +
-                           " steps on rt/mixpilot/* (domain " + std::to_string(options_.domain) +
-                           "; " + std::to_string(f.publisher->dropped()) + " dropped)",
-                       f.publisher->dropped() > 0);
+  f.rig->stop();
+  while (f.runner().telemetry().pop(f.sample)) f.history.push(f.sample);
+  const bool flown = f.started();
+  const FlightRig::Closed& c = f.closing = f.rig->close(!f.mode().finished());
+  if (c.published && flown)
+    status_line_.say("published " + std::to_string(c.published_steps) +
+                         " steps on rt/mixpilot/* (domain " + std::to_string(options_.domain) +
+                         "; " + std::to_string(c.publish_dropped) + " dropped)",
+                     c.publish_dropped > 0);
+  if (!c.recorded.empty()) {
+    if (c.recorded == first_record_) first_record_.clear();
+    const std::string what =
+        c.recorded +
+        (c.dropped ? " (" + std::to_string(c.dropped) + " steps lost: the disk was too slow)" : "");
+    recorded_.push_back(what);
+    status_line_.say("recorded " + what, c.dropped > 0);
+  } else if (!c.error.empty()) {
+    status_line_.say(c.error, true);
+    status_ = kExitError;
   }
-  if (!f.record_path.empty()) {
-    std::string error;
-    if (f.recorder.close(error, !f.flight.mode->finished())) {
-      if (f.record_path == first_record_) first_record_.clear();
-      const std::int64_t dropped = f.recorder.dropped();
-      const std::string what =
-          f.record_path +
-          (dropped ? " (" + std::to_string(dropped) + " steps lost: the disk was too slow)" : "");
-      recorded_.push_back(what);
-      status_line_.say("recorded " + what, dropped > 0);
-    } else {
-      status_line_.say(error, true);
-      status_ = kExitError;
-    }
-  }
-  f.closed = true;
 }
 
 int LiveController::finish() {
   int status = status_;
   if (!live_) return status;
   LiveFlight& f = *live_;
-  if (!f.closed) close_live(f);
-  while (f.runner->telemetry().pop(f.sample)) f.history.push(f.sample);
-  const Mode& mode = *f.flight.mode;
-  if (!f.started || mode.steps_done() == 0) {
+  if (!f.closed()) close_live(f);
+  while (f.runner().telemetry().pop(f.sample)) f.history.push(f.sample);
+  const Mode& mode = f.mode();
+  if (!f.started() || mode.steps_done() == 0) {
     // The window closed before Start: no flight, so no score (a 0.0 s flight is not one).
     std::printf("mixpilot %s: %s: not flown (the window was closed before Start)%s\n",
                 options_.command, mode.scenario_name().c_str(),
@@ -193,20 +151,17 @@ int LiveController::finish() {
     return status;
   }
   std::printf("mixpilot %s: %s", options_.command, mode.summary().c_str());
-  const RealtimeStats st = f.runner->stats();
+  const RealtimeStats st = f.runner().stats();
   std::printf("  %.1f s flown in the window\n", double(mode.steps_done()) * mode.dt());
   print_realtime(st, mode.dt());
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   for (const std::string& path : recorded_) std::printf("  recorded %s\n", path.c_str());
-  if (f.publisher)
+  if (f.closing.published)
     std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
-                (unsigned long long)f.publisher->published(), unsigned(options_.domain),
-                (unsigned long long)f.publisher->dropped());
+                (unsigned long long)f.closing.published_steps, unsigned(options_.domain),
+                (unsigned long long)f.closing.publish_dropped);
   if (!options_.report.empty()) {
-    const Metrics metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
-                                               : with_lost_fields(mode.metrics(), mode);
-    const std::string json =
-        to_json(report_labels(f.flight, !mode.finished()), metrics) + "\n";
+    const std::string json = to_json(f.rig->labels(!mode.finished()), f.rig->metrics()) + "\n";
     std::string error;
     if (write_file(options_.report, json, options_.force, error)) {
       std::printf("  report %s\n", options_.report.c_str());
@@ -215,8 +170,8 @@ int LiveController::finish() {
       status = kExitError;
     }
   }
-  if (f.check && mode.finished()) {
-    const std::string diff = f.check->first_difference(mode.steps_done());
+  if (f.flight().recording && mode.finished()) {
+    const std::string diff = f.rig->replay_difference();
     if (!diff.empty()) {
       std::fprintf(stderr, "mixpilot %s: the replay of %s differs from the recording: %s\n",
                    options_.command, options_.pilot.c_str(), diff.c_str());
@@ -254,9 +209,9 @@ std::string LiveController::next_record_path() const {
   char stamp[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
-  std::string name = live_ ? live_->flight.mode->scenario_name() : "flight";
-  if (live_ && !live_->flight.pilot.empty() && !live_->flight.recording)
-    name += "-" + live_->flight.pilot;
+  std::string name = live_ ? live_->mode().scenario_name() : "flight";
+  if (live_ && !live_->flight().pilot.empty() && !live_->flight().recording)
+    name += "-" + live_->flight().pilot;
   const fs::path folder = recordings_folder();
   if (folder.empty()) return "";
   return (folder / file_name_part(name + "-" + stamp + ".mcap")).string();
@@ -279,20 +234,20 @@ bool LiveController::replace_live(std::string& error) {
 }
 
 void LiveController::close() {
-  if (live_ && !live_->closed) close_live(*live_);
+  if (live_ && !live_->closed()) close_live(*live_);
 }
 
 void LiveController::refresh_choices() {
   choices_.pilots.clear();
   choices_.pilot = -1;
   if (!live_) return;
-  if (ModeIdentity id = live_->flight.mode->identity(); !id.pilot.empty()) {
+  if (ModeIdentity id = live_->mode().identity(); !id.pilot.empty()) {
     choices_.pilots = std::move(id.pilots);
     choices_.pilots.push_back("gamepad");
     choices_.pilots.push_back("keyboard");
     if (options_.pilot.ends_with(".mcap")) choices_.pilots.push_back(options_.pilot);
     const auto it = std::find(choices_.pilots.begin(), choices_.pilots.end(),
-                              options_.pilot.empty() ? live_->flight.pilot : options_.pilot);
+                              options_.pilot.empty() ? live_->flight().pilot : options_.pilot);
     choices_.pilot = it == choices_.pilots.end() ? -1 : int(it - choices_.pilots.begin());
   }
   choices_.record_to = choices_.record ? next_record_path() : "";
@@ -323,7 +278,7 @@ void LiveController::open_scenario(const std::string& path) {
 }
 
 void LiveController::reopen() {
-  if (live_ && !live_->closed) return;
+  if (live_ && !live_->closed()) return;
   if (options_.scenario_path.empty() && !options_.pilot.ends_with(".mcap")) {
     live_.reset();
     return;
@@ -335,16 +290,16 @@ void LiveController::reopen() {
 void LiveController::settings_changed() {
   options_.input_settings.clear();  // the app's settings from now on, not the file's
   std::string error;
-  if (live_ && !is_flying(*live_) && live_->flight.devices && !replace_live(error))
+  if (live_ && !is_flying(*live_) && live_->flight().devices && !replace_live(error))
     status_line_.say(error, true);
 }
 
 void LiveController::start() {
-  if (!live_ || live_->started) return;
+  if (!live_ || live_->started()) return;
   if (live_->awaiting_vehicle || live_->no_vehicle) return;  // the status line says why
   // A gamepad pilot starts once a pad is connected (the banner asks for one meanwhile).
-  if (live_->flight.devices && live_->flight.devices->gamepad &&
-      !live_->flight.devices->gamepad->connected()) {
+  if (live_->flight().devices && live_->flight().devices->gamepad &&
+      !live_->flight().devices->gamepad->connected()) {
     live_->waiting = true;
     return;
   }
@@ -362,16 +317,17 @@ void LiveController::start() {
     std::error_code ec;
     if (path != options_.record) fs::create_directories(fs::path(path).parent_path(), ec);
     std::string error;
-    if (!open_recording(*live_, path, choices_.trainee,
-                        path == options_.record && options_.force, error)) {
+    RecordingSink::Settings rs;
+    rs.when_full = RecordingSink::FullRing::drop;  // the control thread never waits on the disk
+    rs.slots = 4096;
+    if (!live_->rig->record(path, choices_.trainee, rs, path == options_.record && options_.force,
+                            error)) {
       status_line_.say(error, true);
       return;
     }
   }
   live_->history.clear();  // the initial state shown while ready
-  if (live_->flight.devices) live_->flight.devices->started();
-  live_->runner->start();
-  live_->started = true;
+  live_->rig->start();
   status_line_.say("");
 }
 
@@ -383,28 +339,29 @@ void LiveController::handle(const ui::LiveRequest& r) {
       ui::overloaded{
           [&](const ui::StartFlight&) { start(); },
           [&](const ui::TogglePause&) {
-            if (is_flying(*live_)) live_->runner->set_paused(!live_->runner->paused());
+            if (is_flying(*live_)) live_->runner().set_paused(!live_->runner().paused());
           },
           [&](const ui::SetFlightSpeed& s) {
-            live_->runner->set_speed(std::clamp(s.speed, 0.25, 1.0));
+            live_->runner().set_speed(std::clamp(s.speed, 0.25, 1.0));
           },
           [&](const ui::RestartFlight&) {
-            const double speed = live_->runner->speed();
+            const double speed = live_->runner().speed();
             if (!replace_live(error)) {
               status_line_.say(error, true);
               return;
             }
-            live_->runner->set_speed(speed);
+            live_->runner().set_speed(speed);
             start();
           },
           [&](const ui::CancelVehicleWait&) {
             if (!live_->awaiting_vehicle) return;
+            live_->rig->cancel_vehicle_wait();
             live_->awaiting_vehicle = false;
             live_->no_vehicle = true;
             status_line_.say("no vehicle: the wait was cancelled; Restart (R) waits again");
           },
           [&](const ui::HeldFlightKeys& k) {
-            const Devices* d = live_->flight.devices.get();
+            const Devices* d = live_->flight().devices.get();
             if (!d || !d->keyboard) return;
             for (int i = 0; i < int(input::Key::count); ++i)
               d->keyboard->set_key(input::Key(i), (k.keys >> i) & 1u);
@@ -436,31 +393,30 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
   LiveFlight& f = *live_;
   if (f.waiting && pad_connected) start();  // the gamepad it waited for has come
   if (f.awaiting_vehicle) update_vehicle_wait(f);
-  if (!f.closed) {
-    while (f.runner->telemetry().pop(f.sample)) {
+  if (!f.closed()) {
+    while (f.runner().telemetry().pop(f.sample)) {
       f.history.push(f.sample);
       ui::count_step(f.sample, f.counts);
     }
   }
-  const Mode& mode = *f.flight.mode;
+  const Mode& mode = f.mode();
   // Before the start the screen shows the initial state: the arena, the vehicle, the reference.
-  if (!f.started && f.history.empty()) f.history.push(mode.telemetry());
-  const bool over = f.started && !f.runner->running();
+  if (!f.started() && f.history.empty()) f.history.push(mode.telemetry());
+  const bool over = f.started() && !f.runner().running();
   // The run is over: its recording is completed at once, and the score card shows.
-  if (over && !f.closed) close_live(f);
+  if (over && !f.closed()) close_live(f);
   if (over && f.metrics.empty())
-    f.metrics = f.flight.recording ? replay_metrics(mode, *f.flight.recording)
-                                   : with_lost_fields(mode.metrics(), mode);
+    f.metrics = f.rig->metrics();
   run.state = f.awaiting_vehicle ? ui::RunState::waiting
-              : !f.started ? ui::RunState::ready
+              : !f.started() ? ui::RunState::ready
               : mode.lost() ? ui::RunState::lost
               : over ? ui::RunState::finished
-              : f.runner->paused() ? ui::RunState::paused
+              : f.runner().paused() ? ui::RunState::paused
                                    : ui::RunState::flying;
-  run.speed = f.runner->speed();
+  run.speed = f.runner().speed();
   run.deadline_misses = f.counts.deadline_misses;
   run.fallbacks = f.counts.fallbacks;
-  run.recording = !f.record_path.empty() && !f.closed;
+  run.recording = !f.rig->recording_path().empty() && !f.closed();
   run.can_restart = true;
   run.metrics = f.metrics;
   run.replay = nullptr;
@@ -469,7 +425,7 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
 
 bool LiveController::over() const {
   if (!live_) return true;
-  return live_->started && !live_->runner->running() && live_->closed;
+  return live_->started() && !live_->runner().running() && live_->closed();
 }
 
 double LiveController::shown_time() const {

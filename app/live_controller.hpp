@@ -3,7 +3,6 @@
 // recording, the wait for a remote vehicle or for a gamepad, and the session panel's choices
 // for the next flight (scenario, pilot, record, trainee). Start, pause, slow motion, restart
 // and the keyboard pilot's keys act on it.
-#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -11,38 +10,36 @@
 #include <vector>
 
 #include "app/flight.hpp"
+#include "app/flight_rig.hpp"
 #include "app/input_controller.hpp"
 #include "app/status_line.hpp"
-#include "core/recording/replay.hpp"
-#include "core/recording/session_recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
-#include "input/net/telemetry_publisher.hpp"
 #include "ui/requests.hpp"
 #include "ui/screen.hpp"
 
 namespace mixpilot::cli {
 
-// One flight in the app: the mode, its session and sinks, and the runner that paces it.
+// One flight in the app: its assembly (app/flight_rig.hpp: the mode, session, sinks, vehicle
+// link and the runner that paces it) and what the screen keeps of it.
 struct LiveFlight {
-  Flight flight;
-  std::unique_ptr<Session> session;
-  RecordingSink recorder;
-  std::string record_path;  // "" when not recording
-  std::optional<ReplayCheck> check;  // flying a recording's pilot commands
-  std::optional<HapticSink> haptic;  // a gamepad pilot: λ to the rumble
-  std::optional<net::TelemetryPublisher> publisher;  // --publish: the telemetry over DDS
-  std::unique_ptr<RealtimeRunner> runner;
+  std::unique_ptr<FlightRig> rig;
   ui::Scene scene;
   ui::History history;
   Telemetry sample;  // the ring's values are copied into it (sized once)
   ui::RunInfo counts;  // fallbacks and deadline misses so far (ui::count_step)
-  bool started = false, closed = false;
   bool waiting = false;  // Start asked for, waiting for the gamepad
-  // --vehicle dds: listening for the vehicle until vehicle_deadline while the window draws on;
-  // no_vehicle: none came (or the wait was cancelled), so this flight cannot start.
+  // --vehicle dds: listening for the vehicle while the window draws on (FlightRig::
+  // poll_vehicle each frame); no_vehicle: none came (or the wait was cancelled, or it cannot
+  // fly this mode), so this flight cannot start. Restart waits again.
   bool awaiting_vehicle = false, no_vehicle = false;
-  std::chrono::steady_clock::time_point vehicle_deadline;
+  FlightRig::Closed closing;  // what closing the flight did (its recording, the publisher)
   Metrics metrics;   // once the run is over
+
+  const Flight& flight() const { return rig->flight(); }
+  const Mode& mode() const { return rig->mode(); }
+  RealtimeRunner& runner() const { return *rig->runner(); }
+  bool started() const { return rig->started(); }
+  bool closed() const { return rig->closed(); }
 };
 
 class LiveController {

@@ -25,7 +25,7 @@ void Trainer::start() {
 
 void Trainer::build_frame(double wall_dt) {
   const LiveFlight* f = live_.flight();
-  input_.update(f ? f->flight.devices.get() : nullptr, f && f->waiting, ui_.show_settings,
+  input_.update(f ? f->flight().devices.get() : nullptr, f && f->waiting, ui_.show_settings,
                 wizard_.running());
   wizard_.update(input_.started(), input_.info().wizard);
   run_.input = &input_.info();

@@ -174,14 +174,14 @@ TEST_F(App, ClickStartThenSpacePausesAndResumes) {
   const auto start = locate(app, "Session", "Start flight (Space)");
   ASSERT_TRUE(start) << "no Start button in the session panel";
   click(app, *start);
-  ASSERT_TRUE(app.live()->started);
+  ASSERT_TRUE(app.live()->started());
   frame(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::flying);
   key(app, ui::Key::space);
-  EXPECT_TRUE(app.live()->runner->paused());
+  EXPECT_TRUE(app.live()->runner().paused());
   EXPECT_EQ(app.run_info().state, ui::RunState::paused);
   key(app, ui::Key::space);
-  EXPECT_FALSE(app.live()->runner->paused());
+  EXPECT_FALSE(app.live()->runner().paused());
   until_over(app);
   EXPECT_EQ(app.run_info().state, ui::RunState::finished);
   EXPECT_FALSE(app.run_info().metrics.empty()) << "no score card at the end";
@@ -226,7 +226,7 @@ TEST_F(App, RestartFliesANewFlight) {
   ASSERT_GT(app.shown_time(), 0.2);
   key(app, ui::Key::r);
   EXPECT_NE(app.live(), first);
-  EXPECT_TRUE(app.live()->started);
+  EXPECT_TRUE(app.live()->started());
   EXPECT_LT(app.shown_time(), 0.2);
 }
 
@@ -245,8 +245,8 @@ TEST_F(App, TheSessionPanelPicksTheScenario) {
   // The request a pick in the combo makes, acted on by the app.
   app.act(ui::PickScenario{int(it - c.scenarios.begin())});
   frame(app);
-  EXPECT_EQ(app.live()->flight.mode->kind(), ModeKind::pendubot_swingup);
-  EXPECT_FALSE(app.live()->started);
+  EXPECT_EQ(app.live()->mode().kind(), ModeKind::pendubot_swingup);
+  EXPECT_FALSE(app.live()->started());
   EXPECT_TRUE(app.run_info().session->pilots.empty()) << "the Pendubot mode has no pilot";
   // Ctrl+R: the next flight is recorded, and the panel says where.
   ASSERT_FALSE(app.run_info().session->record);
@@ -307,7 +307,7 @@ TEST_F(App, ReplayTimelineSeeksJumpsAndPlays) {
   key(app, ui::Key::escape);
   EXPECT_FALSE(app.replaying());
   ASSERT_TRUE(app.live());
-  EXPECT_FALSE(app.live()->started);
+  EXPECT_FALSE(app.live()->started());
   EXPECT_EQ(app.run_info().state, ui::RunState::ready);
 }
 
@@ -637,7 +637,7 @@ TEST_F(App, InputLossIsShownOverTheArena) {
     frame(app);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  app.live()->runner->set_paused(true);
+  app.live()->runner().set_paused(true);
   frame(app);
   frame(app);
   ASSERT_GE(app.shown_time(), 1.0);
@@ -649,7 +649,7 @@ TEST_F(App, InputLossIsShownOverTheArena) {
   for (int y = int(kH * 0.3); y < int(kH * 0.7); ++y)
     for (int x = kW / 4; x < 3 * kW / 4; ++x) hits += colour_near(p, ImVec2(float(x), float(y)), red, 0, 8);
   EXPECT_GT(hits, 400) << "no input-loss banner in the critical colour";
-  app.live()->runner->set_paused(false);
+  app.live()->runner().set_paused(false);
 }
 
 // A joystick SDL does not know, mapped from the settings panel: Map it... opens the wizard,

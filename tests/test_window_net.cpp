@@ -55,9 +55,10 @@ TEST_F(Net, PublishFromTheWindowReachesAnIndependentSubscriber) {
   }
   ASSERT_TRUE(app.over());
   ASSERT_NE(app.live(), nullptr);
-  ASSERT_TRUE(app.live()->publisher);
-  EXPECT_EQ(app.live()->publisher->published(), 200u);  // every step of 3 s at Δt = 15 ms
-  EXPECT_EQ(app.live()->publisher->dropped(), 0u);
+  const cli::FlightRig::Closed& closed = app.live()->closing;
+  ASSERT_TRUE(closed.published);
+  EXPECT_EQ(closed.published_steps, 200u);  // every step of 3 s at Δt = 15 ms
+  EXPECT_EQ(closed.publish_dropped, 0u);
   EXPECT_EQ(app.finish(), 0);
 
   std::this_thread::sleep_for(std::chrono::seconds(4));  // the subscriber's 6 s are over
@@ -110,7 +111,7 @@ TEST_F(Net, TheWindowWaitsForTheVehicleWithoutFreezingAndCanCancel) {
   if (const char* shots = std::getenv("MIXPILOT_SHOT_DIR"); shots && *shots)
     std::ofstream(std::string(shots) + "/waiting_for_vehicle.png", std::ios::binary) << screen.png();
   app.start();  // Start while waiting does nothing
-  EXPECT_FALSE(app.live()->started);
+  EXPECT_FALSE(app.live()->started());
 
   const ui::Request restart = ui::RestartFlight{};
   const auto t0 = std::chrono::steady_clock::now();
@@ -125,7 +126,7 @@ TEST_F(Net, TheWindowWaitsForTheVehicleWithoutFreezingAndCanCancel) {
   EXPECT_NE(app.run_info().message.find("the wait was cancelled"), std::string::npos)
       << app.run_info().message;
   app.start();
-  EXPECT_FALSE(app.live()->started);
+  EXPECT_FALSE(app.live()->started());
 
   app.act(restart);  // waits again, and this time runs out
   const double out = frames_for(screen, app, 2.6);
