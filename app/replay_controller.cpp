@@ -14,17 +14,18 @@ ReplayController::~ReplayController() {
   if (tape_) tape_->stop();
 }
 
-std::optional<Flight> ReplayController::prepare(const std::string& path, std::string& error) const {
+std::unique_ptr<FlightRig> ReplayController::prepare(const std::string& path,
+                                                     std::string& error) const {
   FlyOptions o;
   o.pilot = path;
   o.replay = true;
   o.command = command_;
   int status = 0;
-  return prepare_flight(o, error, status);
+  return FlightRig::assemble(o, error, status);
 }
 
-void ReplayController::open(Flight flight, const std::string& path) {
-  tape_ = std::make_unique<ReplayTape>(std::move(flight), path);
+void ReplayController::open(std::unique_ptr<FlightRig> rig, const std::string& path) {
+  tape_ = std::make_unique<ReplayTape>(std::move(rig), path);
   tape_->start();
   info_ = ui::ReplayInfo{};
   info_.duration = double(tape_->steps()) * tape_->dt();

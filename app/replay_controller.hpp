@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "app/flight.hpp"
+#include "app/flight_rig.hpp"
 #include "app/replay_tape.hpp"
 #include "app/status_line.hpp"
 #include "ui/requests.hpp"
@@ -25,9 +25,10 @@ class ReplayController {
 
   // The recording at `path` made ready to replay; nullopt with the reason. Nothing changes
   // until open() (the caller may close what the replay replaces in between).
-  [[nodiscard]] std::optional<Flight> prepare(const std::string& path, std::string& error) const;
+  [[nodiscard]] std::unique_ptr<FlightRig> prepare(const std::string& path,
+                                                 std::string& error) const;
   // Shows the prepared replay of `path`, loading on its thread, the playhead at 0.
-  void open(Flight flight, const std::string& path);
+  void open(std::unique_ptr<FlightRig> rig, const std::string& path);
   void close();
   bool is_open() const { return tape_ != nullptr; }
 

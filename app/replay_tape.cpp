@@ -39,12 +39,13 @@ class TapeSink final : public TelemetrySink {
 
 }  // namespace
 
-ReplayTape::ReplayTape(Flight flight, std::string path)
-    : flight_(std::move(flight)), path_(std::move(path)) {
-  const Mode& mode = *flight_.mode;
+ReplayTape::ReplayTape(std::unique_ptr<FlightRig> rig, std::string path)
+    : rig_(std::move(rig)), path_(std::move(path)) {
+  const Mode& mode = rig_->mode();
+  const std::string& pilot = rig_->flight().pilot;
   dt_ = mode.dt();
-  scene_ = ui::scene_of(mode, flight_.pilot.empty() ? std::string("replay of ") + path_
-                                                    : "replay of " + path_ + " (" + flight_.pilot + ")");
+  scene_ = ui::scene_of(mode, pilot.empty() ? std::string("replay of ") + path_
+                                            : "replay of " + path_ + " (" + pilot + ")");
   tape_.assign(std::size_t(std::max<std::int64_t>(mode.steps_total(), 0)), mode.telemetry());
 }
 
@@ -72,22 +73,20 @@ void ReplayTape::stop() {
 }
 
 void ReplayTape::load() {
-  Mode& mode = *flight_.mode;
+  const Mode& mode = rig_->mode();
   const auto& p = tape_.empty() ? Eigen::Matrix3Xd() : tape_.front().predicted;
   const std::size_t bytes = tape_.size() * std::size_t(p.size()) * 2 * sizeof(double);
   const std::size_t stride = std::max<std::size_t>(1, (bytes + kPredictedBudget - 1) / kPredictedBudget);
   TapeSink sink(tape_, ready_, stride);
-  ReplayCheck check(*flight_.recording);
-  Session session(mode);
-  session.add_sink(&sink);
-  session.add_sink(&check);
-  while (!stop_.load(std::memory_order_relaxed) && session.step()) {
+  rig_->watch(sink);
+  rig_->start();
+  while (!stop_.load(std::memory_order_relaxed) && rig_->step()) {
   }
   if (!mode.finished() && stop_.load()) {
     mismatch_ = "interrupted";
   } else {
-    mismatch_ = check.first_difference(mode.steps_done());
-    metrics_ = replay_metrics(mode, *flight_.recording);
+    mismatch_ = rig_->replay_difference();
+    metrics_ = rig_->metrics();
   }
   done_.store(true, std::memory_order_release);
 }

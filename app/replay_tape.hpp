@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "app/flight.hpp"
+#include "app/flight_rig.hpp"
 #include "core/recording/replay.hpp"
 #include "ui/scene.hpp"
 
@@ -19,8 +19,9 @@ namespace mixpilot::cli {
 
 class ReplayTape {
  public:
-  // `flight` is a prepared replay (prepare_flight of a recording); `path` names the recording.
-  ReplayTape(Flight flight, std::string path);
+  // `rig` is an assembled replay (FlightRig::assemble of a recording, which checks it step by
+  // step); `path` names the recording.
+  ReplayTape(std::unique_ptr<FlightRig> rig, std::string path);
   ~ReplayTape();
   ReplayTape(const ReplayTape&) = delete;
   ReplayTape& operator=(const ReplayTape&) = delete;
@@ -39,7 +40,7 @@ class ReplayTape {
   double dt() const { return dt_; }
   const ui::Scene& scene() const { return scene_; }
   const std::string& path() const { return path_; }
-  const Mode& mode() const { return *flight_.mode; }  // read it only once done()
+  const Mode& mode() const { return rig_->mode(); }  // read it only once done()
 
   // After done(): the replay's metrics (the score card), and what differed from the recording
   // ("" when every step was reproduced bit for bit; "interrupted" when stopped early).
@@ -49,7 +50,7 @@ class ReplayTape {
  private:
   void load();
 
-  Flight flight_;
+  std::unique_ptr<FlightRig> rig_;
   std::string path_;
   double dt_ = 0.01;
   ui::Scene scene_;

@@ -10,10 +10,10 @@ Trainer::Trainer(FlyOptions o)
 bool Trainer::open_live(std::string& error, int& status) { return live_.open(error, status); }
 
 bool Trainer::open_replay(const std::string& path, std::string& error) {
-  std::optional<Flight> flight = replay_.prepare(path, error);
-  if (!flight) return false;
+  std::unique_ptr<FlightRig> rig = replay_.prepare(path, error);
+  if (!rig) return false;
   live_.close();  // its recording is completed before the replay loads
-  replay_.open(std::move(*flight), path);
+  replay_.open(std::move(rig), path);
   ui_.score_card_closed = false;
   return true;
 }
