@@ -33,29 +33,6 @@ std::string rejection_counts(const net::JoyPeerStats& s) {
   return out;
 }
 
-// What a remote vehicle's state may hold before it is not a state (input/net/peer_checks.hpp):
-// positions well beyond any world, a quaternion's parts (unit, with the integrator's drift),
-// speeds and rates no quadrotor reaches; Euler angles integrate freely, so only their size is
-// bounded; the MikroKopter's rotor speeds a hundred times their limit.
-net::RemoteVehicle::StateBounds state_bounds(ModeKind kind) {
-  net::RemoteVehicle::StateBounds b = net::RemoteVehicle::any_state();
-  const auto set = [&](int from, int n, double bound) {
-    for (int i = from; i < from + n; ++i) b[std::size_t(i)] = bound;
-  };
-  set(0, 3, 1e4);  // p [m]
-  if (kind == ModeKind::crazyflie_tracking) {
-    set(3, 4, 2.0);  // q
-    set(7, 3, 1e3);  // v_b [m/s]
-    set(10, 3, 1e4);  // ω [rad/s]
-  } else {
-    set(3, 3, 1e6);  // γ [rad]
-    set(6, 3, 1e3);  // v_b [m/s]
-    set(9, 3, 1e4);  // ω [rad/s]
-    set(12, 4, 100 * models::MikroKopter().p.omega_max);  // Ω
-  }
-  return b;
-}
-
 // Reads the scenario and, for a replay, the recording; on failure `status` may name a more
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
@@ -215,17 +192,15 @@ namespace {
 bool open_vehicle_link(const FlyOptions& o, Flight& f, std::string& error) {
   net::RemoteVehicle::Options vo;
   vo.domain = o.domain;
-  const ModeKind kind = f.mode->kind();
-  if (kind == ModeKind::crazyflie_tracking) {
-    vo.nx = models::Crazyflie::nx;
-  } else if (kind == ModeKind::mixed_initiative) {
-    vo.nx = models::MikroKopter::nx;
-  } else {
-    error = std::string("--vehicle dds: mode ") + to_string(kind) +
+  const VehicleStateSpec spec = f.mode->remote_state();
+  if (spec.nx == 0) {
+    error = std::string("--vehicle dds: mode ") + to_string(f.mode->kind()) +
             " has no remote vehicle (crazyflie_tracking and mixed_initiative have)";
     return false;
   }
-  vo.max_abs = state_bounds(kind);
+  vo.nx = spec.nx;
+  vo.max_abs = net::RemoteVehicle::any_state();
+  std::copy(spec.max_abs.begin(), spec.max_abs.begin() + spec.nx, vo.max_abs.begin());
   net::use_loopback_unless_configured();
   f.vehicle = std::make_unique<net::RemoteVehicle>();
   if (!f.vehicle->start(vo, error)) {

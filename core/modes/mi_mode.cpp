@@ -411,4 +411,21 @@ std::unique_ptr<PilotSource> make_scenario_pilot(const Scenario& scenario, const
   return pilot;
 }
 
+// What a state may hold before it is not one (input/net/peer_checks.hpp): positions well
+// beyond any world, speeds and rates no quadrotor reaches; Euler angles integrate freely, so
+// only their size is bounded; rotor speeds a hundred times their limit.
+VehicleStateSpec MiMode::remote_state() const {
+  VehicleStateSpec spec;
+  spec.nx = models::MikroKopter::nx;
+  const auto set = [&](int from, int n, double bound) {
+    for (int i = from; i < from + n; ++i) spec.max_abs[std::size_t(i)] = bound;
+  };
+  set(0, 3, 1e4);
+  set(3, 3, 1e6);
+  set(6, 3, 1e3);
+  set(9, 3, 1e4);
+  set(12, 4, 100 * model_.p.omega_max);
+  return spec;
+}
+
 }  // namespace mixpilot

@@ -64,6 +64,7 @@ class MiMode final : public Mode {
     remote_.attach(link);
     return true;
   }
+  VehicleStateSpec remote_state() const override;
   const VehicleFeed& vehicle_feed() const { return remote_.feed(); }
 
   Score score() const { return scorer_.finish(); }

@@ -182,6 +182,8 @@ class Mode {
     (void)link;
     return false;
   }
+  // The states its remote vehicle sends, for the link to check ({}: it has none).
+  virtual VehicleStateSpec remote_state() const { return {}; }
 
   // A paced run (core/runtime/realtime_runner.hpp), before each step: how late the step
   // starts after its schedule and the wall-clock period it has [µs]. The step is then marked

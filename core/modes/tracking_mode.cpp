@@ -245,6 +245,22 @@ void TrackingMode::add_sample(long m, const Eigen::Vector3d& p, const Eigen::Vec
   }
 }
 
+// What a state may hold before it is not one (input/net/peer_checks.hpp): positions well
+// beyond any world, a quaternion's parts (unit, with the integrator's drift), speeds and rates
+// no quadrotor reaches.
+VehicleStateSpec TrackingMode::remote_state() const {
+  VehicleStateSpec spec;
+  spec.nx = models::Crazyflie::nx;
+  const auto set = [&](int from, int n, double bound) {
+    for (int i = from; i < from + n; ++i) spec.max_abs[std::size_t(i)] = bound;
+  };
+  set(0, 3, 1e4);
+  set(3, 4, 2.0);
+  set(7, 3, 1e3);
+  set(10, 3, 1e4);
+  return spec;
+}
+
 bool TrackingMode::set_vehicle(VehicleLink* link) {
   remote_.attach(link);
   return true;

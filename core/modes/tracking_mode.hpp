@@ -114,6 +114,7 @@ class TrackingMode final : public Mode {
   // Flies the vehicle behind `link` instead of the simulated plant (after setup(), before the
   // first step; nullptr: the simulated plant). The link outlives the flight.
   [[nodiscard]] bool set_vehicle(VehicleLink* link) override;
+  VehicleStateSpec remote_state() const override;
   bool remote() const { return remote_.attached(); }
   const RttEstimator& rtt_estimator() const { return remote_.rtt(); }
   // Why the vehicle was lost ("" while it is not): left the world, or silent.

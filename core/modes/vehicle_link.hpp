@@ -7,6 +7,7 @@
 // input/net/remote_vehicle.hpp; core never sees how the bytes travel.
 //
 // Its calls are made on the control thread, never wait and allocate nothing.
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -34,6 +35,13 @@ struct VehicleSample {
   std::int64_t received_ns = 0; // when the sample arrived (VehicleLink::now_ns())
   bool left_world = false;      // the vehicle says it left its world (its state is the last inside)
   bool ended = false;           // the vehicle says its flight is over
+};
+
+// What a mode's remote vehicle sends (SPEC §9): nx state values, each within max_abs (beyond
+// it a value is not physical and the link rejects the state). nx = 0: the mode flies none.
+struct VehicleStateSpec {
+  int nx = 0;
+  std::array<double, VehicleSample::kMaxState> max_abs{};
 };
 
 class VehicleLink {
