@@ -95,5 +95,8 @@ template <class... F>
 struct overloaded : F... {
   using F::operator()...;
 };
+// Spelled out: clang 14 (the sanitizer build) does not deduce an aggregate's arguments.
+template <class... F>
+overloaded(F...) -> overloaded<F...>;
 
 }  // namespace mixpilot::ui
