@@ -1,0 +1,537 @@
+// The trainee's history (SPEC §10): the store (SQLite), its schema, content hashes, writers in
+// parallel and killed, damaged and locked files, hostile names; and every front end's flight
+// recorded once.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <thread>
+#include <string>
+#include <vector>
+
+#include "core/history/content_hash.hpp"
+#include "core/history/history.hpp"
+#include "core/history/schema.hpp"
+#include "core/history/sqlite_history.hpp"
+#include "temp_files.hpp"
+
+namespace mixpilot {
+namespace {
+
+namespace fs = std::filesystem;
+using history::FlightRecord;
+using history::HistoryStore;
+using history::StoredFlight;
+
+FlightRecord sample_flight(const std::string& trainee = "Ada", std::int64_t started = 1'700'000'000'000) {
+  FlightRecord f;
+  f.trainee = trainee;
+  f.station = "station-1";
+  f.scenario = "mi_helix";
+  f.scenario_hash = history::sha256_hex("scenario text");
+  f.mode = "mixed_initiative";
+  f.pilot = "novice";
+  f.input_device = "";
+  f.input_settings_hash = "";
+  f.started_unix_ms = started;
+  f.duration_s = 30.0;
+  f.ended = history::Ended::completed;
+  f.app_version = "mixpilot 0.1.0";
+  f.front_end = "fly";
+  f.metrics = {{"skill", 71.5}, {"mean_lambda", 0.8}, {"min_clearance_m", INFINITY},
+               {"lost", 0.0}};
+  return f;
+}
+
+std::unique_ptr<HistoryStore> open_store(const fs::path& p, const history::SqliteSettings& s = {}) {
+  std::string error;
+  auto store = history::open_sqlite(p.string(), error, s);
+  EXPECT_TRUE(store) << error;
+  return store;
+}
+
+std::vector<StoredFlight> all(HistoryStore& store, const history::Query& q = {}) {
+  std::vector<StoredFlight> out;
+  std::string error;
+  EXPECT_TRUE(store.query(q, out, error)) << error;
+  return out;
+}
+
+// A statement's one integer answer through SQLite directly (not through the store).
+std::int64_t sql_int(const fs::path& p, const char* sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  sqlite3_stmt* s = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &s, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  std::int64_t v = -1;
+  if (sqlite3_step(s) == SQLITE_ROW) v = sqlite3_column_int64(s, 0);
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return v;
+}
+std::string sql_text(const fs::path& p, const char* sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  sqlite3_stmt* s = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &s, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  std::string v;
+  if (sqlite3_step(s) == SQLITE_ROW && sqlite3_column_text(s, 0))
+    v = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return v;
+}
+
+bool running_as_root() { return ::geteuid() == 0; }
+
+// ---- Content hashes -------------------------------------------------------------------------
+
+// FIPS 180-4's examples (NIST's SHA256.pdf) and the empty message.
+TEST(HistoryHash, Sha256GivesTheStandardsVectors) {
+  EXPECT_EQ(history::sha256_hex("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(history::sha256_hex(""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(history::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  // A file across several read blocks hashes as its bytes do.
+  const fs::path p = test::fresh_path("history", "big.bin");
+  std::string bytes(200'003, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 131 % 251);
+  std::ofstream(p, std::ios::binary) << bytes;
+  std::string error;
+  const auto h = history::sha256_file(p.string(), error);
+  ASSERT_TRUE(h) << error;
+  EXPECT_EQ(*h, history::sha256_hex(bytes));
+  EXPECT_FALSE(history::sha256_file((p.parent_path() / "absent").string(), error));
+  EXPECT_NE(error.find("absent"), std::string::npos) << error;
+}
+
+// ---- The schema ----------------------------------------------------------------------------
+
+TEST(HistorySchema, OneSchemaTwoDialects) {
+  const auto sqlite = history::pending(0, history::Dialect::sqlite);
+  const auto pg = history::pending(0, history::Dialect::postgresql);
+  ASSERT_EQ(sqlite.size(), pg.size());
+  ASSERT_FALSE(sqlite.empty());
+  EXPECT_TRUE(sqlite.back().takes_time);  // the version's row, last
+  EXPECT_NE(sqlite[0].sql.find("INTEGER PRIMARY KEY"), std::string::npos) << sqlite[0].sql;
+  EXPECT_NE(pg[0].sql.find("BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY"), std::string::npos)
+      << pg[0].sql;
+  for (const auto& s : pg) EXPECT_EQ(s.sql.find('{'), std::string::npos) << s.sql;
+  EXPECT_TRUE(history::pending(history::kSchemaVersion, history::Dialect::sqlite).empty());
+  EXPECT_EQ(history::newer_schema_message(history::kSchemaVersion, "f"), "");
+  EXPECT_NE(history::newer_schema_message(history::kSchemaVersion + 1, "f"), "");
+}
+
+// ---- The store -----------------------------------------------------------------------------
+
+// A flight comes back with every field it went in with, its metrics in their order; a metric
+// that is not a finite number comes back as NaN (stored NULL, as the reports' null).
+TEST(HistoryStore, AFlightComesBackWithEveryField) {
+  const fs::path p = test::fresh_path("history", "roundtrip.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord f = sample_flight();
+  f.input_device = "gamepad";
+  f.input_settings_hash = history::sha256_hex("mode = 2");
+  f.ended = history::Ended::lost;
+  f.probe = true;
+  f.recording_path = "/tmp/a.mcap";
+  f.recording_hash = history::sha256_hex("rec");
+  std::string error;
+  ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  const StoredFlight& r = rows[0];
+  EXPECT_GT(r.id, 0);
+  EXPECT_EQ(r.trainee, f.trainee);
+  EXPECT_EQ(r.station, f.station);
+  EXPECT_EQ(r.scenario, f.scenario);
+  EXPECT_EQ(r.scenario_hash, f.scenario_hash);
+  EXPECT_EQ(r.mode, f.mode);
+  EXPECT_EQ(r.pilot, f.pilot);
+  EXPECT_EQ(r.input_device, f.input_device);
+  EXPECT_EQ(r.input_settings_hash, f.input_settings_hash);
+  EXPECT_EQ(r.started_unix_ms, f.started_unix_ms);
+  EXPECT_EQ(r.duration_s, f.duration_s);
+  EXPECT_EQ(r.ended, history::Ended::lost);
+  EXPECT_TRUE(r.probe);
+  EXPECT_EQ(r.recording_path, f.recording_path);
+  EXPECT_EQ(r.recording_hash, f.recording_hash);
+  EXPECT_EQ(r.app_version, f.app_version);
+  EXPECT_EQ(r.front_end, f.front_end);
+  ASSERT_EQ(r.metrics.size(), f.metrics.size());
+  for (std::size_t i = 0; i < f.metrics.size(); ++i) {
+    EXPECT_EQ(r.metrics[i].first, f.metrics[i].first);
+    if (std::isfinite(f.metrics[i].second))
+      EXPECT_EQ(r.metrics[i].second, f.metrics[i].second);
+    else
+      EXPECT_TRUE(std::isnan(r.metrics[i].second));
+  }
+  std::vector<std::string> names;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  EXPECT_EQ(names, std::vector<std::string>{"Ada"});
+  // The database holds what the schema says, with foreign keys on.
+  EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
+  EXPECT_EQ(sql_text(p, "PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), 4);
+}
+
+// A recording is one flight: the same hash again is already known and adds nothing; flights
+// without a recording are each their own.
+TEST(HistoryStore, ARecordingIsAddedOnce) {
+  const fs::path p = test::fresh_path("history", "once.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord f = sample_flight();
+  f.recording_hash = history::sha256_hex("recording");
+  f.recording_path = "/r.mcap";
+  std::string error;
+  bool known = true;
+  ASSERT_TRUE(store->knows_recording(f.recording_hash, known, error)) << error;
+  EXPECT_FALSE(known);
+  EXPECT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(store->add(f, error), HistoryStore::Added::already_known) << error;
+  ASSERT_TRUE(store->knows_recording(f.recording_hash, known, error)) << error;
+  EXPECT_TRUE(known);
+  FlightRecord g = sample_flight();
+  EXPECT_EQ(store->add(g, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(store->add(g, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(all(*store).size(), 3u);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), 12);
+}
+
+TEST(HistoryStore, FiltersAndTheNewestLimit) {
+  const fs::path p = test::fresh_path("history", "filters.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  std::string error;
+  for (int i = 0; i < 6; ++i) {
+    FlightRecord f = sample_flight(i % 2 ? "Ben" : "Ada", 1000 * (10 - i));  // newest first in
+    f.scenario = i < 3 ? "mi_helix" : "mi_slalom";
+    f.metrics = {{"skill", double(i)}};
+    ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  }
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 6u);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    EXPECT_LT(rows[i - 1].started_unix_ms, rows[i].started_unix_ms) << "oldest first";
+  history::Query q;
+  q.trainee = "Ben";
+  for (const auto& r : all(*store, q)) EXPECT_EQ(r.trainee, "Ben");
+  EXPECT_EQ(all(*store, q).size(), 3u);
+  q = {};
+  q.scenario = "mi_slalom";
+  EXPECT_EQ(all(*store, q).size(), 3u);
+  q = {};
+  q.since_unix_ms = 7000;  // i = 0..3 started at 10000, 9000, 8000, 7000
+  EXPECT_EQ(all(*store, q).size(), 4u);
+  q = {};
+  q.limit = 2;  // the two newest, oldest first: i = 1 (9000), i = 0 (10000)
+  const auto newest = all(*store, q);
+  ASSERT_EQ(newest.size(), 2u);
+  EXPECT_EQ(newest[0].started_unix_ms, 9000);
+  EXPECT_EQ(newest[1].started_unix_ms, 10000);
+  ASSERT_EQ(newest[1].metrics.size(), 1u);
+  EXPECT_EQ(newest[1].metrics[0].second, 0.0);
+  EXPECT_EQ(newest[0].metrics[0].second, 1.0);
+  q = {};
+  q.trainee = "nobody";
+  EXPECT_TRUE(all(*store, q).empty());
+}
+
+// Names are data, never SQL: quotes and a statement in a name are stored and read back as
+// they are; 10 000 characters, invalid UTF-8, control characters and an empty name are
+// refused with the reason, and nothing of them is written.
+TEST(HistoryStore, HostileTraineeNames) {
+  const fs::path p = test::fresh_path("history", "names.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  std::string error;
+  const std::vector<std::string> stored = {
+      "O'Brien", "\"quoted\"", "Robert'); DROP TABLE flights; --", "'; DROP TABLE trainees",
+      "Zoë Ångström 飛行", std::string(history::kMaxNameChars, 'x')};
+  for (const std::string& name : stored)
+    EXPECT_EQ(store->add(sample_flight(name), error), HistoryStore::Added::added)
+        << name << ": " << error;
+  const struct {
+    std::string name;
+    const char* reason;
+  } refused[] = {
+      {std::string(10'000, 'a'), "10000 characters long"},
+      {std::string(history::kMaxNameChars + 1, 'x'), "201 characters long"},
+      {"bad\xff" "byte", "not valid UTF-8"},
+      {"over\xc0\xaflong", "not valid UTF-8"},
+      {"cut\xe2\x82", "not valid UTF-8"},
+      {"surrogate\xed\xa0\x80", "not valid UTF-8"},
+      {"line\nbreak", "control character"},
+      {"esc\x1b[31mred", "control character"},
+      {"c1\xc2\x9b", "control character"},
+      {"", "empty"},
+  };
+  for (const auto& r : refused) {
+    error.clear();
+    EXPECT_FALSE(store->add(sample_flight(r.name), error)) << r.reason;
+    EXPECT_NE(error.find(r.reason), std::string::npos) << error;
+    EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  }
+  std::vector<std::string> names;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  std::set<std::string> want(stored.begin(), stored.end());
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()), want);
+  for (const std::string& name : stored) {
+    history::Query q;
+    q.trainee = name;
+    const auto rows = all(*store, q);
+    ASSERT_EQ(rows.size(), 1u) << name;
+    EXPECT_EQ(rows[0].trainee, name);
+  }
+  EXPECT_EQ(all(*store).size(), stored.size());  // the tables are all still there
+  EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
+}
+
+// A newer mixpilot's history is refused with the reason and left as it was, byte for byte.
+TEST(HistoryStore, ANewerSchemaIsRefusedAndLeftUntouched) {
+  const fs::path p = test::fresh_path("history", "newer.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  std::string error;
+  {
+    auto store = open_store(p);
+    ASSERT_TRUE(store);
+    ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+  }
+  EXPECT_EQ(sql_int(p, "INSERT INTO schema_version VALUES (99, 0) RETURNING version"), 99);
+  const auto before = test::slurp(p);
+  const auto store = history::open_sqlite(p.string(), error);
+  EXPECT_FALSE(store);
+  EXPECT_NE(error.find("newer mixpilot (schema version 99"), std::string::npos) << error;
+  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  EXPECT_EQ(test::slurp(p), before);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM flights"), 1);
+}
+
+// A file that is not a database: refused with the file's name and what to do.
+TEST(HistoryStore, ACorruptFileIsSaidAsSuch) {
+  const fs::path p = test::fresh_path("history", "corrupt.sqlite");
+  std::ofstream(p) << std::string(8192, 'Z');
+  const auto before = test::slurp(p);
+  std::string error;
+  EXPECT_FALSE(history::open_sqlite(p.string(), error));
+  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("not a database"), std::string::npos) << error;
+  EXPECT_NE(error.find("damaged"), std::string::npos) << error;
+  EXPECT_EQ(test::slurp(p), before);
+  // A real history with a page overwritten in its middle.
+  const fs::path q = test::fresh_path("history", "damaged.sqlite");
+  {
+    auto store = open_store(q);
+    ASSERT_TRUE(store);
+    for (int i = 0; i < 200; ++i) ASSERT_TRUE(store->add(sample_flight(), error)) << error;
+  }
+  sql_int(q, "PRAGMA wal_checkpoint(TRUNCATE)");
+  {
+    std::fstream f(q, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(0);
+    f << std::string(100, '\x5a');  // the header: no longer SQLite's
+  }
+  error.clear();
+  EXPECT_FALSE(history::open_sqlite(q.string(), error));
+  EXPECT_NE(error.find("damaged"), std::string::npos) << error;
+}
+
+TEST(HistoryStore, AReadOnlyFileOrFolderIsSaidAsSuch) {
+  if (running_as_root()) GTEST_SKIP() << "root writes read-only files: run as a user";
+  const fs::path dir = test::fresh_path("history", "ro");
+  const fs::path p = dir / "history.sqlite";
+  std::string error;
+  {
+    auto store = open_store(p);
+    ASSERT_TRUE(store);
+    ASSERT_TRUE(store->add(sample_flight(), error)) << error;
+  }
+  sql_int(p, "PRAGMA wal_checkpoint(TRUNCATE)");
+  ::chmod(p.c_str(), 0400);
+  auto store = history::open_sqlite(p.string(), error);
+  if (store) {
+    EXPECT_FALSE(store->add(sample_flight(), error));
+  }
+  EXPECT_NE(error.find("cannot be written"), std::string::npos) << error;
+  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  ::chmod(p.c_str(), 0600);
+  // A folder where no history can be made.
+  const fs::path locked = test::fresh_path("history", "locked_folder");
+  fs::create_directories(locked);
+  ::chmod(locked.c_str(), 0500);
+  error.clear();
+  EXPECT_FALSE(history::open_sqlite((locked / "h.sqlite").string(), error));
+  EXPECT_NE(error.find("cannot be written"), std::string::npos) << error;
+  ::chmod(locked.c_str(), 0700);
+}
+
+// Another program holding the write lock past the busy timeout: the write waits that long,
+// then says why.
+TEST(HistoryStore, ALockedDatabaseWaitsThenSaysSo) {
+  const fs::path p = test::fresh_path("history", "locked.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(p.c_str(), &holder), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  history::SqliteSettings s;
+  s.busy_timeout_ms = 300;
+  std::string error;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(history::open_sqlite(p.string(), error, s));
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(waited, 0.25);
+  EXPECT_LT(waited, 5.0);
+  EXPECT_NE(error.find("locked"), std::string::npos) << error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  // Opened before the lock, a store's write waits the same way.
+  auto store = open_store(p, s);
+  ASSERT_TRUE(store);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  error.clear();
+  EXPECT_FALSE(store->add(sample_flight(), error));
+  EXPECT_NE(error.find("locked"), std::string::npos) << error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  EXPECT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+}
+
+// The default file's missing folders are made, private to the user.
+TEST(HistoryStore, MissingFoldersAreMadePrivate) {
+  const fs::path base = test::fresh_path("history", "xdg");
+  const fs::path p = base / "a" / "b" / "history.sqlite";
+  ASSERT_TRUE(open_store(p));
+  EXPECT_TRUE(fs::exists(p));
+  struct stat st {};
+  ASSERT_EQ(::stat((base / "a" / "b").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  ASSERT_EQ(::stat((base / "a").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  // The factory: "" is the default file under $XDG_DATA_HOME; sqlite:PATH a file.
+  setenv("XDG_DATA_HOME", base.c_str(), 1);
+  std::string error;
+  auto d = history::open_history("", error);
+  ASSERT_TRUE(d) << error;
+  EXPECT_EQ(d->where(), (base / "mixpilot" / "history.sqlite").string());
+  auto s = history::open_history("sqlite:" + (base / "x.sqlite").string(), error);
+  ASSERT_TRUE(s) << error;
+  EXPECT_EQ(s->where(), (base / "x.sqlite").string());
+  EXPECT_FALSE(history::open_history("postgresql://user:secret@host/db", error));
+  EXPECT_NE(error.find("PostgreSQL"), std::string::npos) << error;
+  EXPECT_EQ(error.find("secret"), std::string::npos) << error;
+  EXPECT_FALSE(history::open_history(base.string(), error));  // a folder
+  EXPECT_NE(error.find("folder"), std::string::npos) << error;
+}
+
+// ---- Writers at once, and killed ----------------------------------------------------------
+
+// Eight processes write 50 flights each into one file at once: 400 rows, none lost.
+TEST(HistoryStore, EightProcessesWriteAtOnce) {
+  const fs::path p = test::fresh_path("history", "parallel.sqlite");
+  constexpr int kProcs = 8, kEach = 50;
+  std::vector<pid_t> kids;
+  for (int k = 0; k < kProcs; ++k) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      std::string error;
+      auto store = history::open_sqlite(p.string(), error);  // each its own, new file or not
+      if (!store) {
+        std::fprintf(stderr, "child %d: %s\n", k, error.c_str());
+        ::_exit(2);
+      }
+      for (int i = 0; i < kEach; ++i) {
+        FlightRecord f = sample_flight("writer " + std::to_string(k), i);
+        f.recording_hash = history::sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+        if (store->add(f, error) != HistoryStore::Added::added) {
+          std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
+          ::_exit(3);
+        }
+      }
+      ::_exit(0);
+    }
+    kids.push_back(pid);
+  }
+  for (pid_t pid : kids) {
+    int st = 0;
+    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "a writer failed: " << st;
+  }
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  const auto rows = all(*store);
+  EXPECT_EQ(rows.size(), std::size_t(kProcs * kEach));
+  std::set<std::string> hashes;
+  for (const auto& r : rows) hashes.insert(r.recording_hash);
+  EXPECT_EQ(hashes.size(), std::size_t(kProcs * kEach));
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), kProcs * kEach * 4);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM schema_version"), history::kSchemaVersion);
+  std::vector<std::string> names;
+  std::string error;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  EXPECT_EQ(names.size(), std::size_t(kProcs));
+}
+
+// A writer killed (SIGKILL) in the middle of its transactions: the file passes SQLite's
+// integrity check and holds every flight whose commit the writer reported, and nothing half.
+TEST(HistoryStore, AWriterKilledMidTransactionLosesNothingCommitted) {
+  const fs::path p = test::fresh_path("history", "killed.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  constexpr int kMetrics = 3000;  // a long transaction: the kill lands inside one
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::string error;
+    auto store = history::open_sqlite(p.string(), error);
+    if (!store) ::_exit(2);
+    for (int i = 0;; ++i) {
+      FlightRecord f = sample_flight("killed", i);
+      f.metrics.clear();
+      for (int m = 0; m < kMetrics; ++m) f.metrics.emplace_back("m" + std::to_string(m), m);
+      if (!store->add(f, error)) ::_exit(3);
+      const std::int32_t done = i;
+      if (::write(fds[1], &done, sizeof done) != sizeof done) ::_exit(4);
+    }
+  }
+  ::close(fds[1]);
+  std::int32_t last = -1, got = 0;
+  while (last < 20 && ::read(fds[0], &got, sizeof got) == sizeof got) last = got;
+  // Somewhere inside the next transaction.
+  std::this_thread::sleep_for(std::chrono::milliseconds(7));
+  ::kill(pid, SIGKILL);
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  ASSERT_TRUE(WIFSIGNALED(st)) << "the writer ended before the kill: " << st;
+  while (::read(fds[0], &got, sizeof got) == sizeof got) last = got;  // reported before dying
+  ::close(fds[0]);
+  EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
+  EXPECT_EQ(sql_int(p, "PRAGMA foreign_key_check"), -1) << "a dangling reference";
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  const auto rows = all(*store);
+  ASSERT_GE(rows.size(), std::size_t(last + 1));
+  EXPECT_LE(rows.size(), std::size_t(last + 2));  // at most the one committed unreported
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].started_unix_ms, std::int64_t(i));
+    EXPECT_EQ(rows[i].metrics.size(), std::size_t(kMetrics)) << "a flight half written";
+  }
+}
+
+}  // namespace
+}  // namespace mixpilot
