@@ -12,16 +12,21 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <set>
 #include <thread>
 #include <string>
 #include <vector>
 
+#include "app/flight_rig.hpp"
+#include "app/trainer.hpp"
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
+#include "core/numerics/version.hpp"
+#include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot {
@@ -531,6 +536,285 @@ TEST(HistoryStore, AWriterKilledMidTransactionLosesNothingCommitted) {
     EXPECT_EQ(rows[i].started_unix_ms, std::int64_t(i));
     EXPECT_EQ(rows[i].metrics.size(), std::size_t(kMetrics)) << "a flight half written";
   }
+}
+
+
+// ---- Every front end's flight, once ----------------------------------------------------------
+
+const std::string kSrc = MIXPILOT_SOURCE_DIR;
+const std::string kMixpilot = MIXPILOT_BINARY;
+
+// A user's folders in a fresh place; their default history file.
+fs::path fresh_home(const std::string& name) {
+  const fs::path home = test::fresh_path("history_home", name);
+  fs::create_directories(home);
+  return home;
+}
+fs::path default_history(const fs::path& home) {
+  return home / "data" / "mixpilot" / "history.sqlite";
+}
+std::int64_t rows_in(const fs::path& db) {
+  return fs::exists(db) ? sql_int(db, "SELECT count(*) FROM flights") : 0;
+}
+int count_of(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1))
+    ++n;
+  return n;
+}
+
+// `fly --headless`: one row with the flight's fields, its metrics the report's; score, replay,
+// fly of the recording and import add nothing (they are not new flights).
+TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
+  const fs::path home = fresh_home("fly");
+  const fs::path rec = home / "recs" / "a.mcap", report = home / "a.json";
+  fs::create_directories(rec.parent_path());
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot,
+                               "fly --scenario " + scen + " --pilot novice --headless --duration 3 "
+                               "--trainee \"Zoë O'Brien\" --record " + rec.string() +
+                                   " --report " + report.string(),
+                               home),
+            0)
+      << test::read_file(home / "out.txt");
+  const fs::path db = default_history(home);
+  ASSERT_EQ(rows_in(db), 1) << test::read_file(home / "out.txt");
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error);
+  ASSERT_TRUE(store) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  const StoredFlight& f = rows[0];
+  EXPECT_EQ(f.trainee, "Zoë O'Brien");
+  EXPECT_EQ(f.station, history::host_name());
+  EXPECT_EQ(f.scenario, "mi_helix");
+  EXPECT_EQ(f.scenario_hash, history::sha256_hex(test::read_file(scen)));
+  EXPECT_EQ(f.mode, "mixed_initiative");
+  EXPECT_EQ(f.pilot, "novice");
+  EXPECT_EQ(f.input_device, "");
+  EXPECT_NEAR(f.duration_s, 3.0, 1e-9);
+  EXPECT_EQ(f.ended, history::Ended::completed);
+  EXPECT_FALSE(f.probe);
+  EXPECT_EQ(f.recording_path, rec.string());
+  EXPECT_EQ(f.recording_hash, *history::sha256_file(rec.string(), error));
+  EXPECT_EQ(f.app_version, version());
+  EXPECT_EQ(f.front_end, "fly");
+  const auto now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          std::chrono::system_clock::now().time_since_epoch())
+                          .count();
+  EXPECT_GT(f.started_unix_ms, now_ms - 120'000);
+  EXPECT_LE(f.started_unix_ms, now_ms);
+  const auto reported = test::numbers(test::read_file(report));
+  ASSERT_FALSE(f.metrics.empty());
+  for (const auto& [name, value] : f.metrics) {
+    ASSERT_TRUE(reported.count(name)) << name;
+    EXPECT_NEAR(value, reported.at(name), 1e-12 * std::max(1.0, std::abs(value))) << name;
+  }
+  EXPECT_EQ(f.metrics.size(), reported.size());
+  // Not new flights: nothing added.
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "score " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "replay --headless " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "fly --headless --pilot " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + rec.parent_path().string(), home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("already in the history"), std::string::npos);
+  EXPECT_EQ(rows_in(db), 1);
+  // --history off: nothing; another file: there.
+  const fs::path other = home / "other.sqlite";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice --headless "
+                                          "--duration 1 --history off", home), 0);
+  EXPECT_EQ(rows_in(db), 1);
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice --headless "
+                                          "--duration 1 --history sqlite:" + other.string(), home), 0);
+  EXPECT_EQ(rows_in(db), 1);
+  EXPECT_EQ(rows_in(other), 1);
+  // What `history` shows of it, in each form.
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --json", home), 0);
+  const std::string json = test::read_file(home / "out.txt");
+  EXPECT_NE(json.find("\"trainee\": \"Zoë O'Brien\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"front_end\": \"fly\""), std::string::npos) << json;
+  EXPECT_EQ(test::numbers(json).at("skill"), reported.at("skill"));
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --csv", home), 0);
+  const std::string csv = test::read_file(home / "out.txt");
+  EXPECT_EQ(count_of(csv, "\n"), 2) << csv;
+  EXPECT_NE(csv.find(",metrics.skill"), std::string::npos) << csv;
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --trainee nobody", home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("0 flights"), std::string::npos);
+}
+
+// history import: recordings flown again and added once, a bad file named with its reason
+// while the others are imported; importing again adds nothing.
+TEST(HistoryFrontEnds, ImportAddsEachRecordingOnce) {
+  const fs::path home = fresh_home("import");
+  const fs::path dir = home / "recs";
+  fs::create_directories(dir / "sub");
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  for (const char* name : {"a.mcap", "sub/b.mcap"})
+    ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot experienced "
+                                            "--headless --duration 2 --history off --record " +
+                                                (dir / name).string(), home),
+              0);
+  std::ofstream(dir / "bad.mcap") << "not a recording";
+  const fs::path db = default_history(home);
+  EXPECT_EQ(rows_in(db), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + dir.string() + " --jobs 2 "
+                                          "--trainee Imported", home), 1);
+  const std::string out = test::read_file(home / "out.txt");
+  EXPECT_NE(out.find("bad.mcap: not imported: "), std::string::npos) << out;
+  EXPECT_NE(out.find("not an MCAP file"), std::string::npos) << out;
+  EXPECT_NE(out.find("2 added"), std::string::npos) << out;
+  EXPECT_EQ(rows_in(db), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM flights WHERE front_end = 'import'"), 2);
+  EXPECT_EQ(sql_text(db, "SELECT name FROM trainees"), "Imported");
+  fs::remove(dir / "bad.mcap");
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + dir.string(), home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("0 added, 2 already known"), std::string::npos)
+      << test::read_file(home / "out.txt");
+  EXPECT_EQ(rows_in(db), 2);
+}
+
+// A history that cannot be used: fly says so once on stderr, and still flies, records and
+// exits 0.
+TEST(HistoryFrontEnds, ABrokenHistoryNeverCostsTheFlight) {
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  struct Case {
+    const char* name;
+    std::function<void(const fs::path&)> make;  // breaks the history at this path
+    const char* said;
+  };
+  const Case cases[] = {
+      {"corrupt", [](const fs::path& p) { std::ofstream(p) << std::string(4096, 'x'); },
+       "not a database"},
+      {"newer",
+       [](const fs::path& p) {
+         { ASSERT_TRUE(open_store(p)); }
+         sql_int(p, "INSERT INTO schema_version VALUES (7, 0) RETURNING version");
+       },
+       "newer mixpilot"},
+      {"folder", [](const fs::path& p) { fs::create_directories(p); }, "is a folder"},
+  };
+  for (const Case& c : cases) {
+    const fs::path home = fresh_home(std::string("broken_") + c.name);
+    const fs::path db = home / "h.sqlite", rec = home / "r.mcap";
+    c.make(db);
+    EXPECT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice "
+                                            "--headless --duration 1 --history " + db.string() +
+                                                " --record " + rec.string(), home),
+              0)
+        << c.name;
+    const std::string out = test::read_file(home / "out.txt");
+    EXPECT_EQ(count_of(out, "history: "), 1) << c.name << ": " << out;
+    EXPECT_NE(out.find(c.said), std::string::npos) << c.name << ": " << out;
+    EXPECT_NE(out.find("flown but not remembered"), std::string::npos) << out;
+    EXPECT_NE(out.find("recorded " + rec.string()), std::string::npos) << out;
+    EXPECT_TRUE(fs::exists(rec)) << c.name;
+  }
+}
+
+// The rig (every front end's flight) with the history locked past its busy timeout: the
+// flight flies and records, the close says why the row is missing; once the lock is gone the
+// next flight is remembered. And a replay's rig never writes a row.
+TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
+  const fs::path dir = test::fresh_path("history", "rig_locked");
+  fs::create_directories(dir);
+  const fs::path db = dir / "h.sqlite";
+  history::SqliteSettings s;
+  s.busy_timeout_ms = 200;
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error, s);
+  ASSERT_TRUE(store) << error;
+  const auto fly = [&](const fs::path& rec) {
+    cli::FlyOptions o;
+    o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+    o.pilot = "novice";
+    o.duration = 1.0;
+    int status = 0;
+    std::string why;
+    auto rig = cli::FlightRig::assemble(o, why, status);
+    EXPECT_TRUE(rig) << why;
+    EXPECT_TRUE(rig->record(rec.string(), "Lena", {}, true, why)) << why;
+    rig->remember(store.get(), "Lena", "fly");
+    rig->start();
+    while (rig->step()) {
+    }
+    return rig->close(false);
+  };
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &holder), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  const auto locked = fly(dir / "locked.mcap");
+  EXPECT_EQ(locked.recorded, (dir / "locked.mcap").string());
+  EXPECT_EQ(locked.error, "");
+  EXPECT_FALSE(locked.remembered);
+  EXPECT_NE(locked.history_error.find("locked"), std::string::npos) << locked.history_error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  const auto free = fly(dir / "free.mcap");
+  EXPECT_TRUE(free.remembered) << free.history_error;
+  EXPECT_EQ(rows_in(db), 1);
+  // A replay of it: the rig is given the store, and adds nothing.
+  cli::FlyOptions o;
+  o.pilot = (dir / "free.mcap").string();
+  o.replay = true;
+  int status = 0;
+  auto rig = cli::FlightRig::assemble(o, error, status);
+  ASSERT_TRUE(rig) << error;
+  rig->remember(store.get(), "Lena", "fly");
+  rig->start();
+  while (rig->step()) {
+  }
+  const auto replayed = rig->close(false);
+  EXPECT_FALSE(replayed.remembered);
+  EXPECT_EQ(rows_in(db), 1);
+}
+
+// The window's live flight, driven through the app as the window does (no frames needed): the
+// trainee typed in the session panel, recorded, remembered once as "window"; a flight that was
+// made ready but never started is not.
+TEST(HistoryFrontEnds, TheWindowsLiveFlightIsRememberedOnce) {
+  const fs::path home = fresh_home("window");
+  setenv("XDG_CONFIG_HOME", (home / "config").c_str(), 1);
+  setenv("XDG_DATA_HOME", (home / "data").c_str(), 1);
+  cli::FlyOptions o;
+  o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+  o.pilot = "novice";
+  o.duration = 1.5;
+  o.record = (home / "w.mcap").string();
+  {
+    cli::Trainer app(o);
+    std::string error;
+    int status = 0;
+    ASSERT_TRUE(app.open_live(error, status)) << error;
+    app.act(ui::LiveRequest{ui::SetTrainee{"Marie-Hélène"}});
+    app.start();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (app.live()->rig->running() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(app.finish(), 0);
+    testing::internal::GetCapturedStdout();
+  }
+  {
+    cli::Trainer app(o);  // opened, never started
+    std::string error;
+    int status = 0;
+    ASSERT_TRUE(app.open_live(error, status)) << error;
+    testing::internal::CaptureStdout();
+    (void)app.finish();
+    testing::internal::GetCapturedStdout();
+  }
+  const fs::path db = default_history(home);
+  ASSERT_EQ(rows_in(db), 1);
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error);
+  ASSERT_TRUE(store) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].trainee, "Marie-Hélène");
+  EXPECT_EQ(rows[0].front_end, "window");
+  EXPECT_EQ(rows[0].pilot, "novice");
+  EXPECT_NEAR(rows[0].duration_s, 1.5, 0.02);
+  EXPECT_EQ(rows[0].recording_path, o.record);
+  EXPECT_EQ(rows[0].recording_hash, *history::sha256_file(o.record, error));
 }
 
 }  // namespace
