@@ -476,24 +476,35 @@ int history_command(int argc, char** argv) {
   if (importing && import_dir.empty())
     usage_error(cmd, "which folder? (mixpilot history import DIR)");
   std::string error;
+  std::vector<history::StoredFlight> rows;
+  const auto print = [&] {
+    if (as_csv)
+      print_csv(rows);
+    else if (as_json)
+      print_json(rows);
+    else
+      print_table(rows);
+    return kExitOk;
+  };
+  // A listing never creates a history: no SQLite file yet is no flight yet.
+  if (!importing && !location.starts_with("postgres")) {
+    const std::string file = location.empty()            ? history::default_history_path()
+                             : location.starts_with("sqlite:") ? location.substr(7)
+                                                               : location;
+    std::error_code ec;
+    if (!file.empty() && !fs::exists(file, ec) && !ec) return print();
+  }
   const auto store = history::open_history(location, error);
   if (!store) {
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
   if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
-  std::vector<history::StoredFlight> rows;
   if (!store->query(q, rows, error)) {
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
-  if (as_csv)
-    print_csv(rows);
-  else if (as_json)
-    print_json(rows);
-  else
-    print_table(rows);
-  return kExitOk;
+  return print();
 }
 
 }  // namespace mixpilot::cli

@@ -354,9 +354,30 @@ TEST(HistoryStore, ACorruptFileIsSaidAsSuch) {
   EXPECT_NE(error.find("damaged"), std::string::npos) << error;
 }
 
+// As root, permissions do not hold: the check runs in a child that drops to `nobody`.
+template <class Check>
+void as_a_user(Check check) {
+  if (!running_as_root()) {
+    check();
+    return;
+  }
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(77);
+    check();
+    ::_exit(testing::Test::HasFailure() ? 1 : 0);
+  }
+  int st = 0;
+  ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+  ASSERT_TRUE(WIFEXITED(st));
+  if (WEXITSTATUS(st) == 77) GTEST_SKIP() << "cannot drop root to test permissions";
+  EXPECT_EQ(WEXITSTATUS(st), 0) << "the check failed as nobody (its output is above)";
+}
+
 TEST(HistoryStore, AReadOnlyFileOrFolderIsSaidAsSuch) {
-  if (running_as_root()) GTEST_SKIP() << "root writes read-only files: run as a user";
   const fs::path dir = test::fresh_path("history", "ro");
+  fs::create_directories(dir);
   const fs::path p = dir / "history.sqlite";
   std::string error;
   {
@@ -365,22 +386,24 @@ TEST(HistoryStore, AReadOnlyFileOrFolderIsSaidAsSuch) {
     ASSERT_TRUE(store->add(sample_flight(), error)) << error;
   }
   sql_int(p, "PRAGMA wal_checkpoint(TRUNCATE)");
-  ::chmod(p.c_str(), 0400);
-  auto store = history::open_sqlite(p.string(), error);
-  if (store) {
-    EXPECT_FALSE(store->add(sample_flight(), error));
-  }
-  EXPECT_NE(error.find("cannot be written"), std::string::npos) << error;
-  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  ::chmod(p.c_str(), 0444);
+  // Readable by all (the folders on the way too), writable by nobody but root.
+  for (fs::path d = dir; d != test::process_temp_dir().parent_path(); d = d.parent_path())
+    ::chmod(d.c_str(), 0755);
+  ::chmod(dir.c_str(), 0555);
+  as_a_user([&] {
+    std::string why;
+    auto store = history::open_sqlite(p.string(), why);
+    if (store) EXPECT_FALSE(store->add(sample_flight(), why));
+    EXPECT_NE(why.find("cannot be written"), std::string::npos) << why;
+    EXPECT_NE(why.find(p.string()), std::string::npos) << why;
+    // A folder where no history can be made.
+    why.clear();
+    EXPECT_FALSE(history::open_sqlite((dir / "new.sqlite").string(), why));
+    EXPECT_NE(why.find("cannot be written"), std::string::npos) << why;
+  });
+  ::chmod(dir.c_str(), 0700);
   ::chmod(p.c_str(), 0600);
-  // A folder where no history can be made.
-  const fs::path locked = test::fresh_path("history", "locked_folder");
-  fs::create_directories(locked);
-  ::chmod(locked.c_str(), 0500);
-  error.clear();
-  EXPECT_FALSE(history::open_sqlite((locked / "h.sqlite").string(), error));
-  EXPECT_NE(error.find("cannot be written"), std::string::npos) << error;
-  ::chmod(locked.c_str(), 0700);
 }
 
 // Another program holding the write lock past the busy timeout: the write waits that long,
@@ -655,7 +678,9 @@ TEST(HistoryFrontEnds, ImportAddsEachRecordingOnce) {
               0);
   std::ofstream(dir / "bad.mcap") << "not a recording";
   const fs::path db = default_history(home);
-  EXPECT_EQ(rows_in(db), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history --json", home), 0);
+  EXPECT_EQ(test::read_file(home / "out.txt"), "[]\n");
+  EXPECT_FALSE(fs::exists(db)) << "a listing made a history";
   EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + dir.string() + " --jobs 2 "
                                           "--trainee Imported", home), 1);
   const std::string out = test::read_file(home / "out.txt");
