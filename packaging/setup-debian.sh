@@ -11,6 +11,9 @@ packages=(
   libeigen3-dev coinor-libipopt-dev
   # scenario files
   libtomlplusplus-dev
+  # the trainee's history: SQLite (sqlite3: its shell, to look into a history), SHA-256 of
+  # recordings and scenarios (libcrypto)
+  libsqlite3-dev sqlite3 libssl-dev
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
   libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
   libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev xvfb xauth
