@@ -394,7 +394,9 @@ TEST(HistoryStore, AReadOnlyFileOrFolderIsSaidAsSuch) {
   as_a_user([&] {
     std::string why;
     auto store = history::open_sqlite(p.string(), why);
-    if (store) EXPECT_FALSE(store->add(sample_flight(), why));
+    if (store) {
+      EXPECT_FALSE(store->add(sample_flight(), why));
+    }
     EXPECT_NE(why.find("cannot be written"), std::string::npos) << why;
     EXPECT_NE(why.find(p.string()), std::string::npos) << why;
     // A folder where no history can be made.
