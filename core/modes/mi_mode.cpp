@@ -328,6 +328,7 @@ ModeIdentity MiMode::identity() const {
   id.pilot = pilot_->name();
   for (const auto& entry : scenario_.pilots) id.pilots.push_back(entry.first);
   id.seed = scenario_.plant.seed;
+  id.probe = !controller_.assisted();
   return id;
 }
 
