@@ -251,12 +251,33 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     status = kExitUsage;
     return std::nullopt;
   }
+  if (o.assist && *o.assist == Assistance::off && *kind_name != "mixed_initiative") {
+    error = usage_message(o.command, "--assist is for mixed_initiative scenarios (a pilot shares "
+                                     "the authority there), " + f->scenario_source + " is " +
+                                         *kind_name);
+    status = kExitUsage;
+    return std::nullopt;
+  }
+  if (f->recording && o.assist) {
+    const std::optional<Assistance> recorded = recorded_assistance(*f->recording, o.pilot, error);
+    if (!recorded) return std::nullopt;
+    if (*recorded != *o.assist) {
+      error = usage_message(
+          o.command, o.pilot + " was flown with assistance " +
+                         (*recorded == Assistance::on ? "on" : "off") +
+                         ": its replay flies it so (leave out --assist " +
+                         (*o.assist == Assistance::on ? "on" : "off") + ")");
+      status = kExitUsage;
+      return std::nullopt;
+    }
+  }
   if (f->recording) {
     f->mode = replay_mode(*f->recording, o.pilot, f->scenario_text, f->scenario_source,
                           o.duration, error);
   } else {
     ModeRequest request;
     request.duration = o.duration;
+    request.assist = o.assist.value_or(Assistance::on);
     if (is_device_pilot(o.pilot)) {
       f->devices = open_devices(o, f->scenario_text, f->scenario_source, std::move(gamepad),
                                 request, error);
@@ -290,6 +311,8 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
   info.scenario_path = f.scenario_file;
   info.pilot = f.pilot;
   if (f.vehicle) info.vehicle = "dds";
+  if (f.mode->kind() == ModeKind::mixed_initiative)
+    info.assist = f.mode->identity().probe ? "off" : "on";
   if (const auto seed = f.mode->identity().seed) info.seed = *seed;
   return info;
 }
@@ -297,6 +320,7 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
 Labels report_labels(const Flight& f, bool was_interrupted) {
   Labels labels = {{"mode", to_string(f.mode->kind())}, {"scenario", f.mode->scenario_name()}};
   if (!f.pilot.empty()) labels.emplace_back("pilot", f.pilot);
+  if (f.mode->identity().probe) labels.emplace_back("probe", "true");
   if (was_interrupted) labels.emplace_back("interrupted", "true");
   return labels;
 }

@@ -16,6 +16,7 @@
 #include "input/net/remote_vehicle.hpp"
 #include "input/settings.hpp"
 #include "input/virtual_gamepad.hpp"
+#include "core/control/mi_settings.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/session.hpp"
 #include "core/modes/report.hpp"
@@ -43,6 +44,9 @@ struct FlyOptions {
   std::string gamepad_script;      // --gamepad-script: a virtual gamepad plays it
   std::string input_settings;      // --input-settings (default: the user's input.toml)
   std::optional<input::InputSettings> input_values;  // the app's settings, instead of a file
+  // --assist on|off (mixed initiative): off flies a probe (SPEC §10). Unset: on for a new
+  // flight, as recorded for a replay (which refuses another value).
+  std::optional<Assistance> assist;
   std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
   bool publish = false;            // --publish: telemetry out over DDS
   std::string vehicle;             // --vehicle: "" (simulated) or "dds" (mixpilot vehicle)

@@ -52,6 +52,14 @@ constexpr const char* kFlyUsage =
     "                     topic joy; headless only with --realtime) |\n"
     "                     RECORDING.mcap (replays its pilot commands, checked step by step\n"
     "                     against the recording); default: the scenario's (mixed_initiative only)\n"
+    "  --assist on|off    on (default): the planner assists the pilot, their references blended\n"
+    "                     by the PH index λ (SPEC §5.4). off: a probe flight (SPEC §10): λ is\n"
+    "                     pinned to 1 in the cost, so the planner's reference has no weight and\n"
+    "                     the score is the pilot's own skill, while every constraint still keeps\n"
+    "                     the vehicle safe (obstacles, arena walls, input bounds, the safe hold;\n"
+    "                     a lost device still hands the vehicle to the planner). Marked as a\n"
+    "                     probe in the report and the recording, whose replays fly it as one\n"
+    "                     (mixed_initiative only)\n"
     "  --gamepad-script FILE.csv  with --pilot gamepad: a virtual gamepad plays the script\n"
     "                     (docs/input-settings.md) through SDL from the start of the flight\n"
     "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
@@ -383,6 +391,11 @@ int fly_command(int argc, char** argv) {
       o.scenario_path = value();
     } else if (a == "--pilot") {
       o.pilot = value();
+    } else if (a == "--assist") {
+      const std::string v = value();
+      if (v == "on") o.assist = Assistance::on;
+      else if (v == "off") o.assist = Assistance::off;
+      else usage_error(o.command, "--assist expects on or off, got '" + v + "'");
     } else if (a == "--headless") {
       o.headless = true;
     } else if (a == "--duration") {

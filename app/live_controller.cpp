@@ -11,6 +11,7 @@
 #include "app/cli.hpp"
 #include "core/modes/report.hpp"
 #include "core/scenario/data_files.hpp"
+#include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot::cli {
 
@@ -53,6 +54,15 @@ std::string file_name_part(std::string name) {
 
 bool is_flying(const LiveFlight& f) { return f.started() && f.runner().running(); }
 
+// Whether the scenario at `path` is flown by a pilot (mixed initiative); false when it cannot
+// be read (assembling the flight then says why).
+bool has_pilot(const std::string& path) {
+  std::string text, error;
+  if (!read_text_file(path, text, error)) return false;
+  const std::optional<std::string> mode = scenario_mode(text, path, error);
+  return mode && *mode == "mixed_initiative";
+}
+
 }  // namespace
 
 // ---- The flight's assembly ---------------------------------------------------------------
@@ -63,6 +73,9 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
   auto f = std::make_unique<LiveFlight>();
   FlyOptions o = options_;
   o.replay = o.pilot.ends_with(".mcap");  // a recording's pilot: any mode flies it again
+  // The assistance chosen applies to new flights with a pilot: a recording's pilot flies as it
+  // was recorded, and the thesis's controllers have no pilot to leave alone.
+  if (o.replay || (o.assist == Assistance::off && !has_pilot(o.scenario_path))) o.assist.reset();
   o.input_values = input_.settings();
   std::shared_ptr<input::Gamepad> pad;
   if (o.pilot == "gamepad") {
@@ -258,6 +271,7 @@ void LiveController::close() {
 void LiveController::refresh_choices() {
   choices_.pilots.clear();
   choices_.pilot = -1;
+  choices_.assist_choosable = false;
   if (!live_) return;
   if (ModeIdentity id = live_->mode().identity(); !id.pilot.empty()) {
     choices_.pilots = std::move(id.pilots);
@@ -269,6 +283,9 @@ void LiveController::refresh_choices() {
     choices_.pilot = it == choices_.pilots.end() ? -1 : int(it - choices_.pilots.begin());
   }
   choices_.record_to = choices_.record ? next_record_path() : "";
+  const ModeIdentity id = live_->mode().identity();
+  choices_.assist_choosable = !id.pilot.empty() && !live_->flight().recording;
+  choices_.assist = !id.probe;
 }
 
 void LiveController::fly_scenario(std::size_t index) {
@@ -404,6 +421,16 @@ void LiveController::handle(const ui::LiveRequest& r) {
             choices_.record_to = choices_.record ? next_record_path() : "";
           },
           [&](const ui::SetTrainee& t) { choices_.trainee = t.name; },
+          [&](const ui::SetAssist& a) {
+            // The unstarted flight is made again with the choice, as for a pilot.
+            if (is_flying(*live_) || !choices_.assist_choosable) return;
+            const FlyOptions before = options_;
+            options_.assist = a.on ? Assistance::on : Assistance::off;
+            if (!replace_live(error)) {
+              options_ = before;
+              status_line_.say(error, true);
+            }
+          },
       },
       r);
 }

@@ -30,7 +30,8 @@ constexpr const char* kScoreUsage =
     "replayed states against the recorded ones bit for bit: mixed_initiative recordings replay\n"
     "their pilot commands and are scored (the timing fields come from the recorded solver\n"
     "statistics: they describe that flight); other modes are flown for the recorded number of\n"
-    "steps and give their metrics (timing fields from this run). Progress on stderr, a table on\n"
+    "steps and give their metrics (timing fields from this run). A probe flight (fly --assist\n"
+    "off) is replayed as one and marked \"probe\": \"true\". Progress on stderr, a table on\n"
     "stdout.\n"
     "\n"
     "  --jobs N     replay N recordings in parallel (default: the number of cores)\n"
@@ -46,6 +47,7 @@ struct ScoreRow {
   std::string mode;
   std::string pilot;
   std::string scenario;
+  bool probe = false;  // a probe flight (assistance off), replayed as one
   Metrics metrics;
   bool ok = false;
   std::string difference;  // what differed first; empty: every step replayed bit for bit
@@ -85,6 +87,7 @@ ScoreRow score_recording(const std::string& path) {
   const Mode& mode = rig->mode();
   row.mode = to_string(mode.kind());
   row.scenario = mode.scenario_name();
+  row.probe = mode.identity().probe;
   row.metrics = rig->metrics();
   row.difference = rig->replay_difference();
   row.ended_early = recording_ended_early(rec, mode);
@@ -161,8 +164,8 @@ int score_command(int argc, char** argv) {
   for (int j = 0; j < std::min<int>(jobs, int(files.size())); ++j) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
 
-  std::printf("%-32s %-12s %8s %7s %7s %8s %5s %6s %7s %s\n", "recording", "pilot", "time_s",
-              "lambda", "min_l", "maxdev_m", "coll", "fallb", "skill", "replay");
+  std::printf("%-32s %-12s %8s %7s %7s %6s %8s %5s %6s %7s %s\n", "recording", "pilot", "time_s",
+              "lambda", "min_l", "D", "maxdev_m", "coll", "fallb", "skill", "replay");
   int failures = 0, mismatches = 0;
   std::string json = "[\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -176,23 +179,26 @@ int score_command(int argc, char** argv) {
     const bool exact = r.difference.empty();
     std::string replay = exact ? "exact" : "DIFFERS from recording";
     if (!r.ended_early.empty()) replay += " (" + r.ended_early + ")";
+    if (r.probe) replay += " (probe: assistance off)";
     if (!exact) {
       ++mismatches;
       std::fprintf(stderr, "%s: the replay differs from the recording: %s\n", r.file.c_str(),
                    r.difference.c_str());
     }
     if (r.mode == "mixed_initiative") {
-      std::printf("%-32s %-12s %8.1f %7.3f %7.3f %8.3f %5d %6lld %7.1f %s\n", r.file.c_str(),
-                  r.pilot.c_str(), m("duration_s"), m("mean_lambda"), m("min_lambda"),
-                  m("max_deviation_m"), int(m("collisions")), static_cast<long long>(m("fallbacks")),
-                  m("skill"), replay.c_str());
+      std::printf("%-32s %-12s %8.1f %7.3f %7.3f %6.3f %8.3f %5d %6lld %7.1f %s\n",
+                  r.file.c_str(), r.pilot.c_str(), m("duration_s"), m("mean_lambda"),
+                  m("min_lambda"), m("assistance_dependence"), m("max_deviation_m"),
+                  int(m("collisions")), static_cast<long long>(m("fallbacks")), m("skill"),
+                  replay.c_str());
     } else {  // the other modes' metrics are in the JSON
-      std::printf("%-32s %-12.12s %8s %7s %7s %8s %5s %6s %7s %s\n", r.file.c_str(),
-                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", replay.c_str());
+      std::printf("%-32s %-12.12s %8s %7s %7s %6s %8s %5s %6s %7s %s\n", r.file.c_str(),
+                  r.mode.c_str(), "-", "-", "-", "-", "-", "-", "-", "-", replay.c_str());
     }
     if (json.size() > 2) json += ",\n";
     Labels labels = {{"file", r.file}, {"mode", r.mode}, {"scenario", r.scenario}};
     if (!r.pilot.empty()) labels.emplace_back("pilot", r.pilot);
+    if (r.probe) labels.emplace_back("probe", "true");
     labels.emplace_back("replay", exact ? "exact" : "differs");
     if (!r.ended_early.empty()) labels.emplace_back("interrupted", "true");
     json += to_json(labels, r.metrics);

@@ -257,6 +257,47 @@ TEST_F(App, TheSessionPanelPicksTheScenario) {
   EXPECT_FALSE(app.run_info().session->record_to.empty());
 }
 
+// The session panel's assistance switch (a probe flight, SPEC §10): the request makes the
+// unstarted flight again without assistance, and the HUD's scene knows it; on again makes it
+// assisted. A scenario without a pilot offers no switch, and the choice waits for the next
+// scenario that has one.
+TEST_F(App, ProbeSwitchInTheSessionPanelRebuildsTheNextFlight) {
+  cli::Trainer app(live_options("mi_helix.toml", 2.0));
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  frame(app);
+  EXPECT_TRUE(app.run_info().session->assist_choosable);
+  EXPECT_TRUE(app.run_info().session->assist);
+  EXPECT_FALSE(app.live()->mode().identity().probe);
+  app.act(ui::SetAssist{false});
+  frame(app);
+  EXPECT_TRUE(app.live()->mode().identity().probe);
+  EXPECT_TRUE(app.live()->scene.probe);
+  EXPECT_FALSE(app.live()->started());
+  EXPECT_FALSE(app.run_info().session->assist);
+  app.act(ui::SetAssist{true});
+  frame(app);
+  EXPECT_FALSE(app.live()->mode().identity().probe);
+  EXPECT_TRUE(app.run_info().session->assist);
+
+  app.act(ui::SetAssist{false});
+  const ui::SessionChoices& c = *app.run_info().session;
+  const auto pendubot = std::find(c.scenarios.begin(), c.scenarios.end(), "pendubot_swingup");
+  const auto helix = std::find(c.scenarios.begin(), c.scenarios.end(), "mi_helix");
+  ASSERT_NE(pendubot, c.scenarios.end());
+  ASSERT_NE(helix, c.scenarios.end());
+  const int helix_index = int(helix - c.scenarios.begin());
+  app.act(ui::PickScenario{int(pendubot - c.scenarios.begin())});
+  frame(app);
+  EXPECT_EQ(app.live()->mode().kind(), ModeKind::pendubot_swingup);
+  EXPECT_FALSE(app.run_info().session->assist_choosable);
+  app.act(ui::PickScenario{helix_index});
+  frame(app);
+  EXPECT_EQ(app.live()->mode().kind(), ModeKind::mixed_initiative);
+  EXPECT_TRUE(app.live()->mode().identity().probe);
+}
+
 // A replay: ] jumps to the next event, Home / End, a click on the timeline seeks there, ↑ speeds
 // up, and playing advances the playhead by the wall time times the speed.
 TEST_F(App, ReplayTimelineSeeksJumpsAndPlays) {

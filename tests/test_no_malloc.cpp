@@ -5,6 +5,7 @@
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/control/pendubot_reference.hpp"
 #include "core/control/tracking.hpp"
+#include "core/modes/make_mode.hpp"
 #include "core/modes/pendubot_mode.hpp"
 #include "core/modes/tracking_mode.hpp"
 #include "core/numerics/integrator_erk4.hpp"
@@ -119,6 +120,22 @@ TEST(NoMalloc, TrackingModeStep) {
     EXPECT_EQ(run.allocations, 0);
     EXPECT_FALSE(mode.lost());
   }
+}
+
+// A probe flight (SPEC §10) takes the MI controller's other branch of the cost: every step()
+// of one, flown by the novice, allocates nothing either.
+TEST(NoMalloc, ProbeFlightStep) {
+  ModeRequest request;
+  request.duration = 0.6;
+  request.pilot_name = "novice";
+  request.assist = Assistance::off;
+  std::string error;
+  auto mode = load_mode(MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml", std::move(request), error);
+  ASSERT_TRUE(mode) << error;
+  ASSERT_TRUE(mode->identity().probe);
+  const GuardedSteps run = step_to_end_without_malloc(*mode, [] {});
+  EXPECT_EQ(run.steps, mode->steps_total());
+  EXPECT_EQ(run.allocations, 0);
 }
 
 // Pendubot swing-up: every step() of each path — NMPC tracking and past the reference's end

@@ -151,5 +151,65 @@ TEST(ScoreFormula, TheSkillWeighsEachQuantityAsDocumented) {
   }
 }
 
+
+// D = (1/T)∫(1 − λ) dt over the flown steps, by the rectangle rule of Δt per step (README,
+// Scoring): the made-up flight's λ are 0.9, 0.5, 0.1, 0.7, 0.3 over 5 steps of 0.5 s, so
+// ∫(1 − λ) dt = 0.5 · (0.1 + 0.5 + 0.9 + 0.3 + 0.7) = 1.25 s of T = 2.5 s.
+TEST(AssistanceDependence, IsTheShareOfTheFlightThePlannerFlewWorkedOutByHand) {
+  const Scenario sc = scenario();
+  ScoreAccumulator acc(sc);
+  for (const StepSpec& f : flight()) {
+    Telemetry s;
+    s.x = Eigen::VectorXd::Zero(16);
+    s.x.head<3>() = f.p;
+    s.reference = f.ref;
+    s.lambda = f.lambda;
+    (void)acc.add(s);
+  }
+  const Score s = acc.finish();
+  EXPECT_DOUBLE_EQ(s.assistance_dependence, 1.25 / 2.5);
+  // Between mean_lambda and the rest of the report, in every report's metrics.
+  const Metrics m = to_metrics(s);
+  const auto at = std::find_if(m.begin(), m.end(),
+                               [](const auto& kv) { return kv.first == "assistance_dependence"; });
+  ASSERT_NE(at, m.end());
+  EXPECT_EQ((at - 1)->first, "min_lambda");
+  EXPECT_EQ(at->second, s.assistance_dependence);
+}
+
+// λ ≡ 1 (the pilot flew it all): D is exactly 0. Any other λ: D = 1 − mean_lambda to rounding,
+// and weighted by the time each λ lasted (a λ held longer counts more).
+TEST(AssistanceDependence, IsZeroWhenThePilotFlewItAllAndOneMinusTheMeanLambda) {
+  Scenario sc = scenario();
+  sc.arena.obstacles.clear();
+  sc.duration = 50.0;  // 100 steps of 0.5 s
+  const auto fly = [&](auto lambda_of) {
+    ScoreAccumulator acc(sc);
+    for (int k = 0; k < 100; ++k) {
+      Telemetry s;
+      s.x = Eigen::VectorXd::Zero(16);
+      s.x.head<3>() = Eigen::Vector3d(1, 1, 1);
+      s.reference = Eigen::Vector3d(1, 1, 1);
+      s.lambda = lambda_of(k);
+      (void)acc.add(s);
+    }
+    return acc.finish();
+  };
+  const Score pilot = fly([](int) { return 1.0; });
+  EXPECT_EQ(pilot.assistance_dependence, 0.0);
+  EXPECT_EQ(pilot.mean_lambda, 1.0);
+
+  const Score mixed = fly([](int k) { return 0.5 + 0.45 * std::sin(0.37 * k); });
+  double by_hand = 0;
+  for (int k = 0; k < 100; ++k) by_hand += 0.5 * (1.0 - (0.5 + 0.45 * std::sin(0.37 * k)));
+  EXPECT_NEAR(mixed.assistance_dependence, by_hand / 50.0, 1e-15);
+  EXPECT_NEAR(mixed.assistance_dependence, 1.0 - mixed.mean_lambda, 1e-15);
+  EXPECT_GT(mixed.assistance_dependence, 0.0);
+
+  // Three quarters of the time at λ = 0.2, one quarter at λ = 1: D = 0.75 · 0.8 = 0.6.
+  const Score planner = fly([](int k) { return k < 75 ? 0.2 : 1.0; });
+  EXPECT_NEAR(planner.assistance_dependence, 0.6, 1e-15);
+}
+
 }  // namespace
 }  // namespace mixpilot

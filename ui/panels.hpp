@@ -22,8 +22,10 @@ bool project_in_arena(const Scene& scene, const Telemetry& newest, const UiState
 void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec2 max,
                    ImVec2 frame);
 // The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour; with
-// `names`, the shares' names under it (a text line below max.y).
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true);
+// `names`, the shares' names under it (a text line below max.y). A probe flight's bar says
+// PROBE in its label and "assistance off" where the planner's share is named.
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true,
+                        bool probe = false);
 // Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
 // The thrust stick is centred on the hover rotor speed `hover`.
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);

@@ -37,9 +37,12 @@ struct SetRecord {
 struct SetTrainee {
   std::string name;
 };
+struct SetAssist {
+  bool on;                    // false: the next flight is a probe (SPEC §10)
+};
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
-                                 SetRecord, SetTrainee>;
+                                 SetRecord, SetTrainee, SetAssist>;
 
 // A replay's transport.
 struct TogglePlay {};

@@ -13,6 +13,7 @@ Scene scene_of(const Mode& mode, const std::string& input_source) {
   s.input_source = input_source;
   s.dt = mode.dt();
   s.duration = double(mode.steps_total()) * mode.dt();
+  s.probe = mode.identity().probe;
   return s;
 }
 

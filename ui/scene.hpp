@@ -24,6 +24,7 @@ struct Scene : ModeView {
   std::string input_source;  // the pilot source, or the controller for the other modes
   double dt = 0.01;          // [s] control period
   double duration = 0.0;     // [s] of the whole run
+  bool probe = false;        // a probe flight: the planner does not assist (SPEC §10)
 };
 
 // The value of the channel called `name` in `s`, or `fallback` when it has none.

@@ -188,7 +188,7 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
     const ImVec2 bar_min = ImGui::GetCursorScreenPos();
     const float bar_h = (compact ? 1.4f : 2.0f) * ImGui::GetFontSize();
     draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min,
-                       ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact);
+                       ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact, sc.probe);
     ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
   }
   ImGui::PushFont(mono_font());
@@ -261,6 +261,7 @@ const char* score_field_meaning(const std::string& key) {
       {"rms_deviation_m", "RMS distance from the reference [m]"},
       {"mean_lambda", "mean authority of the pilot (1: all pilot)"},
       {"min_lambda", "least authority of the pilot"},
+      {"assistance_dependence", "share of the flight the planner flew: mean of 1 - lambda"},
       {"collisions", "contacts with obstacles, walls or floor"},
       {"min_clearance_m", "closest approach to an obstacle [m]"},
       {"override_rms", "RMS of what the MPC changed in the pilot's tilt [rad]"},

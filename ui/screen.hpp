@@ -56,6 +56,11 @@ struct SessionChoices {
   bool record = false;                 // record the next flight
   std::string record_to;               // where (a file, or the folder of automatic names)
   std::string trainee;                 // the person flying
+  // Mixed initiative: whether the planner assists the next flight (false: a probe, SPEC §10),
+  // and whether it can be chosen (a new flight of a scenario with a pilot; a recording's
+  // pilot flies as it was recorded).
+  bool assist = true;
+  bool assist_choosable = false;
 };
 
 // A joystick SDL sees.

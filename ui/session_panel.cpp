@@ -62,6 +62,18 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
     std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
   ImGui::InputTextWithHint("trainee", "your name", ui.trainee, sizeof ui.trainee);
   if (ImGui::IsItemDeactivatedAfterEdit()) out.push_back(SetTrainee{ui.trainee});
+  if (c.assist_choosable) {
+    bool assist = c.assist;
+    if (ImGui::Checkbox("assistance", &assist)) out.push_back(SetAssist{assist});
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("On: the planner shares the controls with you, more when you stray.\n"
+                        "Off: a probe flight - you fly alone and the score is your own\n"
+                        "skill; obstacles, walls and input limits still keep the vehicle safe.");
+    if (!c.assist) {
+      ImGui::SameLine();
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCaution), "off: probe flight");
+    }
+  }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());

@@ -45,7 +45,7 @@ std::string elide_middle(const std::string& text, float width) {
   return cut(lo);
 }
 
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names) {
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool probe) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const double l = std::clamp(lambda, 0.0, 1.0);
   // The pilot's share λ fills from the left in the pilot's colour, the planner's share 1 − λ
@@ -58,7 +58,8 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names) {
   dl->AddLine(ImVec2(mid, min.y - scaled(3)), ImVec2(mid, max.y + scaled(3)), colour::kText, scaled(1.0f));
   dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));  // the needle
   char label[64];
-  std::snprintf(label, sizeof label, "%s %.2f", l >= 0.5 ? "PILOT" : "PLANNER", l);
+  std::snprintf(label, sizeof label, "%s%s %.2f", probe ? "PROBE · " : "",
+                l >= 0.5 ? "PILOT" : "PLANNER", l);
   const ImVec2 ts = ImGui::CalcTextSize(label);
   const ImVec2 at(mid - 0.5f * ts.x, 0.5f * (min.y + max.y) - 0.5f * ts.y);
   dl->AddRectFilled(ImVec2(at.x - scaled(6), at.y - scaled(1)),
@@ -68,8 +69,11 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names) {
   if (!names) return;
   const float below = max.y + scaled(4);
   dl->AddText(ImVec2(min.x + scaled(2), below), colour::kPilot, "pilot share λ");
-  const ImVec2 ps = ImGui::CalcTextSize("planner share 1 − λ");
-  dl->AddText(ImVec2(max.x - ps.x - scaled(2), below), colour::kPlanner, "planner share 1 − λ");
+  // A probe: the planner's reference has no weight in the cost (SPEC §10).
+  const char* planner = probe ? "assistance off" : "planner share 1 − λ";
+  const ImVec2 ps = ImGui::CalcTextSize(planner);
+  dl->AddText(ImVec2(max.x - ps.x - scaled(2), below), probe ? colour::kCaution : colour::kPlanner,
+              planner);
 }
 
 namespace {

@@ -103,6 +103,8 @@ void MiController::reset(const Eigen::VectorXd& x) {
 void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x) {
   const int N = settings_.N;
   const double l = out_.lambda_used;
+  // e and u: weighted by 1 − λ when assisted; a probe keeps them at a fixed regularizing weight.
+  const double keep = settings_.assist == Assistance::on ? 1.0 - l : settings_.probe_regularization;
   OcpStageData& data = rti_.data();
   for (int i = 0; i <= N; ++i) {
     Eigen::VectorXd& y = data.yref[i];
@@ -115,7 +117,7 @@ void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eig
     const int n = int(d.size());  // 20, or 16 at the terminal stage
     d.head<3>() = (1.0 - l) * weights_.head<3>();
     d.segment<6>(3) = l * weights_.segment<6>(3);
-    d.segment(9, n - 9) = (1.0 - l) * weights_.segment(9, n - 9);
+    d.segment(9, n - 9) = keep * weights_.segment(9, n - 9);
   }
 
   if (num_obstacles_ > 0) {
@@ -141,8 +143,10 @@ void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eig
 }
 
 RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
-  // The source's authority caps λ (input loss hands the vehicle to the planner, SPEC §6).
-  out_.lambda_used = std::min(out_.lambda_next, std::clamp(pilot.authority, 0.0, 1.0));
+  // The source's authority caps λ (input loss hands the vehicle to the planner, SPEC §6). A
+  // probe pins the PH index's part to 1: the cap alone sets λ.
+  const double cap = std::clamp(pilot.authority, 0.0, 1.0);
+  out_.lambda_used = settings_.assist == Assistance::on ? std::min(out_.lambda_next, cap) : cap;
   set_stage_data(t, pilot, x);
   rti_.prepare();
   const RtiStatus status = rti_.feedback(x);

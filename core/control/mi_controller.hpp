@@ -5,7 +5,11 @@
 // η = p, ν = (φ, θ, Ω1..4), e = (ψ, v_b, ω) with reference 0; terminal cost without u.
 // λ comes from the previous step's prediction (ph_index.hpp) and is held over the horizon;
 // ν^r is held constant over the horizon (ZOH); η^r is the planner's trajectory sampled at the
-// shooting nodes. Ω and τ are bounded (SPEC §3.3).
+// shooting nodes. Ω and τ are bounded (SPEC §3.3). A probe flight (settings.assist = off,
+// SPEC §10) uses λ = 1 for η and ν (capped only by the pilot source's authority) whatever the
+// PH index says, which is still computed from each prediction (ph_index()) but not applied; e
+// and u keep the weight settings.probe_regularization · (Q_e, R), without which the QP is
+// singular.
 //
 // Safety beyond the thesis (on by default): the ball B is only a soft working condition, so the
 // nearest obstacles enter as lcl clearance constraints ‖p − o‖ ≥ r_o + r_vehicle and the arena
@@ -60,6 +64,10 @@ class MiController {
 
   const Eigen::VectorXd& control() const { return out_.control; }  // τ (nu)
   double lambda() const { return out_.lambda_used; }               // λ used in the last step
+  // The PH index of the last step's prediction: λ for the next step when assisted (a probe
+  // computes it and does not apply it).
+  double ph_index() const { return out_.lambda_next; }
+  bool assisted() const { return settings_.assist == Assistance::on; }
   // The MPC's own (φ, θ, Ω) at stage 1: what the pilot's command became.
   PilotCommand applied_command() const;
   // Predicted positions and planner reference at the nodes of the last step (3 x (N+1)).

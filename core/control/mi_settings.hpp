@@ -47,7 +47,17 @@ struct MiWeights {
   double r = 70.0;                             // R = r·I4 on τ
 };
 
+// Whether the planner assists the pilot (SPEC §10). off is a probe flight: λ is pinned to 1 in
+// the cost of §5.4 for η and ν, so the planner's reference η^r has no weight and the MPC follows
+// the pilot's ν^r, while every constraint stays (Ω and τ bounds, obstacles, arena walls) and so
+// does the pilot source's authority cap (a lost device still hands the vehicle to the planner).
+// The e and u terms keep a fixed weight (probe_regularization): with none the QP is singular.
+// Chosen per flight (ModeRequest::assist, a recording's `assist` metadata), never by the
+// scenario file.
+enum class Assistance { on, off };
+
 struct MiControllerSettings {
+  Assistance assist = Assistance::on;
   int N = mi_defaults::kHorizon;
   double dt = mi_defaults::kDt;  // [s]
   MiWeights weights{};
@@ -61,6 +71,8 @@ struct MiControllerSettings {
   double slack_l1 = mi_defaults::kSlackL1;  // exact-penalty weight per constraint side
   double slack_l2 = mi_defaults::kSlackL2;  // ℓ2² weight per constraint side
   double rotor_speed_backoff = mi_defaults::kRotorSpeedBackoff;  // Ω bounds tightened by this
+  // A probe's weight on e and u, as a fraction of Q_e and R (the planner's η^r keeps none).
+  double probe_regularization = mi_defaults::kProbeRegularization;
 };
 
 // An emulated pilot (SPEC §5.4, eq. 7.9): an NMPC tracking η^r with cost

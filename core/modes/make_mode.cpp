@@ -54,6 +54,7 @@ std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& sou
     pilot = make_scenario_pilot(*scenario, name, error);
     if (!pilot) return nullptr;
   }
+  scenario->controller.assist = request.assist;
   auto mode = std::make_unique<MiMode>();
   if (SetupResult r = mode->setup(std::move(*scenario), std::move(pilot)); !r) {
     error = source_name + ": " + r.reason();
@@ -95,6 +96,11 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
   }
   if (*kind != ModeKind::mixed_initiative && (request.pilot_source || !request.pilot_name.empty())) {
     error = source_name + ": a pilot flies only mixed_initiative scenarios, this one is " + *name;
+    return nullptr;
+  }
+  if (*kind != ModeKind::mixed_initiative && request.assist == Assistance::off) {
+    error = source_name + ": a probe flight (assistance off) is for mixed_initiative scenarios, "
+            "this one is " + *name;
     return nullptr;
   }
   std::unique_ptr<Mode> mode = make_kind(*kind, text, source_name, request, error);

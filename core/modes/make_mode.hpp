@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/control/mi_settings.hpp"
 #include "core/control/pilot.hpp"
 #include "core/modes/mode.hpp"
 
@@ -17,6 +18,8 @@ struct ModeRequest {
   // the scenario's profile of this name; else the scenario's default pilot.
   std::unique_ptr<PilotSource> pilot_source;
   std::string pilot_name;
+  // Mixed initiative only: off flies a probe (SPEC §10; core/control/mi_settings.hpp).
+  Assistance assist = Assistance::on;
 };
 
 // The mode of a scenario's text (`source_name` for messages and relative paths), set up and

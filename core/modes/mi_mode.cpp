@@ -328,6 +328,7 @@ ModeIdentity MiMode::identity() const {
   id.pilot = pilot_->name();
   for (const auto& entry : scenario_.pilots) id.pilots.push_back(entry.first);
   id.seed = scenario_.plant.seed;
+  id.probe = !controller_.assisted();
   return id;
 }
 
@@ -347,14 +348,15 @@ std::string MiMode::summary() const {
                 "%s, pilot %s\n"
                 "  flew %.1f s; RTI median %.0f us, p99 %.0f us, %d deadline misses, %lld "
                 "fallbacks\n"
-                "  lambda mean %.3f (min %.3f); deviation max %.3f m, rms %.3f m; in ball %.1f%%; "
-                "progress %.1f%%\n"
+                "  lambda mean %.3f (min %.3f); assistance dependence D %.3f; deviation max "
+                "%.3f m, rms %.3f m; in ball %.1f%%; progress %.1f%%\n"
                 "  collisions %d; min clearance %.3f m; override %.4f rad rms; skill %.1f / 100\n",
                 scenario_.name.c_str(), pilot_ ? pilot_->name().c_str() : "?", s.duration_s,
                 s.rti_median_us, s.rti_p99_us, s.deadline_misses,
                 static_cast<long long>(s.fallbacks), s.mean_lambda, s.min_lambda,
-                s.max_deviation_m, s.rms_deviation_m, 100.0 * s.time_in_ball, 100.0 * s.progress,
-                s.collisions, s.min_clearance_m, s.override_rms, s.skill);
+                s.assistance_dependence, s.max_deviation_m, s.rms_deviation_m,
+                100.0 * s.time_in_ball, 100.0 * s.progress, s.collisions, s.min_clearance_m,
+                s.override_rms, s.skill);
   std::string out = buf;
   if (s.input_lost_s > 0.0) {
     std::snprintf(buf, sizeof buf,

@@ -67,6 +67,9 @@ struct ModeIdentity {
   std::string pilot;                  // the pilot flying ("" where the controller flies)
   std::vector<std::string> pilots;    // the scenario's own pilots a user may pick ("": none)
   std::optional<std::uint64_t> seed;  // the plant's random seed, where it has one
+  // A probe flight (SPEC §10): the planner does not assist (λ pinned to 1 in the cost, every
+  // constraint kept), so the score is the pilot's own skill.
+  bool probe = false;
 };
 
 // Samples of a path given as p(t) over [0, duration], every 50 ms (2 to 4000 samples).

@@ -98,13 +98,20 @@ Score ScoreAccumulator::finish() const {
   }
   sc.progress = double(reached) / double(std::max<std::int64_t>(total, std::int64_t(K)));
 
-  double sum_l = 0, min_l = 1.0;
+  // D = (1/T)∫(1 − λ) dt by the rectangle rule over the steps, T = K Δt: (1/K) Σ (1 − λ_k),
+  // over the same λ_k as mean_lambda (the λ the step applied: 0 while the safe controller
+  // flew, capped by the pilot's authority). Summed as its own terms rather than taken as
+  // 1 − mean_lambda, so a flight whose λ is 1 throughout gives exactly 0; the two agree to
+  // rounding.
+  double sum_l = 0, sum_planner = 0, min_l = 1.0;
   for (double l : m.lambda) {
     sum_l += l;
+    sum_planner += 1.0 - l;
     min_l = std::min(min_l, l);
   }
   sc.mean_lambda = sum_l / double(K);
   sc.min_lambda = min_l;
+  sc.assistance_dependence = sum_planner / double(K);
   sc.collisions = m.collisions;
   sc.min_clearance_m = scenario_->arena.obstacles.empty() ? 0.0 : m.min_clearance;
   sc.override_rms = std::sqrt(m.sum_override_sq / double(K));
@@ -138,6 +145,7 @@ Metrics to_metrics(const Score& s) {
       {"rms_deviation_m", s.rms_deviation_m},
       {"mean_lambda", s.mean_lambda},
       {"min_lambda", s.min_lambda},
+      {"assistance_dependence", s.assistance_dependence},
       {"collisions", double(s.collisions)},
       {"min_clearance_m", s.min_clearance_m},
       {"override_rms", s.override_rms},

@@ -7,6 +7,10 @@
 //   time_in_ball      fraction of steps with ‖p_k − η^r_k‖ ≤ r
 //   max_deviation_m   max_k ‖p_k − η^r_k‖;   rms_deviation_m  √(mean_k ‖p_k − η^r_k‖²)
 //   mean_lambda, min_lambda   of the PH index λ_k
+//   assistance_dependence     D = (1/T)∫₀ᵀ (1 − λ) dt ∈ [0, 1] (SPEC §10), by the rectangle rule
+//                     over the control steps: (1/K) Σ_k (1 − λ_k) with the λ_k applied in step k,
+//                     the same samples as mean_lambda, so D = 1 − mean_lambda up to rounding
+//                     (the share of the flight the planner flew)
 //   collisions        number of times the vehicle sphere (radius r_v) starts touching an
 //                     obstacle, a wall or the floor
 //   min_clearance_m   min_k min_o (‖p_k − o‖ − r_o − r_v): negative means contact
@@ -45,6 +49,7 @@ struct Score {
   double rms_deviation_m = 0;
   double mean_lambda = 0;
   double min_lambda = 0;
+  double assistance_dependence = 0;
   int collisions = 0;
   double min_clearance_m = 0;
   double override_rms = 0;

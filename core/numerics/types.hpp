@@ -131,6 +131,12 @@ inline constexpr double kSlackL2 = 1e2;
 inline constexpr double kRotorSpeedBackoff = 1e-3;
 // A vehicle farther than this outside the arena's box is lost: the flight ends there [m].
 inline constexpr double kLostMargin = 1.0;
+// A probe flight (SPEC §10) pins λ = 1 for η and ν, which leaves e (ψ, v_b, ω → 0) and u with
+// no weight either: the QP is then singular (measured on mi_helix: QP failures, the safe hold,
+// the vehicle lost). It keeps them weighted as at λ = 1 − this (0.5: as at the initial λ).
+// Measured on mi_helix, novice and experienced: 0.5 gives no fallback and no collision with the
+// MPC following the pilot's attitude to 2e-3 rad rms; 0.05–0.3 and 1 still fail or touch.
+inline constexpr double kProbeRegularization = 0.5;
 }  // namespace mi_defaults
 
 // Obstacle avoidance with the LCL constraint, SPEC §5.3 (thesis ch. 6).

@@ -337,16 +337,18 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                                       {{"offered_qos_profiles", kQosProfiles}});
   }
   // Metadata first, so a crashed session's .tmp still says what it was.
-  writer_.write_metadata("mixpilot", {{"mode", info.mode},
-                                      {"scenario", info.scenario},
-                                      {"scenario_path", info.scenario_path},
-                                      {"version", version()},
-                                      {"seed", std::to_string(info.seed)},
-                                      {"pilot", info.pilot},
-                                      {"trainee", info.trainee},
-                                      {"vehicle", info.vehicle},
-                                      {"planned_steps", std::to_string(info.planned_steps)},
-                                      {"control_period_ns", std::to_string(period_ns_)}});
+  McapStringMap metadata = {{"mode", info.mode},
+                             {"scenario", info.scenario},
+                             {"scenario_path", info.scenario_path},
+                             {"version", version()},
+                             {"seed", std::to_string(info.seed)},
+                             {"pilot", info.pilot},
+                             {"trainee", info.trainee},
+                             {"vehicle", info.vehicle},
+                             {"planned_steps", std::to_string(info.planned_steps)},
+                             {"control_period_ns", std::to_string(period_ns_)}};
+  if (!info.assist.empty()) metadata.emplace("assist", info.assist);
+  writer_.write_metadata("mixpilot", metadata);
   if (!writer_.error().empty()) {
     error = writer_.error() + "; no file is kept (no step had been recorded)";
     writer_.discard();

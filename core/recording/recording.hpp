@@ -155,6 +155,10 @@ struct SessionInfo {
   std::string trainee = {};   // the person flying, as typed in the app ("" unknown)
   std::string vehicle = {};   // "dds": a remote vehicle flew (fly --vehicle dds); "": simulated
   std::int64_t planned_steps = 0;  // the flight's planned length (its mode's steps_total)
+  // Mixed initiative: "on" (the planner assists), or "off" for a probe flight (SPEC §10), which
+  // a replay flies again as one; "" (other modes): no key is written. A recording without the
+  // key was assisted.
+  std::string assist = {};
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by

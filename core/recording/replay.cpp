@@ -40,6 +40,16 @@ std::string in_embedded_scenario(const std::string& path, const std::string& err
   return path + ": its embedded scenario: " + error;
 }
 
+std::optional<Assistance> recorded_assistance(const RecordingContents& rec,
+                                              const std::string& path, std::string& error) {
+  const auto it = rec.metadata.find("assist");
+  if (it == rec.metadata.end() || it->second == "on") return Assistance::on;
+  if (it->second == "off") return Assistance::off;
+  error = path + ": its 'assist' metadata is '" + printable(it->second) +
+          "', expected on or off";
+  return std::nullopt;
+}
+
 namespace {
 
 // The steps of the recorded (real-time) flight marked with `event`.
@@ -62,7 +72,8 @@ std::int64_t planned_steps(const RecordingContents& rec) {
 
 std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
-                                  std::optional<double> duration, std::string& error) {
+                                  std::optional<double> duration, Assistance assist,
+                                  std::string& error) {
   const auto kind = scenario_mode(text, source, error);
   if (!kind) return nullptr;
   const bool mi = *kind == "mixed_initiative";
@@ -74,7 +85,10 @@ std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::st
   request.duration = duration;
   if (!duration && dt > 0.0)
     request.duration = double(std::max(planned_steps(rec), recorded)) * dt;
-  if (mi) request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
+  if (mi) {
+    request.assist = assist;
+    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
+  }
   auto mode = make_mode(text, source, std::move(request), error);
   if (mode && !duration) mode->stop_after(recorded);
   return mode;
@@ -90,7 +104,9 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
             "): its plant ran in another process, so the flight cannot be flown again here";
     return nullptr;
   }
-  auto mode = replay_mode_of(rec, path, text, source, duration, error);
+  const std::optional<Assistance> assist = recorded_assistance(rec, path, error);
+  if (!assist) return nullptr;
+  auto mode = replay_mode_of(rec, path, text, source, duration, *assist, error);
   // What depended on the wall clock is replayed as recorded: the overruns' fallbacks and the
   // deadline misses.
   if (mode)

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "core/control/mi_settings.hpp"
 #include "core/modes/mode.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/recording.hpp"
@@ -33,9 +34,14 @@ std::string embedded_scenario_source(const RecordingContents& rec, const std::st
 // file:line:col name the file it was recorded from, which may have changed since.
 [[nodiscard]] std::string in_embedded_scenario(const std::string& path, const std::string& error);
 
+// Whether the recorded flight was assisted or a probe (its `assist` metadata; on when absent);
+// nullopt with "<path>: ..." for a value other than on or off.
+std::optional<Assistance> recorded_assistance(const RecordingContents& rec,
+                                              const std::string& path, std::string& error);
+
 // A fresh flight of `scenario_text` for the recording: mixed initiative replays the recorded
-// pilot commands and is as long as they are; other modes fly on their own for as many steps as
-// were recorded. `duration` overrides the length.
+// pilot commands and is as long as they are, assisted or as a probe as it was recorded; other
+// modes fly on their own for as many steps as were recorded. `duration` overrides the length.
 std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
                                   const std::string& scenario_text, const std::string& source,
                                   std::optional<double> duration, std::string& error);
