@@ -18,8 +18,10 @@ packages=(
   libsdl2-dev
   # network peers (C API + idlc)
   cyclonedds-dev cyclonedds-tools
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # trainee history: SQLite by default, PostgreSQL (libpq) for a training centre
+  libpq-dev
+  # tests and benchmarks; the PostgreSQL server the history tests start themselves
+  libgtest-dev libgmock-dev libbenchmark-dev valgrind postgresql
   # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
   clang libclang-rt-dev
   # tooling: independent MCAP reader in the recording tests
