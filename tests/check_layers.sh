@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The engine's layers (core/CMakeLists.txt) point one way along the data path:
-#   base < numerics < qp < nlp < control < scenario < modes < recording < runtime
+#   base < numerics < qp < nlp < control < scenario < modes < recording < runtime < history
 # A file in core/<L>/ may include only core/<M>/ headers with M at or below L; headers in
 # core/<L>/detail/ are internal to L (tests may include them); core/ has no file of its own
 # besides CMakeLists.txt; core/ and models/ never include UI, SDL or DDS headers, and models/
@@ -11,7 +11,7 @@
 # Usage: check_layers.sh SOURCE_DIR. Prints each violation; exit 1 if any.
 set -u
 src=$1
-layers=(base numerics qp nlp control scenario modes recording runtime)
+layers=(base numerics qp nlp control scenario modes recording runtime history)
 rank() {
   local i
   for i in "${!layers[@]}"; do [ "${layers[$i]}" = "$1" ] && { echo "$i"; return; }; done

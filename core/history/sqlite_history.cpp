@@ -1,0 +1,411 @@
+#include "core/history/sqlite_history.hpp"
+
+#include <sqlite3.h>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <unordered_map>
+
+#include "core/history/schema.hpp"
+
+namespace mixpilot::history {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::int64_t now_unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Makes the missing folders of `dir`, each mode 700 (a person's flights are theirs).
+bool make_folders(const fs::path& dir, std::string& error) {
+  if (dir.empty()) return true;
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return true;
+  if (!make_folders(dir.parent_path(), error)) return false;
+  if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    error = "cannot make the folder " + dir.string() + ": " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+// One prepared statement, finalized when it goes.
+class Stmt {
+ public:
+  Stmt() = default;
+  Stmt(Stmt&& o) noexcept : s_(std::exchange(o.s_, nullptr)) {}
+  Stmt& operator=(Stmt&& o) noexcept {
+    std::swap(s_, o.s_);
+    return *this;
+  }
+  ~Stmt() { sqlite3_finalize(s_); }
+  sqlite3_stmt* get() const { return s_; }
+  sqlite3_stmt** out() { return &s_; }
+
+ private:
+  sqlite3_stmt* s_ = nullptr;
+};
+
+class SqliteHistory final : public HistoryStore {
+ public:
+  SqliteHistory(std::string path, sqlite3* db) : path_(std::move(path)), db_(db) {}
+  ~SqliteHistory() override { sqlite3_close_v2(db_); }
+
+  [[nodiscard]] bool init(const SqliteSettings& s, std::string& error);
+  std::optional<Added> add(const FlightRecord& f, std::string& error) override;
+  bool query(const Query& q, std::vector<StoredFlight>& out, std::string& error) override;
+  bool trainees(std::vector<std::string>& out, std::string& error) override;
+  bool knows_recording(const std::string& hash, bool& known, std::string& error) override;
+  std::string where() const override { return path_; }
+
+ private:
+  // "FILE: what failed: SQLite's message", with the usual causes said in words.
+  std::string fail(const char* what) const;
+  bool exec(const char* sql, std::string& error, const char* what);
+  bool prepare(Stmt& s, const char* sql, std::string& error);
+  // Ends a transaction that failed on the way (the error is already said).
+  void rollback() { sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr); }
+
+  std::string path_;
+  sqlite3* db_;
+};
+
+std::string SqliteHistory::fail(const char* what) const {
+  const int code = sqlite3_extended_errcode(db_) & 0xFF;
+  std::string m = path_ + ": " + what + ": " + sqlite3_errmsg(db_);
+  switch (code) {
+    case SQLITE_NOTADB:
+    case SQLITE_CORRUPT:
+      m += " (the file is damaged or not a mixpilot history; move it aside to start a new one)";
+      break;
+    case SQLITE_READONLY:
+    case SQLITE_CANTOPEN:
+    case SQLITE_PERM:
+      m += " (the file or its folder cannot be written)";
+      break;
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+      m += " (another program holds the database locked)";
+      break;
+    case SQLITE_FULL:
+      m += " (the disk is full)";
+      break;
+    default:
+      break;
+  }
+  return m;
+}
+
+bool SqliteHistory::exec(const char* sql, std::string& error, const char* what) {
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) == SQLITE_OK) return true;
+  error = fail(what);
+  return false;
+}
+
+bool SqliteHistory::prepare(Stmt& s, const char* sql, std::string& error) {
+  if (sqlite3_prepare_v2(db_, sql, -1, s.out(), nullptr) == SQLITE_OK) return true;
+  error = fail("preparing a statement");
+  return false;
+}
+
+bool SqliteHistory::init(const SqliteSettings& s, std::string& error) {
+  sqlite3_extended_result_codes(db_, 1);
+  sqlite3_busy_timeout(db_, s.busy_timeout_ms);
+  if (!exec("PRAGMA foreign_keys = ON", error, "cannot switch foreign keys on")) return false;
+  // WAL: readers (a `history` listing) never wait for a writer (a flight closing).
+  {
+    Stmt wal;
+    if (!prepare(wal, "PRAGMA journal_mode = WAL", error)) return false;
+    const int rc = sqlite3_step(wal.get());
+    if (rc != SQLITE_ROW) {
+      error = fail("cannot open");
+      return false;
+    }
+  }
+  // The schema: read and migrated under the writer's lock, so two processes opening a new file
+  // at once migrate it once.
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to check its schema")) return false;
+  if (!exec(kCreateVersionTable, error, "cannot create the schema")) return rollback(), false;
+  int version = 0;
+  {
+    Stmt v;
+    if (!prepare(v, kReadVersion, error)) return rollback(), false;
+    if (sqlite3_step(v.get()) != SQLITE_ROW) {
+      error = fail("cannot read the schema version");
+      return rollback(), false;
+    }
+    version = sqlite3_column_int(v.get(), 0);
+  }
+  if (std::string why = newer_schema_message(version, path_); !why.empty()) {
+    error = why;
+    return rollback(), false;
+  }
+  for (const Statement& st : pending(version, Dialect::sqlite)) {
+    Stmt m;
+    if (!prepare(m, st.sql.c_str(), error)) return rollback(), false;
+    if (st.takes_time) sqlite3_bind_int64(m.get(), 1, now_unix_ms());
+    if (sqlite3_step(m.get()) != SQLITE_DONE) {
+      error = fail("cannot migrate the schema");
+      return rollback(), false;
+    }
+  }
+  if (!exec("COMMIT", error, "cannot write the schema")) return rollback(), false;
+  return true;
+}
+
+// Binds `text` as the parameter `i`; an empty text as NULL when `null_if_empty`.
+void bind_text(sqlite3_stmt* s, int i, const std::string& text, bool null_if_empty = false) {
+  if (null_if_empty && text.empty())
+    sqlite3_bind_null(s, i);
+  else
+    sqlite3_bind_text(s, i, text.data(), int(text.size()), SQLITE_TRANSIENT);
+}
+
+std::string column_text(sqlite3_stmt* s, int i) {
+  const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(s, i));
+  return p ? std::string(p, std::size_t(sqlite3_column_bytes(s, i))) : std::string();
+}
+
+std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = path_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to add a flight"))
+    return std::nullopt;
+  const auto failed = [&](const char* what) {
+    error = fail(what);
+    rollback();
+    return std::nullopt;
+  };
+  if (!f.recording_hash.empty()) {
+    Stmt k;
+    if (!prepare(k, "SELECT 1 FROM flights WHERE recording_hash = ?", error))
+      return rollback(), std::nullopt;
+    bind_text(k.get(), 1, f.recording_hash);
+    const int rc = sqlite3_step(k.get());
+    if (rc == SQLITE_ROW) {
+      rollback();  // nothing was written
+      return Added::already_known;
+    }
+    if (rc != SQLITE_DONE) return failed("cannot look the recording up");
+  }
+  std::int64_t trainee_id = 0;
+  {
+    Stmt t;
+    if (!prepare(t, "INSERT INTO trainees (name) VALUES (?) ON CONFLICT (name) DO NOTHING", error))
+      return rollback(), std::nullopt;
+    bind_text(t.get(), 1, f.trainee);
+    if (sqlite3_step(t.get()) != SQLITE_DONE) return failed("cannot add the trainee");
+    Stmt id;
+    if (!prepare(id, "SELECT id FROM trainees WHERE name = ?", error))
+      return rollback(), std::nullopt;
+    bind_text(id.get(), 1, f.trainee);
+    if (sqlite3_step(id.get()) != SQLITE_ROW) return failed("cannot find the trainee");
+    trainee_id = sqlite3_column_int64(id.get(), 0);
+  }
+  std::int64_t flight_id = 0;
+  {
+    Stmt s;
+    if (!prepare(s,
+                 "INSERT INTO flights (trainee_id, station, scenario, scenario_hash, mode, pilot, "
+                 "input_device, input_settings_hash, started_unix_ms, duration_s, ended, probe, "
+                 "recording_path, recording_hash, app_version, front_end) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
+                 error))
+      return rollback(), std::nullopt;
+    sqlite3_stmt* p = s.get();
+    sqlite3_bind_int64(p, 1, trainee_id);
+    bind_text(p, 2, f.station);
+    bind_text(p, 3, f.scenario);
+    bind_text(p, 4, f.scenario_hash);
+    bind_text(p, 5, f.mode);
+    bind_text(p, 6, f.pilot);
+    bind_text(p, 7, f.input_device);
+    bind_text(p, 8, f.input_settings_hash);
+    sqlite3_bind_int64(p, 9, f.started_unix_ms);
+    sqlite3_bind_double(p, 10, f.duration_s);
+    bind_text(p, 11, to_string(f.ended));
+    sqlite3_bind_int(p, 12, f.probe ? 1 : 0);
+    bind_text(p, 13, f.recording_path, true);
+    bind_text(p, 14, f.recording_hash, true);
+    bind_text(p, 15, f.app_version);
+    bind_text(p, 16, f.front_end);
+    if (sqlite3_step(p) != SQLITE_ROW) return failed("cannot add the flight");
+    flight_id = sqlite3_column_int64(p, 0);
+  }
+  {
+    Stmt m;
+    if (!prepare(m, "INSERT INTO metrics (flight_id, position, name, value) VALUES (?, ?, ?, ?)",
+                 error))
+      return rollback(), std::nullopt;
+    for (std::size_t i = 0; i < f.metrics.size(); ++i) {
+      sqlite3_reset(m.get());
+      sqlite3_bind_int64(m.get(), 1, flight_id);
+      sqlite3_bind_int64(m.get(), 2, std::int64_t(i));
+      bind_text(m.get(), 3, f.metrics[i].first);
+      // Not a finite number: NULL (as the reports' JSON null).
+      if (std::isfinite(f.metrics[i].second))
+        sqlite3_bind_double(m.get(), 4, f.metrics[i].second);
+      else
+        sqlite3_bind_null(m.get(), 4);
+      if (sqlite3_step(m.get()) != SQLITE_DONE) return failed("cannot add the flight's metrics");
+    }
+  }
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK)
+    return failed("cannot commit the flight");
+  return Added::added;
+}
+
+bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
+  out.clear();
+  // The newest `limit` flights that pass the filters, read oldest first; the same filter picks
+  // their metrics. Readers take a snapshot (WAL): one transaction for both statements.
+  static constexpr const char* kFilter =
+      " FROM flights f JOIN trainees t ON t.id = f.trainee_id"
+      " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
+      " AND f.started_unix_ms >= ?3";
+  const std::string flights_sql =
+      std::string("SELECT * FROM (SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, "
+                  "f.mode, f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, "
+                  "f.duration_s, f.ended, f.probe, f.recording_path, f.recording_hash, "
+                  "f.app_version, f.front_end") +
+      kFilter + " ORDER BY f.started_unix_ms DESC, f.id DESC LIMIT ?4)" +
+      " ORDER BY started_unix_ms, id";
+  if (!exec("BEGIN", error, "cannot read the history")) return false;
+  const auto bind_filter = [&](sqlite3_stmt* s) {
+    bind_text(s, 1, q.trainee);
+    bind_text(s, 2, q.scenario);
+    sqlite3_bind_int64(s, 3, q.since_unix_ms);
+  };
+  {
+    Stmt s;
+    if (!prepare(s, flights_sql.c_str(), error)) return rollback(), false;
+    bind_filter(s.get());
+    sqlite3_bind_int64(s.get(), 4, q.limit > 0 ? q.limit : -1);  // -1: no limit
+    int rc;
+    while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
+      sqlite3_stmt* p = s.get();
+      StoredFlight f;
+      f.id = sqlite3_column_int64(p, 0);
+      f.trainee = column_text(p, 1);
+      f.station = column_text(p, 2);
+      f.scenario = column_text(p, 3);
+      f.scenario_hash = column_text(p, 4);
+      f.mode = column_text(p, 5);
+      f.pilot = column_text(p, 6);
+      f.input_device = column_text(p, 7);
+      f.input_settings_hash = column_text(p, 8);
+      f.started_unix_ms = sqlite3_column_int64(p, 9);
+      f.duration_s = sqlite3_column_double(p, 10);
+      f.ended = ended_from(column_text(p, 11)).value_or(Ended::completed);
+      f.probe = sqlite3_column_int(p, 12) != 0;
+      f.recording_path = column_text(p, 13);
+      f.recording_hash = column_text(p, 14);
+      f.app_version = column_text(p, 15);
+      f.front_end = column_text(p, 16);
+      out.push_back(std::move(f));
+    }
+    if (rc != SQLITE_DONE) {
+      error = fail("cannot read the flights");
+      return rollback(), false;
+    }
+  }
+  if (!out.empty()) {
+    std::unordered_map<std::int64_t, std::size_t> at;
+    at.reserve(out.size());
+    std::int64_t first = std::numeric_limits<std::int64_t>::max();
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      at.emplace(out[i].id, i);
+      first = std::min(first, out[i].id);
+    }
+    // The metrics of the same filter (those of flights past the limit are skipped by id).
+    Stmt s;
+    if (!prepare(s,
+                 "SELECT m.flight_id, m.name, m.value FROM metrics m"
+                 " JOIN flights f ON f.id = m.flight_id JOIN trainees t ON t.id = f.trainee_id"
+                 " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
+                 " AND f.started_unix_ms >= ?3 AND f.id >= ?4"
+                 " ORDER BY m.flight_id, m.position",
+                 error))
+      return rollback(), false;
+    bind_filter(s.get());
+    sqlite3_bind_int64(s.get(), 4, first);
+    int rc;
+    while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
+      const auto it = at.find(sqlite3_column_int64(s.get(), 0));
+      if (it == at.end()) continue;
+      const double v = sqlite3_column_type(s.get(), 2) == SQLITE_NULL
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : sqlite3_column_double(s.get(), 2);
+      out[it->second].metrics.emplace_back(column_text(s.get(), 1), v);
+    }
+    if (rc != SQLITE_DONE) {
+      error = fail("cannot read the metrics");
+      return rollback(), false;
+    }
+  }
+  return exec("COMMIT", error, "cannot read the history");
+}
+
+bool SqliteHistory::trainees(std::vector<std::string>& out, std::string& error) {
+  out.clear();
+  Stmt s;
+  if (!prepare(s, "SELECT name FROM trainees ORDER BY name", error)) return false;
+  int rc;
+  while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) out.push_back(column_text(s.get(), 0));
+  if (rc == SQLITE_DONE) return true;
+  error = fail("cannot read the trainees");
+  return false;
+}
+
+bool SqliteHistory::knows_recording(const std::string& hash, bool& known, std::string& error) {
+  Stmt s;
+  if (!prepare(s, "SELECT 1 FROM flights WHERE recording_hash = ?", error)) return false;
+  bind_text(s.get(), 1, hash);
+  const int rc = sqlite3_step(s.get());
+  if (rc != SQLITE_ROW && rc != SQLITE_DONE) {
+    error = fail("cannot look the recording up");
+    return false;
+  }
+  known = rc == SQLITE_ROW;
+  return true;
+}
+
+}  // namespace
+
+std::unique_ptr<HistoryStore> open_sqlite(const std::string& path, std::string& error,
+                                          const SqliteSettings& settings) {
+  if (path.empty()) {
+    error = "the history's file name is empty";
+    return nullptr;
+  }
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    error = path + ": is a folder, not a history file";
+    return nullptr;
+  }
+  if (settings.create_folder && !make_folders(fs::path(path).parent_path(), error)) return nullptr;
+  sqlite3* db = nullptr;
+  const int rc = sqlite3_open_v2(path.c_str(), &db,
+                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                                 nullptr);
+  auto store = std::make_unique<SqliteHistory>(path, db);  // closes db on every way out
+  if (rc != SQLITE_OK) {
+    error = path + ": cannot open: " + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
+    return nullptr;
+  }
+  if (!store->init(settings, error)) return nullptr;
+  return store;
+}
+
+}  // namespace mixpilot::history
