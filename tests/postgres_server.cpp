@@ -302,6 +302,7 @@ std::string PostgresServer::url(const std::string& db) const {
 
 bool PostgresServer::exec(const std::string& db, const std::string& sql, std::string& error) const {
   PGconn* c = PQconnectdb(conninfo_of(folder_, db, password_).c_str());
+  PQsetNoticeReceiver(c, [](void*, const PGresult*) {}, nullptr);
   bool ok = false;
   if (PQstatus(c) != CONNECTION_OK) {
     error = PQerrorMessage(c);
@@ -314,6 +315,24 @@ bool PostgresServer::exec(const std::string& db, const std::string& sql, std::st
   }
   PQfinish(c);
   return ok;
+}
+
+std::optional<std::string> PostgresServer::scalar(const std::string& db, const std::string& sql,
+                                                  std::string& error) const {
+  PGconn* c = PQconnectdb(conninfo_of(folder_, db, password_).c_str());
+  std::optional<std::string> out;
+  if (PQstatus(c) != CONNECTION_OK) {
+    error = PQerrorMessage(c);
+  } else {
+    PGresult* r = PQexec(c, sql.c_str());
+    if (PQresultStatus(r) == PGRES_TUPLES_OK && PQntuples(r) > 0 && PQnfields(r) > 0)
+      out = std::string(PQgetvalue(r, 0, 0));
+    else
+      error = std::string("no answer: ") + PQresultErrorMessage(r);
+    PQclear(r);
+  }
+  PQfinish(c);
+  return out;
 }
 
 bool PostgresServer::create_database(const std::string& name, std::string& error) const {

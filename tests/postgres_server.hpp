@@ -17,6 +17,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace mixpilot::test {
@@ -41,6 +42,9 @@ class PostgresServer {
 
   // Runs one SQL command as the superuser on `db` (no parameters: the tests' own statements).
   [[nodiscard]] bool exec(const std::string& db, const std::string& sql, std::string& error) const;
+  // The first column of the first row of `sql`'s answer ("" for NULL); nullopt with `error`.
+  [[nodiscard]] std::optional<std::string> scalar(const std::string& db, const std::string& sql,
+                                                  std::string& error) const;
   // A fresh, empty database (dropped first if it exists); its name must be a plain identifier.
   [[nodiscard]] bool create_database(const std::string& name, std::string& error) const;
   // The last lines of the server's log.
