@@ -241,37 +241,49 @@ std::unique_ptr<PostgresServer> PostgresServer::start(Start& status, std::string
     return nullptr;
   }
 
-  // Only the Unix socket in the folder; durability is not what these tests measure.
-  server->postmaster_ =
-      spawn({(bin / "postgres").string(), "-D", (dir / "data").string(), "-k", dir.string(), "-p",
-             kPort, "-c", "listen_addresses=", "-c", "fsync=off", "-c", "synchronous_commit=off",
-             "-c", "full_page_writes=off", "-c", "max_connections=60", "-c",
-             "shared_buffers=16MB", "-c", "logging_collector=off"},
-            env, log, account, SIGQUIT);
-  if (server->postmaster_ < 0) {
-    reason = std::string("fork: ") + std::strerror(errno);
-    return nullptr;
-  }
-  const std::string ping = conninfo_of(dir, "postgres", server->password_);
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  for (;;) {
-    if (PQping(ping.c_str()) == PQPING_OK) break;
-    if (const auto s = wait_for(server->postmaster_, std::chrono::milliseconds(0))) {
-      server->postmaster_ = -1;
-      reason = "the server exited at start:" + tail_of(log, 20);
-      return nullptr;
-    }
-    if (std::chrono::steady_clock::now() >= until) {
-      reason = "the server did not accept connections within 60 s:" + tail_of(log, 20);
-      return nullptr;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-  }
+  server->bin_ = bin;
+  if (account) server->account_ = {account->uid, account->gid};
+  if (!server->launch(reason)) return nullptr;
   status = Start::started;
   return server;
 }
 
-void PostgresServer::stop() {
+bool PostgresServer::launch(std::string& reason) {
+  const fs::path& dir = folder_;
+  const fs::path log = dir / "server.log";
+  const std::vector<std::string> env = {"LC_ALL=C", "LANG=C", "TZ=UTC", "PATH=/usr/bin:/bin",
+                                        "HOME=" + dir.string()};
+  std::optional<Account> account;
+  if (account_) account = Account{account_->first, account_->second};
+  // Only the Unix socket in the folder; durability is not what these tests measure.
+  postmaster_ =
+      spawn({(bin_ / "postgres").string(), "-D", (dir / "data").string(), "-k", dir.string(), "-p",
+             kPort, "-c", "listen_addresses=", "-c", "fsync=off",
+             "-c", "full_page_writes=off", "-c", "max_connections=60", "-c",
+             "shared_buffers=16MB", "-c", "logging_collector=off"},
+            env, log, account, SIGQUIT);
+  if (postmaster_ < 0) {
+    reason = std::string("fork: ") + std::strerror(errno);
+    return false;
+  }
+  const std::string ping = conninfo_of(dir, "postgres", password_);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  for (;;) {
+    if (PQping(ping.c_str()) == PQPING_OK) return true;
+    if (wait_for(postmaster_, std::chrono::milliseconds(0))) {
+      postmaster_ = -1;
+      reason = "the server exited at start:" + tail_of(log, 20);
+      return false;
+    }
+    if (std::chrono::steady_clock::now() >= until) {
+      reason = "the server did not accept connections within 60 s:" + tail_of(log, 20);
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+}
+
+void PostgresServer::stop_postmaster() {
   if (postmaster_ > 0) {
     // Immediate shutdown: the postmaster ends its backends and exits without a checkpoint.
     ::kill(postmaster_, SIGQUIT);
@@ -281,6 +293,15 @@ void PostgresServer::stop() {
     }
     postmaster_ = -1;
   }
+}
+
+bool PostgresServer::restart(std::string& error) {
+  stop_postmaster();
+  return launch(error);
+}
+
+void PostgresServer::stop() {
+  stop_postmaster();
   if (!folder_.empty()) {
     std::error_code ec;
     fs::remove_all(folder_, ec);

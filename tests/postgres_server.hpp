@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace mixpilot::test {
 
@@ -47,15 +48,22 @@ class PostgresServer {
                                                   std::string& error) const;
   // A fresh, empty database (dropped first if it exists); its name must be a plain identifier.
   [[nodiscard]] bool create_database(const std::string& name, std::string& error) const;
+  // Stops the server at once (as a crash or a power cut would) and starts it again on the same
+  // cluster: clients' connections break.
+  [[nodiscard]] bool restart(std::string& error);
   // The last lines of the server's log.
   [[nodiscard]] std::string log_tail(std::size_t lines = 20) const;
 
  private:
   PostgresServer() = default;
+  bool launch(std::string& reason);  // the postmaster, until it accepts connections
+  void stop_postmaster();
   void stop();
 
   std::filesystem::path folder_;  // the socket, the cluster (data/), the log
   std::string password_;
+  std::filesystem::path bin_;
+  std::optional<std::pair<uid_t, gid_t>> account_;  // the server's user, when not ours
   pid_t postmaster_ = -1;
 };
 

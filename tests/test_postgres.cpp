@@ -22,8 +22,11 @@
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/postgres_history.hpp"
+#include "core/history/push.hpp"
 #include "core/history/schema.hpp"
+#include "core/history/sqlite_history.hpp"
 #include "postgres_server.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot::test {
 namespace {
@@ -517,6 +520,136 @@ TEST(Postgres, AServerThatGoesAwayIsSaidClearly) {
   EXPECT_EQ(error.find(password), std::string::npos) << error;
   std::vector<StoredFlight> rows;
   EXPECT_FALSE(store->query({}, rows, error));
+}
+
+// The server restarts between two flights (a crash, an update): the store's next write
+// connects again and the flight is kept; nothing was lost of the first.
+TEST(Postgres, AServerRestartBetweenFlightsCostsNothing) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  PostgresServer::Start status{};
+  std::string error;
+  auto own = PostgresServer::start(status, error);
+  ASSERT_EQ(status, PostgresServer::Start::started) << error;
+  ASSERT_TRUE(own->create_database("restarted", error)) << error;
+  auto store = open_store(own->url("restarted"));
+  ASSERT_TRUE(store);
+  ASSERT_EQ(store->add(sample_flight("Ada", 1), error), HistoryStore::Added::added) << error;
+  ASSERT_TRUE(own->restart(error)) << error;
+  EXPECT_EQ(store->add(sample_flight("Ada", 2), error), HistoryStore::Added::added) << error;
+  ASSERT_TRUE(own->restart(error)) << error;
+  std::vector<std::string> names;
+  EXPECT_TRUE(store->trainees(names, error)) << error;
+  ASSERT_TRUE(own->restart(error)) << error;
+  EXPECT_EQ(all(*store).size(), 2u);
+  ASSERT_TRUE(own->restart(error)) << error;
+  bool known = true;
+  EXPECT_TRUE(store->knows_recording("x", known, error)) << error;
+  EXPECT_FALSE(known);
+}
+
+// A station's SQLite history pushed into the centre's database: every flight once, with its
+// fields; pushing again adds nothing, recorded or not; a flight flown since is the one added
+// by the next push; a second station's flights join the first's.
+TEST(Postgres, PushTwiceAddsNothingTheSecondTime) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "centre");
+  std::string error;
+  const fs::path file = fresh_path("postgres", "station.sqlite");
+  auto station = history::open_sqlite(file.string(), error);
+  ASSERT_TRUE(station) << error;
+  for (int i = 0; i < 6; ++i) {
+    FlightRecord f = sample_flight(i % 2 ? "O'Brien" : "Ada", 1'700'000'000'000 + 1000 * i);
+    if (i < 4) {  // two without a recording
+      f.recording_path = "/rec/" + std::to_string(i) + ".mcap";
+      f.recording_hash = history::sha256_hex("recording " + std::to_string(i));
+    }
+    f.metrics.emplace_back("attempt", double(i));
+    ASSERT_EQ(station->add(f, error), HistoryStore::Added::added) << error;
+  }
+  auto centre = open_store(url);
+  ASSERT_TRUE(centre);
+  history::PushCounts counts;
+  std::size_t progress_calls = 0;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error,
+                                    [&](std::size_t, std::size_t) { ++progress_calls; }))
+      << error;
+  EXPECT_EQ(counts.flights, 6u);
+  EXPECT_EQ(counts.added, 6u);
+  EXPECT_EQ(counts.already_there, 0u);
+  EXPECT_EQ(progress_calls, 6u);
+  const auto mine = all(*station);
+  auto pushed = all(*centre);
+  ASSERT_EQ(pushed.size(), mine.size());
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    EXPECT_EQ(pushed[i].trainee, mine[i].trainee);
+    EXPECT_EQ(pushed[i].station, mine[i].station);
+    EXPECT_EQ(pushed[i].started_unix_ms, mine[i].started_unix_ms);
+    EXPECT_EQ(pushed[i].recording_hash, mine[i].recording_hash);
+    EXPECT_EQ(pushed[i].recording_path, mine[i].recording_path);
+    EXPECT_EQ(pushed[i].duration_s, mine[i].duration_s);
+    ASSERT_EQ(pushed[i].metrics.size(), mine[i].metrics.size());
+    for (std::size_t m = 0; m < mine[i].metrics.size(); ++m) {
+      EXPECT_EQ(pushed[i].metrics[m].first, mine[i].metrics[m].first);
+      if (std::isfinite(mine[i].metrics[m].second))
+        EXPECT_EQ(pushed[i].metrics[m].second, mine[i].metrics[m].second);
+      else
+        EXPECT_TRUE(std::isnan(pushed[i].metrics[m].second));
+    }
+  }
+
+  // Again: nothing added, recorded or not.
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 0u);
+  EXPECT_EQ(counts.already_there, 6u);
+  EXPECT_EQ(sql(*server, "centre", "SELECT count(*) FROM flights"), "6");
+  EXPECT_EQ(sql(*server, "centre", "SELECT count(*) FROM metrics"), std::to_string(6 * 5));
+
+  // A flight flown since, without a recording, at the same moment as another trainee's.
+  FlightRecord later = sample_flight("Ben", 1'700'000'000'000);
+  ASSERT_EQ(station->add(later, error), HistoryStore::Added::added) << error;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 1u);
+  EXPECT_EQ(counts.already_there, 6u);
+
+  // Another station's flight at the same moment by the same trainee is another flight.
+  const fs::path file2 = fresh_path("postgres", "station2.sqlite");
+  auto station2 = history::open_sqlite(file2.string(), error);
+  ASSERT_TRUE(station2) << error;
+  FlightRecord elsewhere = sample_flight("Ada", 1'700'000'000'000);
+  elsewhere.station = "station-2";
+  ASSERT_EQ(station2->add(elsewhere, error), HistoryStore::Added::added) << error;
+  ASSERT_TRUE(history::push_history(*station2, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 1u);
+  ASSERT_TRUE(history::push_history(*station2, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 0u);
+  EXPECT_EQ(sql(*server, "centre", "SELECT count(*) FROM flights"), "8");
+}
+
+// A push that cannot write says which flight stopped it and why, without the password.
+TEST(Postgres, APushThatFailsSaysWhere) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  std::string error;
+  PostgresServer::Start status{};
+  auto doomed = PostgresServer::start(status, error);
+  ASSERT_EQ(status, PostgresServer::Start::started) << error;
+  ASSERT_TRUE(doomed->create_database("centre", error)) << error;
+  auto centre = open_store(doomed->url("centre"));
+  ASSERT_TRUE(centre);
+  const fs::path file = fresh_path("postgres", "failing.sqlite");
+  auto station = history::open_sqlite(file.string(), error);
+  ASSERT_TRUE(station) << error;
+  FlightRecord recorded = sample_flight();
+  recorded.recording_hash = history::sha256_hex("a recording");
+  ASSERT_EQ(station->add(recorded, error), HistoryStore::Added::added) << error;
+  const std::string password = doomed->password();
+  doomed.reset();
+  history::PushCounts counts;
+  EXPECT_FALSE(history::push_history(*station, *centre, counts, error));
+  EXPECT_NE(error.find("flight 1 of 1"), std::string::npos) << error;
+  EXPECT_NE(error.find("is the server running"), std::string::npos) << error;
+  EXPECT_NE(error.find(centre->where()), std::string::npos) << error;
+  EXPECT_EQ(error.find(password), std::string::npos) << error;
+  EXPECT_EQ(counts.added, 0u);
 }
 
 }  // namespace

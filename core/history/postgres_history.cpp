@@ -134,6 +134,9 @@ std::string hint_for(const std::string& m, const char* sqlstate) {
       m.find("password authentication failed") != std::string::npos)
     return " (check the user name and password the URL gives)";
   if (state == "3D000") return " (create the database first, or fix its name in the URL)";
+  if (state.starts_with("57P") || m.find("server closed the connection") != std::string::npos ||
+      m.find("no connection to the server") != std::string::npos)
+    return " (the server stopped or restarted, or the network to it was cut)";
   if (state == "42501") return " (the user may not write this database)";
   if (m.find("Connection refused") != std::string::npos ||
       m.find("No such file or directory") != std::string::npos ||
@@ -250,12 +253,21 @@ class PostgresHistory final : public HistoryStore {
   }
   // Ends a transaction that failed on the way (the error is already said).
   void rollback() { PQclear(PQexec(conn_, "ROLLBACK")); }
-  // A connection that broke (a server restart, a network cut) is opened again once.
+  // A connection known to be broken is opened again.
   bool connected(std::string& error);
+  // A connection that broke since the last operation (a server restart, an idle connection
+  // cut) shows only when used: an operation's first statement, which has changed nothing yet,
+  // is tried once more on a new connection.
+  std::optional<Result> first(const std::string& sql, const Params& p, ExecStatusType expected,
+                              const char* what, std::string& error);
+  bool begin(const char* sql, const char* what, std::string& error) {
+    return first(sql, Params{}, PGRES_COMMAND_OK, what, error).has_value();
+  }
 
   std::string where_;
   std::vector<std::string> secrets_;
   PGconn* conn_;
+  std::string last_sqlstate_;  // of the last statement that failed on the server ("" otherwise)
 };
 
 std::optional<Result> PostgresHistory::run(const std::string& sql, const Params& p,
@@ -264,7 +276,10 @@ std::optional<Result> PostgresHistory::run(const std::string& sql, const Params&
   const auto values = p.pointers();
   Result r(PQexecParams(conn_, sql.c_str(), p.size(), nullptr, values.data(), nullptr, nullptr,
                         0));
+  last_sqlstate_.clear();
   if (r.get() != nullptr && PQresultStatus(r.get()) == expected) return r;
+  if (r.get() != nullptr)
+    if (const char* state = PQresultErrorField(r.get(), PG_DIAG_SQLSTATE)) last_sqlstate_ = state;
   if (r.get() == nullptr || PQstatus(conn_) == CONNECTION_BAD) {
     error = connection_failure(what);
   } else {
@@ -282,6 +297,26 @@ bool PostgresHistory::connected(std::string& error) {
   if (PQstatus(conn_) == CONNECTION_OK) return true;
   error = connection_failure("the connection to the server was lost");
   return false;
+}
+
+std::optional<Result> PostgresHistory::first(const std::string& sql, const Params& p,
+                                             ExecStatusType expected, const char* what,
+                                             std::string& error) {
+  if (!connected(error)) return std::nullopt;
+  if (auto r = run(sql, p, expected, what, error)) return r;
+  // libpq does not always mark the connection bad at once: a failure said by libpq itself (no
+  // SQLSTATE), a connection exception (08) or an operator's intervention (57P) counts too.
+  const std::string state = last_sqlstate_;
+  if (PQstatus(conn_) != CONNECTION_BAD && !state.empty() && !state.starts_with("08") &&
+      !state.starts_with("57P"))
+    return std::nullopt;
+  const std::string broken = error;
+  PQreset(conn_);
+  if (PQstatus(conn_) != CONNECTION_OK) {
+    error = broken + "; connecting again: " + connection_failure("cannot connect");
+    return std::nullopt;
+  }
+  return run(sql, p, expected, what, error);
 }
 
 bool PostgresHistory::init(std::string& error) {
@@ -320,8 +355,7 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
     error = where_ + ": the flight is not stored: its duration is not a finite number";
     return std::nullopt;
   }
-  if (!connected(error)) return std::nullopt;
-  if (!command("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
+  if (!begin("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
   const auto failed = [&] {
     rollback();
     return std::nullopt;
@@ -407,11 +441,9 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
 
 bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
   out.clear();
-  if (!connected(error)) return false;
   // The newest `limit` flights that pass the filters, read oldest first, and their metrics:
   // one snapshot for both statements.
-  if (!command("BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY", "cannot read the history",
-               error))
+  if (!begin("BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY", "cannot read the history", error))
     return false;
   Params p;
   p.text(q.trainee).text(q.scenario).integer(q.since_unix_ms);
@@ -479,9 +511,8 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
 
 bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error) {
   out.clear();
-  if (!connected(error)) return false;
   // Byte order, as SQLite's: the same list on either backend, whatever the server's collation.
-  const auto r = run("SELECT name FROM trainees ORDER BY name COLLATE \"C\"", Params{},
+  const auto r = first("SELECT name FROM trainees ORDER BY name COLLATE \"C\"", Params{},
                      PGRES_TUPLES_OK, "cannot read the trainees", error);
   if (!r) return false;
   for (int i = 0; i < r->rows(); ++i) out.push_back(r->text(i, 0));
@@ -489,8 +520,7 @@ bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error
 }
 
 bool PostgresHistory::knows_recording(const std::string& hash, bool& known, std::string& error) {
-  if (!connected(error)) return false;
-  const auto r = run("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(hash),
+  const auto r = first("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(hash),
                      PGRES_TUPLES_OK, "cannot look the recording up", error);
   if (!r) return false;
   known = r->rows() > 0;
