@@ -12,5 +12,6 @@ int models_command();
 int gamepad_script_command(int argc, char** argv);
 int joy_publish_command(int argc, char** argv);
 int vehicle_command(int argc, char** argv);
+int history_command(int argc, char** argv);
 
 }  // namespace mixpilot::cli

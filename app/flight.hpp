@@ -47,6 +47,8 @@ struct FlyOptions {
   bool publish = false;            // --publish: telemetry out over DDS
   std::string vehicle;             // --vehicle: "" (simulated) or "dds" (mixpilot vehicle)
   double vehicle_wait_s = 30.0;    // --vehicle-wait: how long to wait for the vehicle
+  std::string trainee;             // --trainee: who flies ("" → the login name; SPEC §10)
+  std::string history;             // --history: "" the default SQLite file, "off", a location
   const char* command = "fly";     // for messages
 };
 

@@ -1,7 +1,11 @@
 #include "app/flight_rig.hpp"
 
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
 
+#include "core/history/content_hash.hpp"
+#include "core/numerics/version.hpp"
 #include "input/net/dds.hpp"
 
 namespace mixpilot::cli {
@@ -87,6 +91,13 @@ bool FlightRig::record(const std::string& path, const std::string& trainee,
   return true;
 }
 
+void FlightRig::remember(history::HistoryStore* store, std::string trainee,
+                         std::string front_end) {
+  history_ = store;
+  trainee_ = std::move(trainee);
+  front_end_ = std::move(front_end);
+}
+
 void FlightRig::pace(std::size_t ring_slots) {
   runner_ = std::make_unique<RealtimeRunner>(*session_, ring_slots);
 }
@@ -96,6 +107,9 @@ void FlightRig::start() {
   if (flight_.devices) flight_.devices->started();
   if (runner_) runner_->start();
   started_ = true;
+  started_unix_ms_ = std::chrono::duration_cast<std::chrono::milliseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
 }
 
 bool FlightRig::running() const {
@@ -123,9 +137,61 @@ FlightRig::Closed FlightRig::close(bool interrupted) {
     if (recorder_.close(c.error, interrupted)) {
       c.recorded = record_path_;
       c.dropped = recorder_.dropped();
+      completed_recording_ = true;
     }
   }
+  // The history's row, after the recording is complete (its hash is the finished file's). A
+  // failure is said by the front end; the flight and its recording stand.
+  if (history_ && started_ && !flight_.recording && flight_.mode->steps_done() > 0) {
+    std::string error;
+    std::optional<history::FlightRecord> row = flight_record(interrupted, error);
+    std::optional<history::HistoryStore::Added> added;
+    if (row) added = history_->add(*row, error);
+    c.remembered = added.has_value();
+    if (!added) c.history_error = error;
+  }
   return c;
+}
+
+std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
+                                                              std::string& error) const {
+  const Mode& mode = *flight_.mode;
+  history::FlightRecord r;
+  const auto meta = [this](const char* key) {
+    if (!flight_.recording) return std::string();
+    const auto it = flight_.recording->metadata.find(key);
+    return it == flight_.recording->metadata.end() ? std::string() : it->second;
+  };
+  r.trainee = flight_.recording ? meta("trainee") : trainee_;
+  if (r.trainee.empty()) r.trainee = history::login_name();
+  if (r.trainee.empty()) r.trainee = "unnamed";  // an account without a name
+  r.station = history::host_name();
+  r.scenario = mode.scenario_name();
+  r.scenario_hash = history::sha256_hex(flight_.scenario_text);
+  r.mode = to_string(mode.kind());
+  r.pilot = flight_.recording ? meta("pilot") : flight_.pilot;
+  if (!flight_.recording && is_device_pilot(options_.pilot)) {
+    r.input_device = options_.pilot;
+    if (flight_.devices) r.input_settings_hash = history::sha256_hex(input::to_toml(flight_.devices->settings));
+  }
+  r.started_unix_ms = started_unix_ms_;
+  r.duration_s = double(mode.steps_done()) * mode.dt();
+  r.ended = mode.lost()     ? history::Ended::lost
+            : interrupted ? history::Ended::interrupted
+                          : history::Ended::completed;
+  const bool remote = flight_.recording ? meta("vehicle") == "dds" : flight_.vehicle != nullptr;
+  r.front_end = remote ? "vehicle" : front_end_;
+  r.app_version = version();
+  if (completed_recording_) {
+    std::error_code ec;
+    const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);
+    r.recording_path = ec ? record_path_ : abs.lexically_normal().string();
+    const auto hash = history::sha256_file(record_path_, error);
+    if (!hash) return std::nullopt;
+    r.recording_hash = *hash;
+  }
+  r.metrics = metrics();
+  return r;
 }
 
 Metrics FlightRig::metrics() const {

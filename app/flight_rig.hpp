@@ -5,7 +5,8 @@
 // screenshots or a replay's tape) and the real-time runner. Every way a flight is run builds it
 // here: the window's live flights (app/trainer.cpp), `fly --headless` (app/fly.cpp), a replay's
 // tape (app/replay_tape.cpp, the window's and `replay --headless`'s) and `score`
-// (app/score.cpp); the tests drive the same class. Errors come back as values with an exit
+// (app/score.cpp); the tests drive the same class. A live flight is remembered in the trainee's
+// history (SPEC §10) when it closes: remember(). Errors come back as values with an exit
 // status; nothing here exits.
 //
 // The threads mixpilot starts, and who owns them (each is joined by its owner's stop or
@@ -33,6 +34,7 @@
 #include <string>
 
 #include "app/flight.hpp"
+#include "core/history/history.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/replay.hpp"
@@ -73,6 +75,12 @@ class FlightRig {
   [[nodiscard]] bool record(const std::string& path, const std::string& trainee,
                             const RecordingSink::Settings& settings, bool overwrite,
                             std::string& error);
+  // The flight goes into `store` when it closes (SPEC §10: every flight one row), flown by
+  // `trainee` ("" → the account's login name) from `front_end` ("window", "fly"; "vehicle"
+  // whenever a remote vehicle flies it). Not a replay (it is no new flight: `history import`
+  // adds recordings), nor a flight that never started. `store` outlives the rig; the write
+  // happens in close(), on the caller's thread, never on the control thread.
+  void remember(history::HistoryStore* store, std::string trainee, std::string front_end);
   // Another sink (screenshots, a replay's tape), called on the thread that steps the session.
   void watch(TelemetrySink& sink) { session_->add_sink(&sink); }
 
@@ -97,6 +105,10 @@ class FlightRig {
     std::string error;           // the recording could not be completed ("" when fine)
     bool published = false;      // --publish: the publisher's counts
     std::uint64_t published_steps = 0, publish_dropped = 0;
+    // remember(): the flight's row in the history, or why it is not there ("" when remembered
+    // or not asked for). The flight itself is fine either way.
+    bool remembered = false;
+    std::string history_error;
   };
   // Stops the runner, the publisher and the vehicle link, and completes the recording
   // (`interrupted`: the flight stopped before its end). Once; later calls return {}.
@@ -108,6 +120,12 @@ class FlightRig {
   Metrics metrics() const;
   Labels labels(bool interrupted) const { return report_labels(flight_, interrupted); }
   std::string replay_difference() const;
+  // The flight's history row as it stands: its labels, metrics, times, the scenario's and
+  // input settings' hashes; the recording's path and hash once close() has completed it.
+  // A replay's row describes the recorded flight (trainee and pilot from the recording).
+  // nullopt with the reason (the recording cannot be read to hash it).
+  [[nodiscard]] std::optional<history::FlightRecord> flight_record(bool interrupted,
+                                                                   std::string& error) const;
   std::string recording_path() const { return record_path_; }
 
   Mode& mode() { return *flight_.mode; }
@@ -133,6 +151,10 @@ class FlightRig {
   VehicleStatus vehicle_ = VehicleStatus::none;
   std::chrono::steady_clock::time_point vehicle_deadline_;
   bool started_ = false, closed_ = false;
+  std::int64_t started_unix_ms_ = 0;       // the wall-clock time of start()
+  history::HistoryStore* history_ = nullptr;  // remember()
+  std::string trainee_, front_end_;
+  bool completed_recording_ = false;        // close() completed record_path_
 };
 
 }  // namespace mixpilot::cli

@@ -17,6 +17,7 @@
 #include "app/offscreen.hpp"
 #include "app/trainer.hpp"
 #include "app/window.hpp"
+#include "core/history/history.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
@@ -84,6 +85,14 @@ constexpr const char* kFlyUsage =
     "                     sizes the window has on such a display. Default: the window follows\n"
     "                     the desktop (GLFW's content scale, Xft.dpi / 96 on X11); --headless\n"
     "                     renders at 1 (100 %)\n"
+    "  --trainee NAME     who flies (default: the login name): the history's row and the\n"
+    "                     recording's metadata. 1-200 characters of UTF-8, no control characters\n"
+    "  --history LOCATION where the flight is remembered (SPEC §10; `mixpilot history` lists\n"
+    "                     them): an SQLite file (PATH or sqlite:PATH; default\n"
+    "                     $XDG_DATA_HOME/mixpilot/history.sqlite), postgresql://..., or off.\n"
+    "                     A history that cannot be written is said on stderr; the flight, its\n"
+    "                     recording and its exit status are not affected. A replay (--pilot\n"
+    "                     REC.mcap) is no new flight and is not added (see history import)\n"
     "  --force            overwrite existing --record, --report and --screenshot files\n"
     "  --allow-mismatch   fly a recording with a --scenario other than its embedded one, and\n"
     "                     accept a replay that differs from the recording\n"
@@ -237,6 +246,10 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
     for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
   }
   if (!closed.recorded.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
+  // The history never changes the exit status: the flight is fine without it.
+  if (!closed.history_error.empty())
+    std::fprintf(stderr, "mixpilot %s: history: %s; this flight is flown but not remembered\n",
+                 o.command, closed.history_error.c_str());
   if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
   if (stopped) {
     std::printf("  interrupted at t = %.3f s\n", flown);
@@ -268,6 +281,8 @@ int run_fly(const FlyOptions& o) {
   if (!o.headless) return run_in_window(o);
   if (o.replay) return run_replay_headless(o);
   int status = kExitOk;
+  // Declared before the rig, which writes to it when it closes.
+  std::unique_ptr<history::HistoryStore> store;
   const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
   if (!rig) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
@@ -304,10 +319,19 @@ int run_fly(const FlyOptions& o) {
     // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
     RecordingSink::Settings rs;
     if (o.realtime) rs.when_full = RecordingSink::FullRing::drop;
-    if (!rig->record(o.record, "", rs, o.force, error)) {
+    if (!rig->record(o.record, o.trainee, rs, o.force, error)) {
       std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       return kExitError;
     }
+  }
+  if (o.history != "off" && !rig->flight().recording) {
+    std::string why;
+    store = history::open_history(o.history, why);
+    if (store)
+      rig->remember(store.get(), o.trainee, "fly");
+    else
+      std::fprintf(stderr, "mixpilot %s: history: %s; this flight is flown but not remembered\n",
+                   o.command, why.c_str());
   }
   ScreenshotSink* shots = screenshots ? &*screenshots : nullptr;
   std::optional<RealtimeStats> realtime;
@@ -394,6 +418,12 @@ int fly_command(int argc, char** argv) {
       o.domain = parse_domain(o.command, value());
     } else if (a == "--allow-mismatch") {
       o.allow_mismatch = true;
+    } else if (a == "--trainee") {
+      o.trainee = value();
+      if (const std::string why = history::check_trainee(o.trainee); !why.empty())
+        usage_error(o.command, "--trainee: " + why);
+    } else if (a == "--history") {
+      o.history = value();
     } else if (a == "--force") {
       o.force = true;
     } else {

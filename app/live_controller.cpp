@@ -133,6 +133,24 @@ void LiveController::close_live(LiveFlight& f) {
     status_line_.say(c.error, true);
     status_ = kExitError;
   }
+  if (!c.history_error.empty()) history_problem(c.history_error);
+}
+
+history::HistoryStore* LiveController::history_store() {
+  if (options_.history == "off") return nullptr;
+  if (!history_opened_) {
+    history_opened_ = true;  // once: a failing open (a lock) would stall every Start
+    std::string why;
+    history_ = history::open_history(options_.history, why);
+    if (!history_) history_problem(why);
+  }
+  return history_.get();
+}
+
+void LiveController::history_problem(const std::string& why) {
+  if (why == history_said_) return;
+  history_said_ = why;
+  status_line_.say("history: " + why + "; flights are flown but not remembered", true);
 }
 
 int LiveController::finish() {
@@ -329,6 +347,7 @@ void LiveController::start() {
   live_->history.clear();  // the initial state shown while ready
   live_->rig->start();
   status_line_.say("");
+  if (history::HistoryStore* h = history_store()) live_->rig->remember(h, choices_.trainee, "window");
 }
 
 void LiveController::handle(const ui::LiveRequest& r) {

@@ -92,8 +92,16 @@ class LiveController {
   void fly_scenario(std::size_t index);  // the next flight flies scenario_paths_[index]
   void refresh_choices();
   std::string next_record_path() const;
+  // The history the flights go into (SPEC §10), opened at the first start; nullptr with
+  // --history off or when it cannot be opened (said once on the status line).
+  history::HistoryStore* history_store();
+  // A history failure, said on the status line once (the same failure again is not repeated).
+  void history_problem(const std::string& why);
 
   FlyOptions options_;
+  std::unique_ptr<history::HistoryStore> history_;  // before live_: its rig writes to it
+  bool history_opened_ = false;
+  std::string history_said_;
   InputController& input_;
   StatusLine& status_line_;
   std::unique_ptr<LiveFlight> live_;

@@ -27,6 +27,7 @@ constexpr const char* kUsage =
     "  gamepad-script  a recording's pilot commands as a virtual gamepad's script\n"
     "  joy-publish     a recording's sticks as sensor_msgs/msg/Joy over DDS\n"
     "  vehicle         a scenario's vehicle in its own process, for fly --vehicle dds\n"
+    "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -37,8 +38,9 @@ constexpr const char* kUsage =
     "                     <folder of the executable>/../share/mixpilot, /usr/share/mixpilot\n"
     "                     when installed)\n"
     "  CYCLONEDDS_URI     Cyclone DDS configuration (default: loopback only, docs/network.md)\n"
-    "  XDG_CONFIG_HOME, XDG_DATA_HOME  where input settings, gamepad mappings and the window's\n"
-    "                     recordings go (~/.config/mixpilot, ~/.local/share/mixpilot)\n"
+    "  XDG_CONFIG_HOME, XDG_DATA_HOME  where input settings, gamepad mappings, the window's\n"
+    "                     recordings and the history go (~/.config/mixpilot,\n"
+    "                     ~/.local/share/mixpilot)\n"
     "  -h, --help      show this help\n"
     "  --version       print the version\n"
     "\n"
@@ -140,6 +142,7 @@ int dispatch(int argc, char** argv) {
   if (cmd == "gamepad-script") return gamepad_script_command(argc, argv);
   if (cmd == "joy-publish") return joy_publish_command(argc, argv);
   if (cmd == "vehicle") return vehicle_command(argc, argv);
+  if (cmd == "history") return history_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

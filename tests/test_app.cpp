@@ -80,6 +80,8 @@ Rgb rgb_of(ImU32 c) { return {int(c & 0xFF), int((c >> 8) & 0xFF), int((c >> 16)
 class App : public testing::Test {
  protected:
   void SetUp() override {
+    // The flights' history and recordings go to this process's folder, never the user's.
+    setenv("XDG_DATA_HOME", (test::process_temp_dir() / "app_data").c_str(), 1);
     std::string error;
     if (!screen_.open(kW, kH, error)) GTEST_SKIP() << "no EGL device: " << error;
   }

@@ -1,8 +1,10 @@
 #include "core/history/history.hpp"
 
+#include <pwd.h>
 #include <unistd.h>
 
 #include <climits>
+#include <cstdlib>
 
 #include "core/history/postgres_history.hpp"
 #include "core/history/sqlite_history.hpp"
@@ -117,6 +119,12 @@ std::string host_name() {
   char name[HOST_NAME_MAX + 1] = {};
   if (::gethostname(name, sizeof name - 1) != 0) return {};
   return name;
+}
+
+std::string login_name() {
+  if (const passwd* pw = ::getpwuid(::geteuid()); pw && pw->pw_name) return pw->pw_name;
+  if (const char* user = std::getenv("USER"); user && *user) return user;
+  return {};
 }
 
 std::string default_history_path(std::string* why) {

@@ -74,5 +74,7 @@ std::string check_record(const FlightRecord& f);
 
 // This machine's host name ("" when it has none).
 std::string host_name();
+// Who flies when nobody said: the account's login name ("" when it has none).
+std::string login_name();
 
 }  // namespace mixpilot::history

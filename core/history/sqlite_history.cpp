@@ -402,6 +402,9 @@ std::unique_ptr<HistoryStore> open_sqlite(const std::string& path, std::string& 
   auto store = std::make_unique<SqliteHistory>(path, db);  // closes db on every way out
   if (rc != SQLITE_OK) {
     error = path + ": cannot open: " + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
+    if ((rc & 0xFF) == SQLITE_CANTOPEN || (rc & 0xFF) == SQLITE_PERM ||
+        (rc & 0xFF) == SQLITE_READONLY)
+      error += " (the file or its folder cannot be written)";
     return nullptr;
   }
   if (!store->init(settings, error)) return nullptr;

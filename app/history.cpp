@@ -1,0 +1,510 @@
+// mixpilot history: the trainee's flights (SPEC §10) as a table, CSV or JSON; `history import`
+// adds recordings that are not in it yet.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "app/cli.hpp"
+#include "app/commands.hpp"
+#include "app/flight_rig.hpp"
+#include "core/base/input_file.hpp"
+#include "core/history/content_hash.hpp"
+#include "core/history/history.hpp"
+#include "core/recording/replay.hpp"
+
+namespace mixpilot::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHistoryUsage =
+    "usage: mixpilot history [--trainee NAME] [--scenario NAME] [--since DATE] [--limit N]\n"
+    "                        [--csv | --json] [--history LOCATION]\n"
+    "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--history LOCATION]\n"
+    "\n"
+    "The flights mixpilot remembers (SPEC §10): every flight of the window and of `fly`, one\n"
+    "row each (a replay or `score` adds none). Oldest first, so the newest is next to the\n"
+    "prompt. A table on the terminal, or every field with --csv or --json.\n"
+    "\n"
+    "  --trainee NAME     only this trainee's flights\n"
+    "  --scenario NAME    only this scenario's flights (its name, as in the table)\n"
+    "  --since DATE       only flights started at or after DATE, local time: YYYY-MM-DD,\n"
+    "                     YYYY-MM-DDTHH:MM or YYYY-MM-DDTHH:MM:SS (a space for the T too)\n"
+    "  --limit N          only the newest N flights\n"
+    "  --csv              comma-separated values, a header line and one line per flight, every\n"
+    "                     score field in a column of its own (metrics.NAME)\n"
+    "  --json             a JSON array, one object per flight, its score fields in \"metrics\"\n"
+    "  --history LOCATION the history: an SQLite file (PATH or sqlite:PATH; default\n"
+    "                     $XDG_DATA_HOME/mixpilot/history.sqlite) or postgresql://...\n"
+    "\n"
+    "history import DIR: flies each recording (*.mcap) under DIR again and checks it, as score\n"
+    "does, and adds those the history does not know yet (by the SHA-256 of the file: importing\n"
+    "twice adds nothing). The trainee is the recording's; --trainee names one for recordings\n"
+    "without (default: the login name). The start time is the file's modification time minus\n"
+    "the flight's duration. Progress on stderr; a file that cannot be read or replayed is named\n"
+    "with the reason, and the others are still imported.\n"
+    "  --jobs N           replay N recordings in parallel (default: the number of cores)\n"
+    "\n"
+    "exit status: 0 done, 1 the history cannot be read or written, or (import) a recording\n"
+    "could not be imported, 2 usage\n";
+
+// --since's text as unix milliseconds (local time); nullopt when it is not one of the forms.
+std::optional<std::int64_t> parse_since(const std::string& text) {
+  std::tm tm{};
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0;
+  char sep = 0, end = 0;
+  int n = std::sscanf(text.c_str(), "%4d-%2d-%2d%c%2d:%2d:%2d%c", &y, &mo, &d, &sep, &h, &mi, &s,
+                      &end);
+  const bool date_only = n == 3 && text.size() == 10;
+  const bool minutes = n == 6 && text.size() == 16;
+  const bool seconds = n == 7 && text.size() == 19;
+  if (!date_only && !minutes && !seconds) return std::nullopt;
+  if (!date_only && sep != 'T' && sep != ' ') return std::nullopt;
+  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || s > 60 || y < 1970)
+    return std::nullopt;
+  tm.tm_year = y - 1900;
+  tm.tm_mon = mo - 1;
+  tm.tm_mday = d;
+  tm.tm_hour = h;
+  tm.tm_min = mi;
+  tm.tm_sec = s;
+  tm.tm_isdst = -1;
+  const std::time_t t = std::mktime(&tm);
+  if (t == std::time_t(-1) || tm.tm_mday != d) return std::nullopt;  // 2024-02-31
+  return std::int64_t(t) * 1000;
+}
+
+std::string local_time(std::int64_t unix_ms, const char* format) {
+  const std::time_t t = std::time_t(unix_ms / 1000);
+  std::tm tm{};
+  localtime_r(&t, &tm);
+  char text[64];
+  return std::strftime(text, sizeof text, format, &tm) ? text : "";
+}
+
+// `text` in a terminal column of `width` characters: control characters escaped, cut with an
+// ellipsis when longer, padded with spaces (UTF-8 code points counted as one column each).
+std::string cell(std::string_view raw, std::size_t width, bool right = false) {
+  const std::string text = escape_controls(raw);
+  std::string out;
+  std::size_t cols = 0, i = 0;
+  const auto next = [&](std::size_t at) {
+    std::size_t len = 1;
+    while (at + len < text.size() && (static_cast<unsigned char>(text[at + len]) & 0xC0) == 0x80)
+      ++len;
+    return len;
+  };
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < text.size(); k += next(k)) ++total;
+  while (i < text.size() && cols < width) {
+    if (total > width && cols + 1 == width) {
+      out += "\u2026";
+      ++cols;
+      break;
+    }
+    const std::size_t len = next(i);
+    out.append(text, i, len);
+    i += len;
+    ++cols;
+  }
+  const std::string pad(width - cols, ' ');
+  return right ? pad + out : out + pad;
+}
+
+std::optional<double> metric_of(const history::StoredFlight& f, std::string_view name) {
+  for (const auto& [k, v] : f.metrics)
+    if (k == name) return v;
+  return std::nullopt;
+}
+
+std::string number(double v, const char* format = "%.17g") {
+  if (!std::isfinite(v)) return "";
+  char text[40];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+void print_table(const std::vector<history::StoredFlight>& rows) {
+  std::printf("%s %s %s %s %s %s %s %s %s %s\n", cell("id", 6, true).c_str(),
+              cell("started", 16).c_str(), cell("trainee", 16).c_str(),
+              cell("scenario", 18).c_str(), cell("pilot", 12).c_str(),
+              cell("time_s", 7, true).c_str(), cell("ended", 11).c_str(),
+              cell("skill", 6, true).c_str(), cell("from", 7).c_str(), "recording");
+  for (const history::StoredFlight& f : rows) {
+    const auto skill = metric_of(f, "skill");
+    std::string ended = history::to_string(f.ended);
+    if (f.probe) ended += "*";
+    std::printf("%s %s %s %s %s %s %s %s %s %s\n",
+                cell(std::to_string(f.id), 6, true).c_str(),
+                cell(local_time(f.started_unix_ms, "%Y-%m-%d %H:%M"), 16).c_str(),
+                cell(f.trainee, 16).c_str(), cell(f.scenario, 18).c_str(),
+                cell(f.pilot.empty() ? "-" : f.pilot, 12).c_str(),
+                cell(number(f.duration_s, "%.1f"), 7, true).c_str(), cell(ended, 11).c_str(),
+                cell(skill ? number(*skill, "%.1f") : "-", 6, true).c_str(),
+                cell(f.front_end, 7).c_str(),
+                escape_controls(f.recording_path.empty() ? "-" : f.recording_path).c_str());
+  }
+  std::printf("%zu flight%s%s\n", rows.size(), rows.size() == 1 ? "" : "s",
+              std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.probe; })
+                  ? " (* a probe flight: unassisted)"
+                  : "");
+}
+
+// A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line break.
+std::string csv(std::string_view s) {
+  if (s.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(s);
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+const char* const kFields[] = {"id", "trainee", "station", "scenario", "scenario_hash", "mode",
+                               "pilot", "input_device", "input_settings_hash", "started",
+                               "started_unix_ms", "duration_s", "ended", "probe",
+                               "recording_path", "recording_hash", "app_version", "front_end"};
+
+std::vector<std::string> field_values(const history::StoredFlight& f) {
+  return {std::to_string(f.id),  f.trainee, f.station, f.scenario, f.scenario_hash, f.mode,
+          f.pilot, f.input_device, f.input_settings_hash,
+          local_time(f.started_unix_ms, "%Y-%m-%dT%H:%M:%S%z"), std::to_string(f.started_unix_ms),
+          number(f.duration_s), history::to_string(f.ended), f.probe ? "1" : "0",
+          f.recording_path, f.recording_hash, f.app_version, f.front_end};
+}
+
+void print_csv(const std::vector<history::StoredFlight>& rows) {
+  // The score fields' columns: every name any row has, in the order first seen.
+  std::vector<std::string> names;
+  for (const auto& f : rows)
+    for (const auto& [k, v] : f.metrics)
+      if (std::find(names.begin(), names.end(), k) == names.end()) names.push_back(k);
+  std::string line;
+  for (const char* f : kFields) {
+    if (!line.empty()) line += ',';
+    line += f;
+  }
+  for (const auto& n : names) {
+    line += ',';
+    line += csv("metrics." + n);  // as in the JSON; never one of the flight's own columns
+  }
+  std::printf("%s\n", line.c_str());
+  for (const auto& f : rows) {
+    line.clear();
+    for (const std::string& v : field_values(f)) {
+      if (!line.empty()) line += ',';
+      line += csv(v);
+    }
+    for (const auto& n : names) {
+      line += ',';
+      if (const auto v = metric_of(f, n)) line += number(*v);
+    }
+    std::printf("%s\n", line.c_str());
+  }
+}
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '"') out += "\\\"";
+    else if (c == '\\') out += "\\\\";
+    else if (c == '\n') out += "\\n";
+    else if (c == '\t') out += "\\t";
+    else if (c < 0x20 || c == 0x7F) {
+      char u[8];
+      std::snprintf(u, sizeof u, "\\u%04x", c);
+      out += u;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+void print_json(const std::vector<history::StoredFlight>& rows) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const history::StoredFlight& f = rows[i];
+    const std::vector<std::string> values = field_values(f);
+    out += i ? ",\n  {" : "\n  {";
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const std::string_view name = kFields[k];
+      out += (k ? ", " : "") + json_string(name) + ": ";
+      if (name == "id" || name == "started_unix_ms")
+        out += values[k];
+      else if (name == "duration_s")
+        out += values[k].empty() ? "null" : values[k];
+      else if (name == "probe")
+        out += f.probe ? "true" : "false";
+      else
+        out += json_string(values[k]);
+    }
+    out += ", \"metrics\": {";
+    for (std::size_t m = 0; m < f.metrics.size(); ++m) {
+      const std::string v = number(f.metrics[m].second);
+      out += (m ? ", " : "") + json_string(f.metrics[m].first) + ": " + (v.empty() ? "null" : v);
+    }
+    out += "}}";
+  }
+  out += rows.empty() ? "]\n" : "\n]\n";
+  std::fputs(out.c_str(), stdout);
+}
+
+// ---- import ----------------------------------------------------------------------------------
+
+struct ImportRow {
+  std::string file;
+  std::string hash;
+  enum class State { failed, known, scored } state = State::failed;
+  std::optional<history::FlightRecord> record;
+  std::string error;
+};
+
+// The recording flown again and checked (as score does), as the history's row.
+void score_for_import(ImportRow& row, const std::string& trainee) {
+  FlyOptions o;
+  o.pilot = row.file;
+  o.replay = true;
+  o.command = "history import";
+  std::string error;
+  int status = kExitOk;
+  const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
+  if (!rig) {
+    row.error = error;
+    return;
+  }
+  rig->start();
+  while (rig->step()) {
+  }
+  if (const std::string diff = rig->replay_difference(); !diff.empty()) {
+    row.error = row.file + ": its replay differs from the recording (" + diff +
+                "): its score would not be that flight's";
+    return;
+  }
+  const RecordingContents& rec = *rig->flight().recording;
+  const bool early = !recording_ended_early(rec, rig->mode()).empty();
+  auto r = rig->flight_record(early, error);
+  if (!r) {
+    row.error = error;
+    return;
+  }
+  if (const auto it = rec.metadata.find("trainee"); it == rec.metadata.end() || it->second.empty())
+    r->trainee = trainee.empty() ? r->trainee : trainee;
+  if (r->front_end != "vehicle") r->front_end = "import";
+  std::error_code ec;
+  const fs::path abs = fs::absolute(row.file, ec);
+  r->recording_path = (ec ? fs::path(row.file) : abs).lexically_normal().string();
+  r->recording_hash = row.hash;
+  struct stat st {};
+  const std::int64_t mtime_ms =
+      ::stat(row.file.c_str(), &st) == 0
+          ? std::int64_t(st.st_mtim.tv_sec) * 1000 + st.st_mtim.tv_nsec / 1'000'000
+          : 0;
+  r->started_unix_ms = std::max<std::int64_t>(0, mtime_ms - std::int64_t(r->duration_s * 1000));
+  row.record = std::move(r);
+  row.state = ImportRow::State::scored;
+}
+
+int import_command(history::HistoryStore& store, const std::string& dir, int jobs,
+                   const std::string& trainee) {
+  std::vector<ImportRow> rows;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    std::fprintf(stderr, "mixpilot history import: %s: %s\n", escape_controls(dir).c_str(),
+                 ec ? ec.message().c_str() : "not a folder");
+    return kExitError;
+  }
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().extension() == ".mcap" && it->is_regular_file(ec))
+      rows.push_back({it->path().string(), {}, ImportRow::State::failed, {}, {}});
+  if (ec) {
+    std::fprintf(stderr, "mixpilot history import: %s: %s\n", escape_controls(dir).c_str(),
+                 ec.message().c_str());
+    return kExitError;
+  }
+  std::sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.file < b.file; });
+  // Known recordings are skipped before they are flown: importing again costs only the hashes.
+  std::string error;
+  for (ImportRow& r : rows) {
+    const auto h = history::sha256_file(r.file, r.error);
+    if (!h) continue;
+    r.hash = *h;
+    bool known = false;
+    if (!store.knows_recording(r.hash, known, error)) {
+      std::fprintf(stderr, "mixpilot history import: %s\n", escape_controls(error).c_str());
+      return kExitError;
+    }
+    if (known) r.state = ImportRow::State::known;
+  }
+  std::atomic<std::size_t> next{0}, done{0};
+  std::mutex io;
+  std::size_t added = 0, known = 0, failed = 0;
+  const auto say = [&](const ImportRow& r, const std::string& what) {
+    std::fprintf(stderr, "[%zu/%zu] %s: %s\n", ++done, rows.size(), escape_controls(r.file).c_str(),
+                 escape_controls(what).c_str());
+  };
+  // Progress as each recording is done; the counts at the end.
+  const auto report = [&](const ImportRow& r) {
+    if (r.state == ImportRow::State::known) {
+      ++known;
+      say(r, "already in the history");
+    } else if (r.state == ImportRow::State::scored) {
+      ++added;
+      const auto skill = std::find_if(r.record->metrics.begin(), r.record->metrics.end(),
+                                      [](const auto& m) { return m.first == "skill"; });
+      say(r, skill != r.record->metrics.end() ? "added (skill " + number(skill->second, "%.1f") + ")"
+                                              : "added (" + r.record->mode + ")");
+    } else {
+      ++failed;
+      say(r, "not imported: " + r.error);
+    }
+  };
+  for (const ImportRow& r : rows)
+    if (r.state == ImportRow::State::known || r.hash.empty()) report(r);
+  const auto worker = [&] {
+    for (std::size_t i = next++; i < rows.size(); i = next++) {
+      ImportRow& r = rows[i];
+      if (r.state == ImportRow::State::known || r.hash.empty()) continue;
+      score_for_import(r, trainee);
+      // One writer at a time in this process; other processes wait on the database's lock.
+      const std::lock_guard<std::mutex> lock(io);
+      if (r.state == ImportRow::State::scored) {
+        std::string why;
+        const auto a = store.add(*r.record, why);
+        if (!a) {
+          r.state = ImportRow::State::failed;
+          r.error = why;
+        } else if (*a == history::HistoryStore::Added::already_known) {
+          r.state = ImportRow::State::known;
+        }
+      }
+      report(r);
+    }
+  };
+  {
+    std::vector<std::thread> pool;
+    for (int j = 0; j < std::min<int>(jobs, int(rows.size())); ++j) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
+  std::printf("mixpilot history import: %zu added, %zu already known, %zu not imported (%s)\n",
+              added, known, failed, escape_controls(store.where()).c_str());
+  return failed > 0 ? kExitError : kExitOk;
+}
+
+}  // namespace
+
+int history_command(int argc, char** argv) {
+  const char* cmd = "history";
+  history::Query q;
+  std::string location, import_dir, trainee_for_import;
+  bool as_csv = false, as_json = false, importing = false;
+  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  int first = 2;
+  if (argc > 2 && std::string_view(argv[2]) == "import") {
+    importing = true;
+    first = 3;
+  } else if (argc > 2 && std::string_view(argv[2]) == "push") {
+    std::fprintf(stderr, "mixpilot history push: copying a history into PostgreSQL is not built "
+                         "into this mixpilot yet\n");
+    return kExitError;
+  }
+  for (int i = first; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const auto value = [&] { return option_value(cmd, argc, argv, i); };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kHistoryUsage, stdout);
+      return kExitOk;
+    } else if (a == "--history") {
+      location = value();
+      if (location == "off") usage_error(cmd, "--history off: there is no history to read");
+    } else if (a == "--trainee") {
+      const std::string v = value();
+      if (const std::string why = history::check_trainee(v); !why.empty())
+        usage_error(cmd, "--trainee: " + why);
+      (importing ? trainee_for_import : q.trainee) = v;
+    } else if (!importing && a == "--scenario") {
+      q.scenario = value();
+    } else if (!importing && a == "--since") {
+      const std::string v = value();
+      const auto t = parse_since(v);
+      if (!t)
+        usage_error(cmd, "--since expects YYYY-MM-DD, YYYY-MM-DDTHH:MM or YYYY-MM-DDTHH:MM:SS, "
+                         "got '" + escape_controls(v) + "'");
+      q.since_unix_ms = *t;
+    } else if (!importing && a == "--limit") {
+      const std::string v = value();
+      char* end = nullptr;
+      const long long n = std::strtoll(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < 1)
+        usage_error(cmd, "--limit expects a whole number of flights ≥ 1, got '" +
+                             escape_controls(v) + "'");
+      q.limit = n;
+    } else if (!importing && a == "--csv") {
+      as_csv = true;
+    } else if (!importing && a == "--json") {
+      as_json = true;
+    } else if (importing && a == "--jobs") {
+      const std::string v = value();
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < 1 || n > 256)
+        usage_error(cmd, "--jobs expects a whole number from 1 to 256, got '" +
+                             escape_controls(v) + "'");
+      jobs = int(n);
+    } else if (importing && !a.empty() && a[0] != '-' && import_dir.empty()) {
+      import_dir = file_argument(cmd, "a folder of recordings", a);
+    } else {
+      usage_error(cmd, "unexpected '" + escape_controls(a) + "'");
+    }
+  }
+  if (as_csv && as_json) usage_error(cmd, "--csv or --json, not both");
+  if (importing && import_dir.empty())
+    usage_error(cmd, "which folder? (mixpilot history import DIR)");
+  std::string error;
+  std::vector<history::StoredFlight> rows;
+  const auto print = [&] {
+    if (as_csv)
+      print_csv(rows);
+    else if (as_json)
+      print_json(rows);
+    else
+      print_table(rows);
+    return kExitOk;
+  };
+  // A listing never creates a history: no SQLite file yet is no flight yet.
+  if (!importing && !location.starts_with("postgres")) {
+    const std::string file = location.empty()            ? history::default_history_path()
+                             : location.starts_with("sqlite:") ? location.substr(7)
+                                                               : location;
+    std::error_code ec;
+    if (!file.empty() && !fs::exists(file, ec) && !ec) return print();
+  }
+  const auto store = history::open_history(location, error);
+  if (!store) {
+    std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
+  if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
+  if (!store->query(q, rows, error)) {
+    std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
+  return print();
+}
+
+}  // namespace mixpilot::cli

@@ -1,0 +1,846 @@
+// The trainee's history (SPEC §10): the store (SQLite), its schema, content hashes, writers in
+// parallel and killed, damaged and locked files, hostile names; and every front end's flight
+// recorded once.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <set>
+#include <thread>
+#include <string>
+#include <vector>
+
+#include "app/flight_rig.hpp"
+#include "app/trainer.hpp"
+#include "core/history/content_hash.hpp"
+#include "core/history/history.hpp"
+#include "core/history/schema.hpp"
+#include "core/history/sqlite_history.hpp"
+#include "core/numerics/version.hpp"
+#include "run_mixpilot.hpp"
+#include "temp_files.hpp"
+
+namespace mixpilot {
+namespace {
+
+namespace fs = std::filesystem;
+using history::FlightRecord;
+using history::HistoryStore;
+using history::StoredFlight;
+
+FlightRecord sample_flight(const std::string& trainee = "Ada", std::int64_t started = 1'700'000'000'000) {
+  FlightRecord f;
+  f.trainee = trainee;
+  f.station = "station-1";
+  f.scenario = "mi_helix";
+  f.scenario_hash = history::sha256_hex("scenario text");
+  f.mode = "mixed_initiative";
+  f.pilot = "novice";
+  f.input_device = "";
+  f.input_settings_hash = "";
+  f.started_unix_ms = started;
+  f.duration_s = 30.0;
+  f.ended = history::Ended::completed;
+  f.app_version = "mixpilot 0.1.0";
+  f.front_end = "fly";
+  f.metrics = {{"skill", 71.5}, {"mean_lambda", 0.8}, {"min_clearance_m", INFINITY},
+               {"lost", 0.0}};
+  return f;
+}
+
+std::unique_ptr<HistoryStore> open_store(const fs::path& p, const history::SqliteSettings& s = {}) {
+  std::string error;
+  auto store = history::open_sqlite(p.string(), error, s);
+  EXPECT_TRUE(store) << error;
+  return store;
+}
+
+std::vector<StoredFlight> all(HistoryStore& store, const history::Query& q = {}) {
+  std::vector<StoredFlight> out;
+  std::string error;
+  EXPECT_TRUE(store.query(q, out, error)) << error;
+  return out;
+}
+
+// A statement's one integer answer through SQLite directly (not through the store).
+std::int64_t sql_int(const fs::path& p, const char* sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  sqlite3_stmt* s = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &s, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  std::int64_t v = -1;
+  if (sqlite3_step(s) == SQLITE_ROW) v = sqlite3_column_int64(s, 0);
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return v;
+}
+std::string sql_text(const fs::path& p, const char* sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  sqlite3_stmt* s = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &s, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  std::string v;
+  if (sqlite3_step(s) == SQLITE_ROW && sqlite3_column_text(s, 0))
+    v = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return v;
+}
+
+bool running_as_root() { return ::geteuid() == 0; }
+
+// ---- Content hashes -------------------------------------------------------------------------
+
+// FIPS 180-4's examples (NIST's SHA256.pdf) and the empty message.
+TEST(HistoryHash, Sha256GivesTheStandardsVectors) {
+  EXPECT_EQ(history::sha256_hex("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(history::sha256_hex(""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(history::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  // A file across several read blocks hashes as its bytes do.
+  const fs::path p = test::fresh_path("history", "big.bin");
+  std::string bytes(200'003, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 131 % 251);
+  std::ofstream(p, std::ios::binary) << bytes;
+  std::string error;
+  const auto h = history::sha256_file(p.string(), error);
+  ASSERT_TRUE(h) << error;
+  EXPECT_EQ(*h, history::sha256_hex(bytes));
+  EXPECT_FALSE(history::sha256_file((p.parent_path() / "absent").string(), error));
+  EXPECT_NE(error.find("absent"), std::string::npos) << error;
+}
+
+// ---- The schema ----------------------------------------------------------------------------
+
+TEST(HistorySchema, OneSchemaTwoDialects) {
+  const auto sqlite = history::pending(0, history::Dialect::sqlite);
+  const auto pg = history::pending(0, history::Dialect::postgresql);
+  ASSERT_EQ(sqlite.size(), pg.size());
+  ASSERT_FALSE(sqlite.empty());
+  EXPECT_TRUE(sqlite.back().takes_time);  // the version's row, last
+  EXPECT_NE(sqlite[0].sql.find("INTEGER PRIMARY KEY"), std::string::npos) << sqlite[0].sql;
+  EXPECT_NE(pg[0].sql.find("BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY"), std::string::npos)
+      << pg[0].sql;
+  for (const auto& s : pg) EXPECT_EQ(s.sql.find('{'), std::string::npos) << s.sql;
+  EXPECT_TRUE(history::pending(history::kSchemaVersion, history::Dialect::sqlite).empty());
+  EXPECT_EQ(history::newer_schema_message(history::kSchemaVersion, "f"), "");
+  EXPECT_NE(history::newer_schema_message(history::kSchemaVersion + 1, "f"), "");
+}
+
+// ---- The store -----------------------------------------------------------------------------
+
+// A flight comes back with every field it went in with, its metrics in their order; a metric
+// that is not a finite number comes back as NaN (stored NULL, as the reports' null).
+TEST(HistoryStore, AFlightComesBackWithEveryField) {
+  const fs::path p = test::fresh_path("history", "roundtrip.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord f = sample_flight();
+  f.input_device = "gamepad";
+  f.input_settings_hash = history::sha256_hex("mode = 2");
+  f.ended = history::Ended::lost;
+  f.probe = true;
+  f.recording_path = "/tmp/a.mcap";
+  f.recording_hash = history::sha256_hex("rec");
+  std::string error;
+  ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  const StoredFlight& r = rows[0];
+  EXPECT_GT(r.id, 0);
+  EXPECT_EQ(r.trainee, f.trainee);
+  EXPECT_EQ(r.station, f.station);
+  EXPECT_EQ(r.scenario, f.scenario);
+  EXPECT_EQ(r.scenario_hash, f.scenario_hash);
+  EXPECT_EQ(r.mode, f.mode);
+  EXPECT_EQ(r.pilot, f.pilot);
+  EXPECT_EQ(r.input_device, f.input_device);
+  EXPECT_EQ(r.input_settings_hash, f.input_settings_hash);
+  EXPECT_EQ(r.started_unix_ms, f.started_unix_ms);
+  EXPECT_EQ(r.duration_s, f.duration_s);
+  EXPECT_EQ(r.ended, history::Ended::lost);
+  EXPECT_TRUE(r.probe);
+  EXPECT_EQ(r.recording_path, f.recording_path);
+  EXPECT_EQ(r.recording_hash, f.recording_hash);
+  EXPECT_EQ(r.app_version, f.app_version);
+  EXPECT_EQ(r.front_end, f.front_end);
+  ASSERT_EQ(r.metrics.size(), f.metrics.size());
+  for (std::size_t i = 0; i < f.metrics.size(); ++i) {
+    EXPECT_EQ(r.metrics[i].first, f.metrics[i].first);
+    if (std::isfinite(f.metrics[i].second))
+      EXPECT_EQ(r.metrics[i].second, f.metrics[i].second);
+    else
+      EXPECT_TRUE(std::isnan(r.metrics[i].second));
+  }
+  std::vector<std::string> names;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  EXPECT_EQ(names, std::vector<std::string>{"Ada"});
+  // The database holds what the schema says, with foreign keys on.
+  EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
+  EXPECT_EQ(sql_text(p, "PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), 4);
+}
+
+// A recording is one flight: the same hash again is already known and adds nothing; flights
+// without a recording are each their own.
+TEST(HistoryStore, ARecordingIsAddedOnce) {
+  const fs::path p = test::fresh_path("history", "once.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord f = sample_flight();
+  f.recording_hash = history::sha256_hex("recording");
+  f.recording_path = "/r.mcap";
+  std::string error;
+  bool known = true;
+  ASSERT_TRUE(store->knows_recording(f.recording_hash, known, error)) << error;
+  EXPECT_FALSE(known);
+  EXPECT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(store->add(f, error), HistoryStore::Added::already_known) << error;
+  ASSERT_TRUE(store->knows_recording(f.recording_hash, known, error)) << error;
+  EXPECT_TRUE(known);
+  FlightRecord g = sample_flight();
+  EXPECT_EQ(store->add(g, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(store->add(g, error), HistoryStore::Added::added) << error;
+  EXPECT_EQ(all(*store).size(), 3u);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), 12);
+}
+
+TEST(HistoryStore, FiltersAndTheNewestLimit) {
+  const fs::path p = test::fresh_path("history", "filters.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  std::string error;
+  for (int i = 0; i < 6; ++i) {
+    FlightRecord f = sample_flight(i % 2 ? "Ben" : "Ada", 1000 * (10 - i));  // newest first in
+    f.scenario = i < 3 ? "mi_helix" : "mi_slalom";
+    f.metrics = {{"skill", double(i)}};
+    ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
+  }
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 6u);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    EXPECT_LT(rows[i - 1].started_unix_ms, rows[i].started_unix_ms) << "oldest first";
+  history::Query q;
+  q.trainee = "Ben";
+  for (const auto& r : all(*store, q)) EXPECT_EQ(r.trainee, "Ben");
+  EXPECT_EQ(all(*store, q).size(), 3u);
+  q = {};
+  q.scenario = "mi_slalom";
+  EXPECT_EQ(all(*store, q).size(), 3u);
+  q = {};
+  q.since_unix_ms = 7000;  // i = 0..3 started at 10000, 9000, 8000, 7000
+  EXPECT_EQ(all(*store, q).size(), 4u);
+  q = {};
+  q.limit = 2;  // the two newest, oldest first: i = 1 (9000), i = 0 (10000)
+  const auto newest = all(*store, q);
+  ASSERT_EQ(newest.size(), 2u);
+  EXPECT_EQ(newest[0].started_unix_ms, 9000);
+  EXPECT_EQ(newest[1].started_unix_ms, 10000);
+  ASSERT_EQ(newest[1].metrics.size(), 1u);
+  EXPECT_EQ(newest[1].metrics[0].second, 0.0);
+  EXPECT_EQ(newest[0].metrics[0].second, 1.0);
+  q = {};
+  q.trainee = "nobody";
+  EXPECT_TRUE(all(*store, q).empty());
+}
+
+// Names are data, never SQL: quotes and a statement in a name are stored and read back as
+// they are; 10 000 characters, invalid UTF-8, control characters and an empty name are
+// refused with the reason, and nothing of them is written.
+TEST(HistoryStore, HostileTraineeNames) {
+  const fs::path p = test::fresh_path("history", "names.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  std::string error;
+  const std::vector<std::string> stored = {
+      "O'Brien", "\"quoted\"", "Robert'); DROP TABLE flights; --", "'; DROP TABLE trainees",
+      "Zoë Ångström 飛行", std::string(history::kMaxNameChars, 'x')};
+  for (const std::string& name : stored)
+    EXPECT_EQ(store->add(sample_flight(name), error), HistoryStore::Added::added)
+        << name << ": " << error;
+  const struct {
+    std::string name;
+    const char* reason;
+  } refused[] = {
+      {std::string(10'000, 'a'), "10000 characters long"},
+      {std::string(history::kMaxNameChars + 1, 'x'), "201 characters long"},
+      {"bad\xff" "byte", "not valid UTF-8"},
+      {"over\xc0\xaflong", "not valid UTF-8"},
+      {"cut\xe2\x82", "not valid UTF-8"},
+      {"surrogate\xed\xa0\x80", "not valid UTF-8"},
+      {"line\nbreak", "control character"},
+      {"esc\x1b[31mred", "control character"},
+      {"c1\xc2\x9b", "control character"},
+      {"", "empty"},
+  };
+  for (const auto& r : refused) {
+    error.clear();
+    EXPECT_FALSE(store->add(sample_flight(r.name), error)) << r.reason;
+    EXPECT_NE(error.find(r.reason), std::string::npos) << error;
+    EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  }
+  std::vector<std::string> names;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  std::set<std::string> want(stored.begin(), stored.end());
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()), want);
+  for (const std::string& name : stored) {
+    history::Query q;
+    q.trainee = name;
+    const auto rows = all(*store, q);
+    ASSERT_EQ(rows.size(), 1u) << name;
+    EXPECT_EQ(rows[0].trainee, name);
+  }
+  EXPECT_EQ(all(*store).size(), stored.size());  // the tables are all still there
+  EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
+}
+
+// A newer mixpilot's history is refused with the reason and left as it was, byte for byte.
+TEST(HistoryStore, ANewerSchemaIsRefusedAndLeftUntouched) {
+  const fs::path p = test::fresh_path("history", "newer.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  std::string error;
+  {
+    auto store = open_store(p);
+    ASSERT_TRUE(store);
+    ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+  }
+  EXPECT_EQ(sql_int(p, "INSERT INTO schema_version VALUES (99, 0) RETURNING version"), 99);
+  const auto before = test::slurp(p);
+  const auto store = history::open_sqlite(p.string(), error);
+  EXPECT_FALSE(store);
+  EXPECT_NE(error.find("newer mixpilot (schema version 99"), std::string::npos) << error;
+  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  EXPECT_EQ(test::slurp(p), before);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM flights"), 1);
+}
+
+// A file that is not a database: refused with the file's name and what to do.
+TEST(HistoryStore, ACorruptFileIsSaidAsSuch) {
+  const fs::path p = test::fresh_path("history", "corrupt.sqlite");
+  std::ofstream(p) << std::string(8192, 'Z');
+  const auto before = test::slurp(p);
+  std::string error;
+  EXPECT_FALSE(history::open_sqlite(p.string(), error));
+  EXPECT_NE(error.find(p.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("not a database"), std::string::npos) << error;
+  EXPECT_NE(error.find("damaged"), std::string::npos) << error;
+  EXPECT_EQ(test::slurp(p), before);
+  // A real history with a page overwritten in its middle.
+  const fs::path q = test::fresh_path("history", "damaged.sqlite");
+  {
+    auto store = open_store(q);
+    ASSERT_TRUE(store);
+    for (int i = 0; i < 200; ++i) ASSERT_TRUE(store->add(sample_flight(), error)) << error;
+  }
+  sql_int(q, "PRAGMA wal_checkpoint(TRUNCATE)");
+  {
+    std::fstream f(q, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(0);
+    f << std::string(100, '\x5a');  // the header: no longer SQLite's
+  }
+  error.clear();
+  EXPECT_FALSE(history::open_sqlite(q.string(), error));
+  EXPECT_NE(error.find("damaged"), std::string::npos) << error;
+}
+
+// As root, permissions do not hold: the check runs in a child that drops to `nobody`.
+template <class Check>
+void as_a_user(Check check) {
+  if (!running_as_root()) {
+    check();
+    return;
+  }
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(77);
+    check();
+    ::_exit(testing::Test::HasFailure() ? 1 : 0);
+  }
+  int st = 0;
+  ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+  ASSERT_TRUE(WIFEXITED(st));
+  if (WEXITSTATUS(st) == 77) GTEST_SKIP() << "cannot drop root to test permissions";
+  EXPECT_EQ(WEXITSTATUS(st), 0) << "the check failed as nobody (its output is above)";
+}
+
+TEST(HistoryStore, AReadOnlyFileOrFolderIsSaidAsSuch) {
+  const fs::path dir = test::fresh_path("history", "ro");
+  fs::create_directories(dir);
+  const fs::path p = dir / "history.sqlite";
+  std::string error;
+  {
+    auto store = open_store(p);
+    ASSERT_TRUE(store);
+    ASSERT_TRUE(store->add(sample_flight(), error)) << error;
+  }
+  sql_int(p, "PRAGMA wal_checkpoint(TRUNCATE)");
+  ::chmod(p.c_str(), 0444);
+  // Readable by all (the folders on the way too), writable by nobody but root.
+  for (fs::path d = dir; d != test::process_temp_dir().parent_path(); d = d.parent_path())
+    ::chmod(d.c_str(), 0755);
+  ::chmod(dir.c_str(), 0555);
+  as_a_user([&] {
+    std::string why;
+    auto store = history::open_sqlite(p.string(), why);
+    if (store) EXPECT_FALSE(store->add(sample_flight(), why));
+    EXPECT_NE(why.find("cannot be written"), std::string::npos) << why;
+    EXPECT_NE(why.find(p.string()), std::string::npos) << why;
+    // A folder where no history can be made.
+    why.clear();
+    EXPECT_FALSE(history::open_sqlite((dir / "new.sqlite").string(), why));
+    EXPECT_NE(why.find("cannot be written"), std::string::npos) << why;
+  });
+  ::chmod(dir.c_str(), 0700);
+  ::chmod(p.c_str(), 0600);
+}
+
+// Another program holding the write lock past the busy timeout: the write waits that long,
+// then says why.
+TEST(HistoryStore, ALockedDatabaseWaitsThenSaysSo) {
+  const fs::path p = test::fresh_path("history", "locked.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(p.c_str(), &holder), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  history::SqliteSettings s;
+  s.busy_timeout_ms = 300;
+  std::string error;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(history::open_sqlite(p.string(), error, s));
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(waited, 0.25);
+  EXPECT_LT(waited, 5.0);
+  EXPECT_NE(error.find("locked"), std::string::npos) << error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  // Opened before the lock, a store's write waits the same way.
+  auto store = open_store(p, s);
+  ASSERT_TRUE(store);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  error.clear();
+  EXPECT_FALSE(store->add(sample_flight(), error));
+  EXPECT_NE(error.find("locked"), std::string::npos) << error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  EXPECT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+}
+
+// The default file's missing folders are made, private to the user.
+TEST(HistoryStore, MissingFoldersAreMadePrivate) {
+  const fs::path base = test::fresh_path("history", "xdg");
+  const fs::path p = base / "a" / "b" / "history.sqlite";
+  ASSERT_TRUE(open_store(p));
+  EXPECT_TRUE(fs::exists(p));
+  struct stat st {};
+  ASSERT_EQ(::stat((base / "a" / "b").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  ASSERT_EQ(::stat((base / "a").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  // The factory: "" is the default file under $XDG_DATA_HOME; sqlite:PATH a file.
+  setenv("XDG_DATA_HOME", base.c_str(), 1);
+  std::string error;
+  auto d = history::open_history("", error);
+  ASSERT_TRUE(d) << error;
+  EXPECT_EQ(d->where(), (base / "mixpilot" / "history.sqlite").string());
+  auto s = history::open_history("sqlite:" + (base / "x.sqlite").string(), error);
+  ASSERT_TRUE(s) << error;
+  EXPECT_EQ(s->where(), (base / "x.sqlite").string());
+  EXPECT_FALSE(history::open_history("postgresql://user:secret@host/db", error));
+  EXPECT_NE(error.find("PostgreSQL"), std::string::npos) << error;
+  EXPECT_EQ(error.find("secret"), std::string::npos) << error;
+  EXPECT_FALSE(history::open_history(base.string(), error));  // a folder
+  EXPECT_NE(error.find("folder"), std::string::npos) << error;
+}
+
+// ---- Writers at once, and killed ----------------------------------------------------------
+
+// Eight processes write 50 flights each into one file at once: 400 rows, none lost.
+TEST(HistoryStore, EightProcessesWriteAtOnce) {
+  const fs::path p = test::fresh_path("history", "parallel.sqlite");
+  constexpr int kProcs = 8, kEach = 50;
+  std::vector<pid_t> kids;
+  for (int k = 0; k < kProcs; ++k) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      std::string error;
+      auto store = history::open_sqlite(p.string(), error);  // each its own, new file or not
+      if (!store) {
+        std::fprintf(stderr, "child %d: %s\n", k, error.c_str());
+        ::_exit(2);
+      }
+      for (int i = 0; i < kEach; ++i) {
+        FlightRecord f = sample_flight("writer " + std::to_string(k), i);
+        f.recording_hash = history::sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+        if (store->add(f, error) != HistoryStore::Added::added) {
+          std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
+          ::_exit(3);
+        }
+      }
+      ::_exit(0);
+    }
+    kids.push_back(pid);
+  }
+  for (pid_t pid : kids) {
+    int st = 0;
+    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "a writer failed: " << st;
+  }
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  const auto rows = all(*store);
+  EXPECT_EQ(rows.size(), std::size_t(kProcs * kEach));
+  std::set<std::string> hashes;
+  for (const auto& r : rows) hashes.insert(r.recording_hash);
+  EXPECT_EQ(hashes.size(), std::size_t(kProcs * kEach));
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM metrics"), kProcs * kEach * 4);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM schema_version"), history::kSchemaVersion);
+  std::vector<std::string> names;
+  std::string error;
+  ASSERT_TRUE(store->trainees(names, error)) << error;
+  EXPECT_EQ(names.size(), std::size_t(kProcs));
+}
+
+// A writer killed (SIGKILL) in the middle of its transactions: the file passes SQLite's
+// integrity check and holds every flight whose commit the writer reported, and nothing half.
+TEST(HistoryStore, AWriterKilledMidTransactionLosesNothingCommitted) {
+  const fs::path p = test::fresh_path("history", "killed.sqlite");
+  { ASSERT_TRUE(open_store(p)); }
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  constexpr int kMetrics = 3000;  // a long transaction: the kill lands inside one
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::string error;
+    auto store = history::open_sqlite(p.string(), error);
+    if (!store) ::_exit(2);
+    for (int i = 0;; ++i) {
+      FlightRecord f = sample_flight("killed", i);
+      f.metrics.clear();
+      for (int m = 0; m < kMetrics; ++m) f.metrics.emplace_back("m" + std::to_string(m), m);
+      if (!store->add(f, error)) ::_exit(3);
+      const std::int32_t done = i;
+      if (::write(fds[1], &done, sizeof done) != sizeof done) ::_exit(4);
+    }
+  }
+  ::close(fds[1]);
+  std::int32_t last = -1, got = 0;
+  while (last < 20 && ::read(fds[0], &got, sizeof got) == sizeof got) last = got;
+  // Somewhere inside the next transaction.
+  std::this_thread::sleep_for(std::chrono::milliseconds(7));
+  ::kill(pid, SIGKILL);
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  ASSERT_TRUE(WIFSIGNALED(st)) << "the writer ended before the kill: " << st;
+  while (::read(fds[0], &got, sizeof got) == sizeof got) last = got;  // reported before dying
+  ::close(fds[0]);
+  EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
+  EXPECT_EQ(sql_int(p, "PRAGMA foreign_key_check"), -1) << "a dangling reference";
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  const auto rows = all(*store);
+  ASSERT_GE(rows.size(), std::size_t(last + 1));
+  EXPECT_LE(rows.size(), std::size_t(last + 2));  // at most the one committed unreported
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].started_unix_ms, std::int64_t(i));
+    EXPECT_EQ(rows[i].metrics.size(), std::size_t(kMetrics)) << "a flight half written";
+  }
+}
+
+
+// ---- Every front end's flight, once ----------------------------------------------------------
+
+const std::string kSrc = MIXPILOT_SOURCE_DIR;
+const std::string kMixpilot = MIXPILOT_BINARY;
+
+// A user's folders in a fresh place; their default history file.
+fs::path fresh_home(const std::string& name) {
+  const fs::path home = test::fresh_path("history_home", name);
+  fs::create_directories(home);
+  return home;
+}
+fs::path default_history(const fs::path& home) {
+  return home / "data" / "mixpilot" / "history.sqlite";
+}
+std::int64_t rows_in(const fs::path& db) {
+  return fs::exists(db) ? sql_int(db, "SELECT count(*) FROM flights") : 0;
+}
+int count_of(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1))
+    ++n;
+  return n;
+}
+
+// `fly --headless`: one row with the flight's fields, its metrics the report's; score, replay,
+// fly of the recording and import add nothing (they are not new flights).
+TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
+  const fs::path home = fresh_home("fly");
+  const fs::path rec = home / "recs" / "a.mcap", report = home / "a.json";
+  fs::create_directories(rec.parent_path());
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot,
+                               "fly --scenario " + scen + " --pilot novice --headless --duration 3 "
+                               "--trainee \"Zoë O'Brien\" --record " + rec.string() +
+                                   " --report " + report.string(),
+                               home),
+            0)
+      << test::read_file(home / "out.txt");
+  const fs::path db = default_history(home);
+  ASSERT_EQ(rows_in(db), 1) << test::read_file(home / "out.txt");
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error);
+  ASSERT_TRUE(store) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  const StoredFlight& f = rows[0];
+  EXPECT_EQ(f.trainee, "Zoë O'Brien");
+  EXPECT_EQ(f.station, history::host_name());
+  EXPECT_EQ(f.scenario, "mi_helix");
+  EXPECT_EQ(f.scenario_hash, history::sha256_hex(test::read_file(scen)));
+  EXPECT_EQ(f.mode, "mixed_initiative");
+  EXPECT_EQ(f.pilot, "novice");
+  EXPECT_EQ(f.input_device, "");
+  EXPECT_NEAR(f.duration_s, 3.0, 1e-9);
+  EXPECT_EQ(f.ended, history::Ended::completed);
+  EXPECT_FALSE(f.probe);
+  EXPECT_EQ(f.recording_path, rec.string());
+  EXPECT_EQ(f.recording_hash, *history::sha256_file(rec.string(), error));
+  EXPECT_EQ(f.app_version, version());
+  EXPECT_EQ(f.front_end, "fly");
+  const auto now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          std::chrono::system_clock::now().time_since_epoch())
+                          .count();
+  EXPECT_GT(f.started_unix_ms, now_ms - 120'000);
+  EXPECT_LE(f.started_unix_ms, now_ms);
+  const auto reported = test::numbers(test::read_file(report));
+  ASSERT_FALSE(f.metrics.empty());
+  for (const auto& [name, value] : f.metrics) {
+    ASSERT_TRUE(reported.count(name)) << name;
+    EXPECT_NEAR(value, reported.at(name), 1e-12 * std::max(1.0, std::abs(value))) << name;
+  }
+  EXPECT_EQ(f.metrics.size(), reported.size());
+  // Not new flights: nothing added.
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "score " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "replay --headless " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "fly --headless --pilot " + rec.string(), home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + rec.parent_path().string(), home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("already in the history"), std::string::npos);
+  EXPECT_EQ(rows_in(db), 1);
+  // --history off: nothing; another file: there.
+  const fs::path other = home / "other.sqlite";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice --headless "
+                                          "--duration 1 --history off", home), 0);
+  EXPECT_EQ(rows_in(db), 1);
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice --headless "
+                                          "--duration 1 --history sqlite:" + other.string(), home), 0);
+  EXPECT_EQ(rows_in(db), 1);
+  EXPECT_EQ(rows_in(other), 1);
+  // What `history` shows of it, in each form.
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --json", home), 0);
+  const std::string json = test::read_file(home / "out.txt");
+  EXPECT_NE(json.find("\"trainee\": \"Zoë O'Brien\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"front_end\": \"fly\""), std::string::npos) << json;
+  EXPECT_EQ(test::numbers(json).at("skill"), reported.at("skill"));
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --csv", home), 0);
+  const std::string csv = test::read_file(home / "out.txt");
+  EXPECT_EQ(count_of(csv, "\n"), 2) << csv;
+  EXPECT_NE(csv.find(",metrics.skill"), std::string::npos) << csv;
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --trainee nobody", home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("0 flights"), std::string::npos);
+}
+
+// history import: recordings flown again and added once, a bad file named with its reason
+// while the others are imported; importing again adds nothing.
+TEST(HistoryFrontEnds, ImportAddsEachRecordingOnce) {
+  const fs::path home = fresh_home("import");
+  const fs::path dir = home / "recs";
+  fs::create_directories(dir / "sub");
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  for (const char* name : {"a.mcap", "sub/b.mcap"})
+    ASSERT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot experienced "
+                                            "--headless --duration 2 --history off --record " +
+                                                (dir / name).string(), home),
+              0);
+  std::ofstream(dir / "bad.mcap") << "not a recording";
+  const fs::path db = default_history(home);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history --json", home), 0);
+  EXPECT_EQ(test::read_file(home / "out.txt"), "[]\n");
+  EXPECT_FALSE(fs::exists(db)) << "a listing made a history";
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + dir.string() + " --jobs 2 "
+                                          "--trainee Imported", home), 1);
+  const std::string out = test::read_file(home / "out.txt");
+  EXPECT_NE(out.find("bad.mcap: not imported: "), std::string::npos) << out;
+  EXPECT_NE(out.find("not an MCAP file"), std::string::npos) << out;
+  EXPECT_NE(out.find("2 added"), std::string::npos) << out;
+  EXPECT_EQ(rows_in(db), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM flights WHERE front_end = 'import'"), 2);
+  EXPECT_EQ(sql_text(db, "SELECT name FROM trainees"), "Imported");
+  fs::remove(dir / "bad.mcap");
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + dir.string(), home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("0 added, 2 already known"), std::string::npos)
+      << test::read_file(home / "out.txt");
+  EXPECT_EQ(rows_in(db), 2);
+}
+
+// A history that cannot be used: fly says so once on stderr, and still flies, records and
+// exits 0.
+TEST(HistoryFrontEnds, ABrokenHistoryNeverCostsTheFlight) {
+  const std::string scen = kSrc + "/scenarios/mi_helix.toml";
+  struct Case {
+    const char* name;
+    std::function<void(const fs::path&)> make;  // breaks the history at this path
+    const char* said;
+  };
+  const Case cases[] = {
+      {"corrupt", [](const fs::path& p) { std::ofstream(p) << std::string(4096, 'x'); },
+       "not a database"},
+      {"newer",
+       [](const fs::path& p) {
+         { ASSERT_TRUE(open_store(p)); }
+         sql_int(p, "INSERT INTO schema_version VALUES (7, 0) RETURNING version");
+       },
+       "newer mixpilot"},
+      {"folder", [](const fs::path& p) { fs::create_directories(p); }, "is a folder"},
+  };
+  for (const Case& c : cases) {
+    const fs::path home = fresh_home(std::string("broken_") + c.name);
+    const fs::path db = home / "h.sqlite", rec = home / "r.mcap";
+    c.make(db);
+    EXPECT_EQ(test::run_mixpilot(kMixpilot, "fly --scenario " + scen + " --pilot novice "
+                                            "--headless --duration 1 --history " + db.string() +
+                                                " --record " + rec.string(), home),
+              0)
+        << c.name;
+    const std::string out = test::read_file(home / "out.txt");
+    EXPECT_EQ(count_of(out, "history: "), 1) << c.name << ": " << out;
+    EXPECT_NE(out.find(c.said), std::string::npos) << c.name << ": " << out;
+    EXPECT_NE(out.find("flown but not remembered"), std::string::npos) << out;
+    EXPECT_NE(out.find("recorded " + rec.string()), std::string::npos) << out;
+    EXPECT_TRUE(fs::exists(rec)) << c.name;
+  }
+}
+
+// The rig (every front end's flight) with the history locked past its busy timeout: the
+// flight flies and records, the close says why the row is missing; once the lock is gone the
+// next flight is remembered. And a replay's rig never writes a row.
+TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
+  const fs::path dir = test::fresh_path("history", "rig_locked");
+  fs::create_directories(dir);
+  const fs::path db = dir / "h.sqlite";
+  history::SqliteSettings s;
+  s.busy_timeout_ms = 200;
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error, s);
+  ASSERT_TRUE(store) << error;
+  const auto fly = [&](const fs::path& rec) {
+    cli::FlyOptions o;
+    o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+    o.pilot = "novice";
+    o.duration = 1.0;
+    int status = 0;
+    std::string why;
+    auto rig = cli::FlightRig::assemble(o, why, status);
+    EXPECT_TRUE(rig) << why;
+    EXPECT_TRUE(rig->record(rec.string(), "Lena", {}, true, why)) << why;
+    rig->remember(store.get(), "Lena", "fly");
+    rig->start();
+    while (rig->step()) {
+    }
+    return rig->close(false);
+  };
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &holder), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  const auto locked = fly(dir / "locked.mcap");
+  EXPECT_EQ(locked.recorded, (dir / "locked.mcap").string());
+  EXPECT_EQ(locked.error, "");
+  EXPECT_FALSE(locked.remembered);
+  EXPECT_NE(locked.history_error.find("locked"), std::string::npos) << locked.history_error;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  const auto free = fly(dir / "free.mcap");
+  EXPECT_TRUE(free.remembered) << free.history_error;
+  EXPECT_EQ(rows_in(db), 1);
+  // A replay of it: the rig is given the store, and adds nothing.
+  cli::FlyOptions o;
+  o.pilot = (dir / "free.mcap").string();
+  o.replay = true;
+  int status = 0;
+  auto rig = cli::FlightRig::assemble(o, error, status);
+  ASSERT_TRUE(rig) << error;
+  rig->remember(store.get(), "Lena", "fly");
+  rig->start();
+  while (rig->step()) {
+  }
+  const auto replayed = rig->close(false);
+  EXPECT_FALSE(replayed.remembered);
+  EXPECT_EQ(rows_in(db), 1);
+}
+
+// The window's live flight, driven through the app as the window does (no frames needed): the
+// trainee typed in the session panel, recorded, remembered once as "window"; a flight that was
+// made ready but never started is not.
+TEST(HistoryFrontEnds, TheWindowsLiveFlightIsRememberedOnce) {
+  const fs::path home = fresh_home("window");
+  setenv("XDG_CONFIG_HOME", (home / "config").c_str(), 1);
+  setenv("XDG_DATA_HOME", (home / "data").c_str(), 1);
+  cli::FlyOptions o;
+  o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+  o.pilot = "novice";
+  o.duration = 1.5;
+  o.record = (home / "w.mcap").string();
+  {
+    cli::Trainer app(o);
+    std::string error;
+    int status = 0;
+    ASSERT_TRUE(app.open_live(error, status)) << error;
+    app.act(ui::LiveRequest{ui::SetTrainee{"Marie-Hélène"}});
+    app.start();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (app.live()->rig->running() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(app.finish(), 0);
+    testing::internal::GetCapturedStdout();
+  }
+  {
+    cli::Trainer app(o);  // opened, never started
+    std::string error;
+    int status = 0;
+    ASSERT_TRUE(app.open_live(error, status)) << error;
+    testing::internal::CaptureStdout();
+    (void)app.finish();
+    testing::internal::GetCapturedStdout();
+  }
+  const fs::path db = default_history(home);
+  ASSERT_EQ(rows_in(db), 1);
+  std::string error;
+  auto store = history::open_sqlite(db.string(), error);
+  ASSERT_TRUE(store) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].trainee, "Marie-Hélène");
+  EXPECT_EQ(rows[0].front_end, "window");
+  EXPECT_EQ(rows[0].pilot, "novice");
+  EXPECT_NEAR(rows[0].duration_s, 1.5, 0.02);
+  EXPECT_EQ(rows[0].recording_path, o.record);
+  EXPECT_EQ(rows[0].recording_hash, *history::sha256_file(o.record, error));
+}
+
+}  // namespace
+}  // namespace mixpilot
