@@ -26,6 +26,7 @@
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
 #include "postgres_server.hpp"
+#include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot::test {
@@ -623,6 +624,60 @@ TEST(Postgres, PushTwiceAddsNothingTheSecondTime) {
   ASSERT_TRUE(history::push_history(*station2, *centre, counts, error)) << error;
   EXPECT_EQ(counts.added, 0u);
   EXPECT_EQ(sql(*server, "centre", "SELECT count(*) FROM flights"), "8");
+}
+
+// `mixpilot history push` as a user runs it: twice, the second adds nothing; the password
+// appears in no output, not even in a usage error that quotes the URL.
+TEST(Postgres, PushCommandTwiceAddsNothingTheSecondTime) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "centre_cli");
+  std::string error;
+  const fs::path home = fresh_path("postgres", "cli_home");
+  fs::create_directories(home);
+  const fs::path file = home / "station.sqlite";
+  {
+    auto station = history::open_sqlite(file.string(), error);
+    ASSERT_TRUE(station) << error;
+    for (int i = 0; i < 3; ++i) {
+      FlightRecord f = sample_flight("Ada", 1'700'000'000'000 + i);
+      if (i == 0) f.recording_hash = history::sha256_hex("cli recording");
+      ASSERT_EQ(station->add(f, error), HistoryStore::Added::added) << error;
+    }
+  }
+  const std::string push = "history push '" + url + "' --history '" + file.string() + "'";
+  ASSERT_EQ(run_mixpilot(MIXPILOT_BINARY, push, home), 0) << read_file(home / "out.txt");
+  std::string out = read_file(home / "out.txt");
+  EXPECT_NE(out.find("3 added, 0 already there"), std::string::npos) << out;
+  EXPECT_EQ(out.find(server->password()), std::string::npos) << out;
+  ASSERT_EQ(run_mixpilot(MIXPILOT_BINARY, push, home), 0) << read_file(home / "out.txt");
+  out = read_file(home / "out.txt");
+  EXPECT_NE(out.find("0 added, 3 already there"), std::string::npos) << out;
+  EXPECT_EQ(sql(*server, "centre_cli", "SELECT count(*) FROM flights"), "3");
+
+  // A wrong password, a URL given twice, no history: said, exit status 1 or 2, no password.
+  const std::string wrong = server->url_with_password("centre_cli", "Not-The-Pw-42");
+  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY,
+                         "history push '" + wrong + "' --history '" + file.string() + "'", home),
+            1);
+  out = read_file(home / "out.txt");
+  EXPECT_NE(out.find("password authentication failed"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Not-The-Pw-42"), std::string::npos) << out;
+  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY, "history push '" + url + "' '" + wrong + "'", home), 2);
+  out = read_file(home / "out.txt");
+  EXPECT_NE(out.find("unexpected"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Not-The-Pw-42"), std::string::npos) << out;
+  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY, "history push 'https://user:Not-The-Pw-42@x/'", home), 2);
+  out = read_file(home / "out.txt");
+  EXPECT_EQ(out.find("Not-The-Pw-42"), std::string::npos) << out;
+  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY,
+                         "history push '" + url + "' --history '" + (home / "none.sqlite").string() +
+                             "'",
+                         home),
+            1);
+  EXPECT_NE(read_file(home / "out.txt").find("nothing to push"), std::string::npos);
+  EXPECT_FALSE(fs::exists(home / "none.sqlite"));
+  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY, "history push --help", home), 0);
+  EXPECT_NE(read_file(home / "out.txt").find("trainee, station"), std::string::npos);
 }
 
 // A push that cannot write says which flight stopped it and why, without the password.
