@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/history/content_hash.hpp"
@@ -393,6 +395,33 @@ TEST(Postgres, EightProcessesWriteAtOnce) {
   std::string error;
   ASSERT_TRUE(store->trainees(names, error)) << error;
   EXPECT_EQ(names, (std::vector<std::string>{"Ada", "Ben"}));
+}
+
+// One store shared by threads (a flight closing while a panel reads): every call is served,
+// none is lost.
+TEST(Postgres, ThreadsShareOneStore) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  auto store = open_store(fresh_database(*server, "threads"));
+  ASSERT_TRUE(store);
+  constexpr int kThreads = 4, kEach = 25;
+  std::atomic<int> failures{0};
+  std::vector<std::thread> pool;
+  for (int t = 0; t < kThreads; ++t)
+    pool.emplace_back([&, t] {
+      for (int i = 0; i < kEach; ++i) {
+        std::string error;
+        FlightRecord f = sample_flight("thread " + std::to_string(t), i);
+        f.recording_hash = history::sha256_hex(std::to_string(t) + ":" + std::to_string(i));
+        if (store->add(f, error) != HistoryStore::Added::added) ++failures;
+        std::vector<StoredFlight> rows;
+        if (!store->query({}, rows, error)) ++failures;
+        std::vector<std::string> names;
+        if (!store->trainees(names, error)) ++failures;
+      }
+    });
+  for (auto& t : pool) t.join();
+  EXPECT_EQ(failures.load(), 0);
+  EXPECT_EQ(all(*store).size(), std::size_t(kThreads * kEach));
 }
 
 // A newer mixpilot's database is refused with the reason, naming the server without its

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <unordered_map>
 
 #include "core/history/schema.hpp"
@@ -268,6 +269,9 @@ class PostgresHistory final : public HistoryStore {
   std::vector<std::string> secrets_;
   PGconn* conn_;
   std::string last_sqlstate_;  // of the last statement that failed on the server ("" otherwise)
+  // A connection serves one statement at a time: a flight closing on one thread and a panel
+  // reading on another take turns.
+  std::mutex mutex_;
 };
 
 std::optional<Result> PostgresHistory::run(const std::string& sql, const Params& p,
@@ -355,6 +359,7 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
     error = where_ + ": the flight is not stored: its duration is not a finite number";
     return std::nullopt;
   }
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (!begin("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
   const auto failed = [&] {
     rollback();
@@ -441,6 +446,7 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
 
 bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
   out.clear();
+  const std::lock_guard<std::mutex> lock(mutex_);
   // The newest `limit` flights that pass the filters, read oldest first, and their metrics:
   // one snapshot for both statements.
   if (!begin("BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY", "cannot read the history", error))
@@ -511,6 +517,7 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
 
 bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error) {
   out.clear();
+  const std::lock_guard<std::mutex> lock(mutex_);
   // Byte order, as SQLite's: the same list on either backend, whatever the server's collation.
   const auto r = first("SELECT name FROM trainees ORDER BY name COLLATE \"C\"", Params{},
                      PGRES_TUPLES_OK, "cannot read the trainees", error);
@@ -520,6 +527,7 @@ bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error
 }
 
 bool PostgresHistory::knows_recording(const std::string& hash, bool& known, std::string& error) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   const auto r = first("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(hash),
                      PGRES_TUPLES_OK, "cannot look the recording up", error);
   if (!r) return false;
