@@ -317,7 +317,8 @@ std::optional<Result> PostgresHistory::first(const std::string& sql, const Param
   const std::string broken = error;
   PQreset(conn_);
   if (PQstatus(conn_) != CONNECTION_OK) {
-    error = broken + "; connecting again: " + connection_failure("cannot connect");
+    error = broken + "; connecting again: " +
+            connection_failure("cannot connect to the PostgreSQL server");
     return std::nullopt;
   }
   return run(sql, p, expected, what, error);
@@ -612,7 +613,7 @@ std::unique_ptr<HistoryStore> open_postgres(const std::string& url, std::string&
   }
   auto store = std::make_unique<PostgresHistory>(where, secrets, conn);  // closes conn on every way out
   if (PQstatus(conn) != CONNECTION_OK) {
-    error = store->connection_failure("cannot connect");
+    error = store->connection_failure("cannot connect to the PostgreSQL server");
     return nullptr;
   }
   PQsetNoticeReceiver(conn, quiet, nullptr);
