@@ -40,8 +40,7 @@ struct Account {
 };
 
 std::string random_password() {
-  static const char alphabet[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+  static const char alphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
   std::random_device rd;
   std::string out;
   for (int i = 0; i < 32; ++i) out += alphabet[rd() % (sizeof alphabet - 1)];
@@ -98,9 +97,7 @@ pid_t spawn(const std::vector<std::string>& argv, const std::vector<std::string>
   }
   const int null_in = ::open("/dev/null", O_RDONLY);
   if (null_in >= 0) ::dup2(null_in, STDIN_FILENO);
-  auto say = [](const char* what) {
-    (void)!::write(STDERR_FILENO, what, std::strlen(what));
-  };
+  auto say = [](const char* what) { (void)!::write(STDERR_FILENO, what, std::strlen(what)); };
   if (account) {
     if (::setgroups(0, nullptr) != 0 || ::setgid(account->gid) != 0 ||
         ::setuid(account->uid) != 0 || ::getuid() != account->uid) {
@@ -136,8 +133,8 @@ std::optional<int> wait_for(pid_t pid, std::chrono::milliseconds timeout) {
 }
 
 std::string conninfo_of(const fs::path& folder, const std::string& db, const std::string& pw) {
-  return "host='" + folder.string() + "' port=" + kPort + " user=" + kSuperuser + " dbname='" +
-         db + "' password='" + pw + "' connect_timeout=5";
+  return "host='" + folder.string() + "' port=" + kPort + " user=" + kSuperuser + " dbname='" + db +
+         "' password='" + pw + "' connect_timeout=5";
 }
 
 // A run killed by SIGKILL stops its server (the death signal) but cannot remove its folder:
@@ -161,7 +158,8 @@ void remove_stale_folders(const fs::path& base) {
 std::unique_ptr<PostgresServer> PostgresServer::start(Start& status, std::string& reason) {
   status = Start::failed;
   const char* bin_env = std::getenv("MIXPILOT_TEST_PG_BIN");
-  const fs::path bin = bin_env && *bin_env ? fs::path(bin_env) : fs::path("/usr/lib/postgresql/15/bin");
+  const fs::path bin =
+      bin_env && *bin_env ? fs::path(bin_env) : fs::path("/usr/lib/postgresql/15/bin");
   for (const char* tool : {"initdb", "postgres"}) {
     if (::access((bin / tool).c_str(), X_OK) != 0) {
       status = Start::unavailable;
@@ -216,8 +214,8 @@ std::unique_ptr<PostgresServer> PostgresServer::start(Start& status, std::string
   }
   ::chmod(pwfile.c_str(), 0600);
 
-  const std::vector<std::string> env = {"LC_ALL=C", "LANG=C", "TZ=UTC",
-                                        "PATH=/usr/bin:/bin", "HOME=" + dir.string()};
+  const std::vector<std::string> env = {"LC_ALL=C", "LANG=C", "TZ=UTC", "PATH=/usr/bin:/bin",
+                                        "HOME=" + dir.string()};
   const pid_t initdb = spawn({(bin / "initdb").string(), "-D", (dir / "data").string(), "-U",
                               kSuperuser, "--auth=scram-sha-256", "--pwfile=" + pwfile.string(),
                               "--no-sync", "--encoding=UTF8", "--locale=C", "--no-instructions"},
@@ -256,12 +254,11 @@ bool PostgresServer::launch(std::string& reason) {
   std::optional<Account> account;
   if (account_) account = Account{account_->first, account_->second};
   // Only the Unix socket in the folder; durability is not what these tests measure.
-  postmaster_ =
-      spawn({(bin_ / "postgres").string(), "-D", (dir / "data").string(), "-k", dir.string(), "-p",
-             kPort, "-c", "listen_addresses=", "-c", "fsync=off",
-             "-c", "full_page_writes=off", "-c", "max_connections=60", "-c",
-             "shared_buffers=16MB", "-c", "logging_collector=off"},
-            env, log, account, SIGQUIT);
+  postmaster_ = spawn(
+      {(bin_ / "postgres").string(), "-D", (dir / "data").string(), "-k", dir.string(), "-p", kPort,
+       "-c", "listen_addresses=", "-c", "fsync=off", "-c", "full_page_writes=off", "-c",
+       "max_connections=60", "-c", "shared_buffers=16MB", "-c", "logging_collector=off"},
+      env, log, account, SIGQUIT);
   if (postmaster_ < 0) {
     reason = std::string("fork: ") + std::strerror(errno);
     return false;
@@ -323,7 +320,8 @@ std::string PostgresServer::url(const std::string& db) const {
 
 bool PostgresServer::exec(const std::string& db, const std::string& sql, std::string& error) const {
   PGconn* c = PQconnectdb(conninfo_of(folder_, db, password_).c_str());
-  PQsetNoticeReceiver(c, [](void*, const PGresult*) {}, nullptr);
+  PQsetNoticeReceiver(
+      c, [](void*, const PGresult*) {}, nullptr);
   bool ok = false;
   if (PQstatus(c) != CONNECTION_OK) {
     error = PQerrorMessage(c);

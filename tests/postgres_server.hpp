@@ -84,11 +84,11 @@ class PostgresEnvironment : public ::testing::Environment {
 
 // In a test: the run's server, skipping the test where none can start here and failing it
 // where one should have started and did not.
-#define MIXPILOT_REQUIRE_POSTGRES(server_var)                                                  \
+#define MIXPILOT_REQUIRE_POSTGRES(server_var)                                                     \
   ::mixpilot::test::PostgresServer* server_var = ::mixpilot::test::PostgresEnvironment::server(); \
-  if (server_var == nullptr) {                                                                 \
-    if (::mixpilot::test::PostgresEnvironment::unavailable())                                  \
-      GTEST_SKIP() << ::mixpilot::test::PostgresEnvironment::reason();                         \
-    FAIL() << "the test PostgreSQL server did not start: "                                    \
-           << ::mixpilot::test::PostgresEnvironment::reason();                                 \
+  if (server_var == nullptr) {                                                                    \
+    if (::mixpilot::test::PostgresEnvironment::unavailable())                                     \
+      GTEST_SKIP() << ::mixpilot::test::PostgresEnvironment::reason();                            \
+    FAIL() << "the test PostgreSQL server did not start: "                                        \
+           << ::mixpilot::test::PostgresEnvironment::reason();                                    \
   }

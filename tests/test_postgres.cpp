@@ -9,13 +9,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <algorithm>
 #include <set>
 #include <string>
 #include <thread>
@@ -102,8 +102,7 @@ FlightRecord sample_flight(const std::string& trainee = "Ada",
   f.ended = history::Ended::completed;
   f.app_version = "mixpilot 0.1.0";
   f.front_end = "fly";
-  f.metrics = {{"skill", 71.5}, {"mean_lambda", 0.8}, {"min_clearance_m", INFINITY},
-               {"lost", 0.0}};
+  f.metrics = {{"skill", 71.5}, {"mean_lambda", 0.8}, {"min_clearance_m", INFINITY}, {"lost", 0.0}};
   return f;
 }
 
@@ -192,8 +191,9 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
   EXPECT_EQ(sql(*server, "roundtrip", "SELECT count(*) FROM metrics"), "7");
   EXPECT_EQ(sql(*server, "roundtrip", "SELECT count(*) FROM metrics WHERE value IS NULL"), "2");
   ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
-  EXPECT_EQ(sql(*server, "roundtrip", "SELECT count(*) FROM flights WHERE recording_hash IS NULL "
-                                      "AND recording_path IS NULL"),
+  EXPECT_EQ(sql(*server, "roundtrip",
+                "SELECT count(*) FROM flights WHERE recording_hash IS NULL "
+                "AND recording_path IS NULL"),
             "1");
   // Opened again: the schema is current, nothing is migrated twice.
   store.reset();
@@ -293,10 +293,15 @@ TEST(Postgres, HostileTraineeNames) {
   auto store = open_store(fresh_database(*server, "names"));
   ASSERT_TRUE(store);
   std::string error;
-  const std::vector<std::string> stored = {
-      "O'Brien", "\"quoted\"", "Robert'); DROP TABLE flights; --", "'; DROP TABLE trainees",
-      "$1 $$ \\x00 E'\\\\'", "Zoë Ångström 飛行", "zed", "Zed",
-      std::string(history::kMaxNameChars, 'x')};
+  const std::vector<std::string> stored = {"O'Brien",
+                                           "\"quoted\"",
+                                           "Robert'); DROP TABLE flights; --",
+                                           "'; DROP TABLE trainees",
+                                           "$1 $$ \\x00 E'\\\\'",
+                                           "Zoë Ångström 飛行",
+                                           "zed",
+                                           "Zed",
+                                           std::string(history::kMaxNameChars, 'x')};
   for (const std::string& name : stored)
     EXPECT_EQ(store->add(sample_flight(name), error), HistoryStore::Added::added)
         << name << ": " << error;
@@ -306,7 +311,9 @@ TEST(Postgres, HostileTraineeNames) {
   } refused[] = {
       {std::string(10'000, 'a'), "10000 characters long"},
       {std::string(history::kMaxNameChars + 1, 'x'), "201 characters long"},
-      {"bad\xff" "byte", "not valid UTF-8"},
+      {"bad\xff"
+       "byte",
+       "not valid UTF-8"},
       {"over\xc0\xaflong", "not valid UTF-8"},
       {"cut\xe2\x82", "not valid UTF-8"},
       {"surrogate\xed\xa0\x80", "not valid UTF-8"},
@@ -488,7 +495,8 @@ TEST(Postgres, CredentialsNeverInMessages) {
   EXPECT_FALSE(error.empty());
   EXPECT_EQ(error.find(wrong), std::string::npos) << error;
   error.clear();
-  EXPECT_FALSE(history::open_history("postgresql:///secrets?password=" + wrong + "&bogus=1", error));
+  EXPECT_FALSE(
+      history::open_history("postgresql:///secrets?password=" + wrong + "&bogus=1", error));
   EXPECT_FALSE(error.empty());
   EXPECT_EQ(error.find(wrong), std::string::npos) << error;
   // No server at the socket: said as such, the password nowhere.
@@ -517,8 +525,7 @@ TEST(Postgres, ASilentServerTimesOut) {
   const auto t0 = std::chrono::steady_clock::now();
   std::string error;
   EXPECT_FALSE(history::open_history(url, error));
-  const double s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ::close(fd);
   EXPECT_GE(s, 3.0) << error;
   EXPECT_LT(s, 12.0) << error;
@@ -698,11 +705,11 @@ TEST(Postgres, PushCommandTwiceAddsNothingTheSecondTime) {
   EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY, "history push 'https://user:Not-The-Pw-42@x/'", home), 2);
   out = read_file(home / "out.txt");
   EXPECT_EQ(out.find("Not-The-Pw-42"), std::string::npos) << out;
-  EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY,
-                         "history push '" + url + "' --history '" + (home / "none.sqlite").string() +
-                             "'",
-                         home),
-            1);
+  EXPECT_EQ(
+      run_mixpilot(MIXPILOT_BINARY,
+                   "history push '" + url + "' --history '" + (home / "none.sqlite").string() + "'",
+                   home),
+      1);
   EXPECT_NE(read_file(home / "out.txt").find("nothing to push"), std::string::npos);
   EXPECT_FALSE(fs::exists(home / "none.sqlite"));
   EXPECT_EQ(run_mixpilot(MIXPILOT_BINARY, "history push --help", home), 0);

@@ -74,8 +74,8 @@ std::vector<std::string> secrets_of(const std::string& url) {
         std::size_t amp = url.find('&', i);
         if (amp == std::string::npos) amp = url.size();
         const std::string param = url.substr(i, amp - i);
-        if (const std::size_t eq = param.find('='); eq != std::string::npos &&
-                                                    names_password(param.substr(0, eq)))
+        if (const std::size_t eq = param.find('=');
+            eq != std::string::npos && names_password(param.substr(0, eq)))
           keep(param.substr(eq + 1));
         i = amp + 1;
       }
@@ -278,8 +278,7 @@ std::optional<Result> PostgresHistory::run(const std::string& sql, const Params&
                                            ExecStatusType expected, const char* what,
                                            std::string& error) {
   const auto values = p.pointers();
-  Result r(PQexecParams(conn_, sql.c_str(), p.size(), nullptr, values.data(), nullptr, nullptr,
-                        0));
+  Result r(PQexecParams(conn_, sql.c_str(), p.size(), nullptr, values.data(), nullptr, nullptr, 0));
   last_sqlstate_.clear();
   if (r.get() != nullptr && PQresultStatus(r.get()) == expected) return r;
   if (r.get() != nullptr)
@@ -317,8 +316,8 @@ std::optional<Result> PostgresHistory::first(const std::string& sql, const Param
   const std::string broken = error;
   PQreset(conn_);
   if (PQstatus(conn_) != CONNECTION_OK) {
-    error = broken + "; connecting again: " +
-            connection_failure("cannot connect to the PostgreSQL server");
+    error = broken +
+            "; connecting again: " + connection_failure("cannot connect to the PostgreSQL server");
     return std::nullopt;
   }
   return run(sql, p, expected, what, error);
@@ -329,8 +328,8 @@ bool PostgresHistory::init(std::string& error) {
   if (!run(kMigrationLock, Params{}, PGRES_TUPLES_OK, "cannot lock the schema", error))
     return rollback(), false;
   if (!command(kCreateVersionTable, "cannot create the schema", error)) return rollback(), false;
-  const auto v = run(kReadVersion, Params{}, PGRES_TUPLES_OK, "cannot read the schema version",
-                     error);
+  const auto v =
+      run(kReadVersion, Params{}, PGRES_TUPLES_OK, "cannot read the schema version", error);
   if (!v || v->rows() != 1) {
     if (v) error = where_ + ": cannot read the schema version: no answer";
     return rollback(), false;
@@ -350,8 +349,7 @@ bool PostgresHistory::init(std::string& error) {
   return true;
 }
 
-std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
-                                                        std::string& error) {
+std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, std::string& error) {
   if (std::string why = check_record(f); !why.empty()) {
     error = where_ + ": the flight is not stored: " + why;
     return std::nullopt;
@@ -367,9 +365,9 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
     return std::nullopt;
   };
   if (!f.recording_hash.empty()) {
-    const auto known = run("SELECT 1 FROM flights WHERE recording_hash = $1",
-                           Params{}.text(f.recording_hash), PGRES_TUPLES_OK,
-                           "cannot look the recording up", error);
+    const auto known =
+        run("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(f.recording_hash),
+            PGRES_TUPLES_OK, "cannot look the recording up", error);
     if (!known) return failed();
     if (known->rows() > 0) {
       rollback();  // nothing was written
@@ -438,8 +436,7 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f,
       else
         mp.null();
     }
-    if (!run(sql, mp, PGRES_COMMAND_OK, "cannot add the flight's metrics", error))
-      return failed();
+    if (!run(sql, mp, PGRES_COMMAND_OK, "cannot add the flight's metrics", error)) return failed();
   }
   if (!command("COMMIT", "cannot commit the flight", error)) return failed();
   return Added::added;
@@ -521,7 +518,7 @@ bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error
   const std::lock_guard<std::mutex> lock(mutex_);
   // Byte order, as SQLite's: the same list on either backend, whatever the server's collation.
   const auto r = first("SELECT name FROM trainees ORDER BY name COLLATE \"C\"", Params{},
-                     PGRES_TUPLES_OK, "cannot read the trainees", error);
+                       PGRES_TUPLES_OK, "cannot read the trainees", error);
   if (!r) return false;
   for (int i = 0; i < r->rows(); ++i) out.push_back(r->text(i, 0));
   return true;
@@ -530,7 +527,7 @@ bool PostgresHistory::trainees(std::vector<std::string>& out, std::string& error
 bool PostgresHistory::knows_recording(const std::string& hash, bool& known, std::string& error) {
   const std::lock_guard<std::mutex> lock(mutex_);
   const auto r = first("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(hash),
-                     PGRES_TUPLES_OK, "cannot look the recording up", error);
+                       PGRES_TUPLES_OK, "cannot look the recording up", error);
   if (!r) return false;
   known = r->rows() > 0;
   return true;
@@ -550,8 +547,7 @@ std::string redact_postgres_url(const std::string& url) {
     if (opts == nullptr) return "(a PostgreSQL connection string that cannot be read)";
     std::string out;
     for (PQconninfoOption* o = opts; o->keyword != nullptr; ++o)
-      if (o->val != nullptr && !names_password(o->keyword))
-      {
+      if (o->val != nullptr && !names_password(o->keyword)) {
         if (!out.empty()) out += ' ';
         out.append(o->keyword).append("='").append(o->val).append("'");
       }
@@ -573,8 +569,7 @@ std::string redact_postgres_url(const std::string& url) {
       if (amp == std::string::npos) amp = rest.size();
       const std::string param = rest.substr(i, amp - i);
       const std::size_t eq = param.find('=');
-      if (!param.empty() && !names_password(param.substr(0, eq)))
-      {
+      if (!param.empty() && !names_password(param.substr(0, eq))) {
         if (!kept.empty()) kept += '&';
         kept += param;
       }
@@ -603,15 +598,16 @@ std::unique_ptr<HistoryStore> open_postgres(const std::string& url, std::string&
   // Keywords are read in order and a later one wins: the URL's own connect_timeout and
   // application name override these.
   // (client_encoding comes last: names are UTF-8 whatever the URL says.)
-  const char* keys[] = {"connect_timeout", "fallback_application_name", "dbname",
-                        "client_encoding", nullptr};
+  const char* keys[] = {"connect_timeout", "fallback_application_name", "dbname", "client_encoding",
+                        nullptr};
   const char* values[] = {"5", "mixpilot", url.c_str(), "UTF8", nullptr};
   PGconn* conn = PQconnectdbParams(keys, values, 1);
   if (conn == nullptr) {
     error = where + ": cannot connect: out of memory";
     return nullptr;
   }
-  auto store = std::make_unique<PostgresHistory>(where, secrets, conn);  // closes conn on every way out
+  auto store =
+      std::make_unique<PostgresHistory>(where, secrets, conn);  // closes conn on every way out
   if (PQstatus(conn) != CONNECTION_OK) {
     error = store->connection_failure("cannot connect to the PostgreSQL server");
     return nullptr;

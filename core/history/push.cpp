@@ -40,8 +40,8 @@ bool push_history(HistoryStore& from, HistoryStore& to, PushCounts& counts, std:
       std::string why;
       const auto added = to.add(f, why);
       if (!added) {
-        error = "flight " + std::to_string(i + 1) + " of " + std::to_string(flights.size()) +
-                " (" + from.where() + " #" + std::to_string(f.id) + "): " + why;
+        error = "flight " + std::to_string(i + 1) + " of " + std::to_string(flights.size()) + " (" +
+                from.where() + " #" + std::to_string(f.id) + "): " + why;
         return false;
       }
       if (*added == HistoryStore::Added::added) {
