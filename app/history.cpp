@@ -1,5 +1,5 @@
 // mixpilot history: the trainee's flights (SPEC §10) as a table, CSV or JSON; `history import`
-// adds recordings that are not in it yet.
+// adds recordings that are not in it yet; `history push` copies them into a centre's database.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -22,6 +22,8 @@
 #include "core/base/input_file.hpp"
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
+#include "core/history/postgres_history.hpp"
+#include "core/history/push.hpp"
 #include "core/recording/replay.hpp"
 
 namespace mixpilot::cli {
@@ -34,6 +36,7 @@ constexpr const char* kHistoryUsage =
     "usage: mixpilot history [--trainee NAME] [--scenario NAME] [--since DATE] [--limit N]\n"
     "                        [--csv | --json] [--history LOCATION]\n"
     "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--history LOCATION]\n"
+    "       mixpilot history push postgresql://[USER@]HOST[:PORT]/DATABASE [--history LOCATION]\n"
     "\n"
     "The flights mixpilot remembers (SPEC §10): every flight of the window and of `fly`, one\n"
     "row each (a replay or `score` adds none). Oldest first, so the newest is next to the\n"
@@ -58,8 +61,16 @@ constexpr const char* kHistoryUsage =
     "with the reason, and the others are still imported.\n"
     "  --jobs N           replay N recordings in parallel (default: the number of cores)\n"
     "\n"
+    "history push URL: copies this station's flights (--history, default the SQLite file above)\n"
+    "into a training centre's PostgreSQL database, every flight once: a recorded flight is\n"
+    "matched by its recording's SHA-256, a flight without a recording by its trainee, station\n"
+    "and start time (to the millisecond). Pushing again adds only the flights flown since.\n"
+    "The URL is libpq's (options such as ?sslmode=require after it); keep the password out of\n"
+    "it, where other users' `ps` would see it: PGPASSWORD or ~/.pgpass. No message repeats a\n"
+    "password. The connection gives up after 5 s unless the URL sets connect_timeout.\n"
+    "\n"
     "exit status: 0 done, 1 the history cannot be read or written, or (import) a recording\n"
-    "could not be imported, 2 usage\n";
+    "could not be imported, or (push) a flight could not be copied, 2 usage\n";
 
 // --since's text as unix milliseconds (local time); nullopt when it is not one of the forms.
 std::optional<std::int64_t> parse_since(const std::string& text) {
@@ -406,6 +417,71 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
   return failed > 0 ? kExitError : kExitOk;
 }
 
+// ---- push -------------------------------------------------------------------------------------
+
+// mixpilot history push URL [--history SOURCE]. The URL may hold a password: no message
+// repeats the argument as given, only its redacted form.
+int push_command(int argc, char** argv) {
+  const char* cmd = "history push";
+  std::string source, destination;
+  for (int i = 3; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kHistoryUsage, stdout);
+      return kExitOk;
+    } else if (a == "--history") {
+      source = option_value(cmd, argc, argv, i);
+      if (source == "off") usage_error(cmd, "--history off: there is no history to push");
+    } else if (destination.empty() &&
+               (a.starts_with("postgresql://") || a.starts_with("postgres://"))) {
+      destination = a;
+    } else if (!a.empty() && a[0] != '-' && destination.empty()) {
+      usage_error(cmd, "the centre's database is a postgresql://... URL, not '" +
+                           escape_controls(history::redact_postgres_url(std::string(a))) + "'");
+    } else {
+      usage_error(cmd, "unexpected '" +
+                           escape_controls(history::redact_postgres_url(std::string(a))) + "'");
+    }
+  }
+  if (destination.empty())
+    usage_error(cmd, "which database? (mixpilot history push postgresql://HOST/DATABASE)");
+  std::string error;
+  // The station's history is read, never made: no SQLite file is nothing to push.
+  if (!source.starts_with("postgres")) {
+    const std::string file = source.empty()                   ? history::default_history_path()
+                             : source.starts_with("sqlite:") ? source.substr(7)
+                                                              : source;
+    std::error_code ec;
+    if (!file.empty() && !fs::exists(file, ec) && !ec) {
+      std::fprintf(stderr, "mixpilot history push: %s: no history here yet: nothing to push\n",
+                   escape_controls(file).c_str());
+      return kExitError;
+    }
+  }
+  const auto from = history::open_history(source, error);
+  if (!from) {
+    std::fprintf(stderr, "mixpilot history push: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
+  const auto to = history::open_history(destination, error);
+  if (!to) {
+    std::fprintf(stderr, "mixpilot history push: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
+  history::PushCounts counts;
+  const bool ok = history::push_history(*from, *to, counts, error, [](std::size_t done,
+                                                                      std::size_t total) {
+    if (done % 1000 == 0 && done < total)
+      std::fprintf(stderr, "mixpilot history push: %zu of %zu flights\n", done, total);
+  });
+  if (!ok)
+    std::fprintf(stderr, "mixpilot history push: %s\n", escape_controls(error).c_str());
+  std::printf("mixpilot history push: %zu added, %zu already there (%s -> %s)\n", counts.added,
+              counts.already_there, escape_controls(from->where()).c_str(),
+              escape_controls(to->where()).c_str());
+  return ok ? kExitOk : kExitError;
+}
+
 }  // namespace
 
 int history_command(int argc, char** argv) {
@@ -419,9 +495,7 @@ int history_command(int argc, char** argv) {
     importing = true;
     first = 3;
   } else if (argc > 2 && std::string_view(argv[2]) == "push") {
-    std::fprintf(stderr, "mixpilot history push: copying a history into PostgreSQL is not built "
-                         "into this mixpilot yet\n");
-    return kExitError;
+    return push_command(argc, argv);
   }
   for (int i = first; i < argc; ++i) {
     const std::string_view a = argv[i];

@@ -12,8 +12,8 @@ packages=(
   # scenario files
   libtomlplusplus-dev
   # the trainee's history: SQLite (sqlite3: its shell, to look into a history), SHA-256 of
-  # recordings and scenarios (libcrypto)
-  libsqlite3-dev sqlite3 libssl-dev
+  # recordings and scenarios (libcrypto), PostgreSQL for a training centre (libpq)
+  libsqlite3-dev sqlite3 libssl-dev libpq-dev
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
   libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
   libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev xvfb xauth
@@ -21,8 +21,8 @@ packages=(
   libsdl2-dev
   # network peers (C API + idlc)
   cyclonedds-dev cyclonedds-tools
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # tests and benchmarks; the PostgreSQL server the history tests start themselves
+  libgtest-dev libgmock-dev libbenchmark-dev valgrind postgresql
   # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
   clang libclang-rt-dev
   # tooling: independent MCAP reader in the recording tests
