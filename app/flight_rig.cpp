@@ -182,6 +182,7 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
   const bool remote = flight_.recording ? meta("vehicle") == "dds" : flight_.vehicle != nullptr;
   r.front_end = remote ? "vehicle" : front_end_;
   r.app_version = version();
+  r.probe = mode.identity().probe;  // an unassisted probe (SPEC §10)
   if (completed_recording_) {
     std::error_code ec;
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);

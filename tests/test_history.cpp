@@ -588,6 +588,30 @@ int count_of(const std::string& text, const std::string& needle) {
   return n;
 }
 
+// A probe flight (`--assist off`) is a probe in the history too, with its dependence D = 0.
+TEST(HistoryFrontEnds, AProbeFlightIsRememberedAsAProbe) {
+  const fs::path home = fresh_home("probe");
+  ASSERT_EQ(test::run_mixpilot(kMixpilot,
+                               "fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot novice "
+                               "--headless --duration 2 --assist off --trainee probe",
+                               home),
+            0)
+      << test::read_file(home / "out.txt");
+  std::string error;
+  auto store = history::open_sqlite(default_history(home).string(), error);
+  ASSERT_TRUE(store) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(rows[0].probe);
+  bool has_d = false;
+  for (const auto& [name, value] : rows[0].metrics) {
+    if (name != "assistance_dependence") continue;
+    has_d = true;
+    EXPECT_EQ(value, 0.0);
+  }
+  EXPECT_TRUE(has_d);
+}
+
 // `fly --headless`: one row with the flight's fields, its metrics the report's; score, replay,
 // fly of the recording and import add nothing (they are not new flights).
 TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
