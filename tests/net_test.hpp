@@ -51,7 +51,8 @@ inline int run(const std::string& args, const std::filesystem::path& dir,
 inline void start(const std::string& args, const std::filesystem::path& dir,
                   const std::string& out, const std::string& prefix = "") {
   const std::string cmd = "( " + prefix + " env XDG_CONFIG_HOME='" + (dir / "config").string() +
-                          "' '" + kMixpilot + "' " + args + " >'" + (dir / out).string() +
+                          "' XDG_DATA_HOME='" + (dir / "data").string() + "' '" + kMixpilot +
+                          "' " + args + " >'" + (dir / out).string() +
                           "' 2>&1; echo $? >'" + (dir / out).string() + ".rc' ) &";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
 }

@@ -632,8 +632,9 @@ TEST_F(Net, VehicleAndControllerInTwoNetworkNamespacesJoinedByAVethPair) {
   const std::string in_b = config(b + ".xml", vb, net + "1");
   const std::string d = std::to_string(domain_);
   start("vehicle --scenario " + kStep + " --latency 30 --domain " + d, dir, "vehicle.txt", in_a);
-  const std::string fly = in_b + " env XDG_CONFIG_HOME='" + (dir / "config").string() + "' '" +
-                          kMixpilot + "' fly --scenario " + kStep + " --vehicle dds --domain " + d +
+  const std::string fly = in_b + " env XDG_CONFIG_HOME='" + (dir / "config").string() +
+                          "' XDG_DATA_HOME='" + (dir / "data").string() + "' '" + kMixpilot +
+                          "' fly --scenario " + kStep + " --vehicle dds --domain " + d +
                           " --headless --realtime --duration 3 --report '" +
                           (dir / "netns.json").string() + "' >'" + (dir / "fly.txt").string() +
                           "' 2>&1";
