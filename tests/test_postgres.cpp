@@ -28,6 +28,7 @@
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
 #include "postgres_server.hpp"
+#include "history_test.hpp"
 #include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
@@ -156,32 +157,9 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
   ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
-  const StoredFlight& r = rows[0];
-  EXPECT_GT(r.id, 0);
-  EXPECT_EQ(r.trainee, f.trainee);
-  EXPECT_EQ(r.station, f.station);
-  EXPECT_EQ(r.scenario, f.scenario);
-  EXPECT_EQ(r.scenario_hash, f.scenario_hash);
-  EXPECT_EQ(r.mode, f.mode);
-  EXPECT_EQ(r.pilot, f.pilot);
-  EXPECT_EQ(r.input_device, f.input_device);
-  EXPECT_EQ(r.input_settings_hash, f.input_settings_hash);
-  EXPECT_EQ(r.started_unix_ms, f.started_unix_ms);
-  EXPECT_EQ(r.duration_s, f.duration_s);
-  EXPECT_EQ(r.ended, history::Ended::lost);
-  EXPECT_TRUE(r.probe);
-  EXPECT_EQ(r.recording_path, f.recording_path);
-  EXPECT_EQ(r.recording_hash, f.recording_hash);
-  EXPECT_EQ(r.app_version, f.app_version);
-  EXPECT_EQ(r.front_end, f.front_end);
-  ASSERT_EQ(r.metrics.size(), f.metrics.size());
-  for (std::size_t i = 0; i < f.metrics.size(); ++i) {
-    EXPECT_EQ(r.metrics[i].first, f.metrics[i].first);
-    if (std::isfinite(f.metrics[i].second))
-      EXPECT_EQ(r.metrics[i].second, f.metrics[i].second) << f.metrics[i].first;
-    else
-      EXPECT_TRUE(std::isnan(r.metrics[i].second)) << f.metrics[i].first;
-  }
+  expect_same_flight(f, rows[0]);
+  EXPECT_EQ(rows[0].ended, history::Ended::lost);
+  EXPECT_TRUE(rows[0].probe);
   std::vector<std::string> names;
   ASSERT_TRUE(store->trainees(names, error)) << error;
   EXPECT_EQ(names, std::vector<std::string>{"Ada"});
