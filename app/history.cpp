@@ -276,6 +276,13 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
   std::fputs(out.c_str(), stdout);
 }
 
+// Nothing at `file` yet (a link to nothing is something: opening it says so).
+bool no_file_yet(const std::string& file) {
+  std::error_code ec, link_ec;
+  return !file.empty() && !fs::exists(file, ec) && !ec &&
+         !fs::is_symlink(fs::symlink_status(file, link_ec));
+}
+
 // ---- import ----------------------------------------------------------------------------------
 
 struct ImportRow {
@@ -451,8 +458,7 @@ int push_command(int argc, char** argv) {
     const std::string file = source.empty()                   ? history::default_history_path()
                              : source.starts_with("sqlite:") ? source.substr(7)
                                                               : source;
-    std::error_code ec;
-    if (!file.empty() && !fs::exists(file, ec) && !ec) {
+    if (no_file_yet(file)) {
       std::fprintf(stderr, "mixpilot history push: %s: no history here yet: nothing to push\n",
                    escape_controls(file).c_str());
       return kExitError;
@@ -540,7 +546,7 @@ int history_command(int argc, char** argv) {
         usage_error(cmd, "--jobs expects a whole number from 1 to 256, got '" +
                              escape_controls(v) + "'");
       jobs = int(n);
-    } else if (importing && !a.empty() && a[0] != '-' && import_dir.empty()) {
+    } else if (importing && (a.empty() || a[0] != '-') && import_dir.empty()) {
       import_dir = file_argument(cmd, "a folder of recordings", a);
     } else {
       usage_error(cmd, "unexpected '" + escape_controls(a) + "'");
@@ -565,8 +571,7 @@ int history_command(int argc, char** argv) {
     const std::string file = location.empty()            ? history::default_history_path()
                              : location.starts_with("sqlite:") ? location.substr(7)
                                                                : location;
-    std::error_code ec;
-    if (!file.empty() && !fs::exists(file, ec) && !ec) return print();
+    if (no_file_yet(file)) return print();
   }
   const auto store = history::open_history(location, error);
   if (!store) {

@@ -39,6 +39,7 @@ import random
 import re
 import shutil
 import struct
+import sqlite3
 import subprocess
 import sys
 import tempfile
@@ -202,8 +203,32 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("fly", ["fly", "--scenario", "{D}/" + toml.name, "--headless"] + short, "refused")],
             {}))
 
-    # An empty file is a valid settings file (every key defaulted) and mapping database.
-    empty_ok = ("--input-settings", "config input.toml", "config gamecontrollerdb.txt")
+    # The trainee's history (SQLite): a flight is never refused for its history (the problem is
+    # said, naming the file), a listing is; `history import` reads a folder.
+    def history_db(d):
+        p = d / "h.sqlite"
+        sqlite3.connect(str(p)).close()  # an empty database: the app migrates it
+        return p
+    inputs.append(("--history", history_db, [
+        ("fly", ["fly", "--scenario", str(scen_dir / "mi_helix.toml"), "--pilot", "novice",
+                 "--headless", "--history", "{X}"]
+         + short, "config"),
+        ("history", ["history", "--history", "{X}"], "refused"),
+    ], {}))
+    def recordings_folder(d):
+        p = d / "recs"
+        p.mkdir()
+        shutil.copy(rec, p / "a.mcap")
+        return p
+    inputs.append(("history import DIR", recordings_folder, [
+        ("history import", ["history", "import", "{X}", "--history", "{D}/h.sqlite"],
+         "refused"),
+    ], {}))
+
+    # An empty file is a valid settings file (every key defaulted), mapping database and
+    # SQLite database; a history import of an empty folder imports nothing.
+    empty_ok = ("--input-settings", "config input.toml", "config gamecontrollerdb.txt",
+                "--history")
     for input_label, make, cmds, env in inputs:
         for cmd_label, argv, expect in cmds:
             for kind in KINDS:
@@ -211,6 +236,8 @@ def build_cases(base, binary, scen_dir, setpriv):
                     continue
                 right = "any" if kind == "regular" or (kind == "empty" and
                                                        input_label in empty_ok) else expect
+                if input_label == "history import DIR" and kind == "directory":
+                    right = "any"  # an empty folder: nothing to import
                 cases.append(Case(f"{input_label} {kind} via {cmd_label}", argv, right, "{X}",
                                   env, kind, make))
 
@@ -296,7 +323,12 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("joy-publish --from", ["joy-publish", "--from", ""], "--from"),
             ("joy-publish --input-settings", ["joy-publish", "--from", R, "--wait", "0",
                                               "--input-settings", ""], "--input-settings"),
-            ("vehicle --scenario", ["vehicle", "--scenario", ""], "--scenario")):
+            ("vehicle --scenario", ["vehicle", "--scenario", ""], "--scenario"),
+            ("fly --history", fly + ["--history", ""], "--history"),
+            ("fly --trainee", fly + ["--trainee", ""], "--trainee"),
+            ("fly --assist", fly + ["--assist", ""], "--assist"),
+            ("history --history", ["history", "--history", ""], "--history"),
+            ("history import DIR", ["history", "import", ""], "empty")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
 
     # The user's folders from the environment: never the current folder's .config.

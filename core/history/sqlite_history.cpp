@@ -394,6 +394,13 @@ std::unique_ptr<HistoryStore> open_sqlite(const std::string& path, std::string& 
     error = path + ": is a folder, not a history file";
     return nullptr;
   }
+  // SQLite would make the history wherever a dangling link points: say it instead, as every
+  // reader of the project says a link to nothing.
+  if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(path, ec)) {
+    error = path + ": is a symbolic link to nothing (" + fs::read_symlink(path, ec).string() +
+            "), not a history file";
+    return nullptr;
+  }
   if (settings.create_folder && !make_folders(fs::path(path).parent_path(), error)) return nullptr;
   sqlite3* db = nullptr;
   const int rc = sqlite3_open_v2(path.c_str(), &db,
