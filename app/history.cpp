@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,9 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight_rig.hpp"
+#include "app/progress.hpp"
+#include "app/progress_html.hpp"
+#include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
@@ -33,6 +37,7 @@ namespace fs = std::filesystem;
 constexpr const char* kHistoryUsage =
     "usage: mixpilot history [--trainee NAME] [--scenario NAME] [--since DATE] [--limit N]\n"
     "                        [--csv | --json] [--history LOCATION]\n"
+    "       mixpilot history --trainee NAME --html OUT.html [--force] [--scenario NAME] ...\n"
     "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--history LOCATION]\n"
     "\n"
     "The flights mixpilot remembers (SPEC §10): every flight of the window and of `fly`, one\n"
@@ -46,7 +51,11 @@ constexpr const char* kHistoryUsage =
     "  --limit N          only the newest N flights\n"
     "  --csv              comma-separated values, a header line and one line per flight, every\n"
     "                     score field in a column of its own (metrics.NAME)\n"
-    "  --json             a JSON array, one object per flight, its score fields in \"metrics\"\n"
+    "  --json             a JSON array, one object per flight, its score fields in \"metrics\"\n"    "  --html OUT.html    the trainee's progress report to take home: one self-contained file\n"
+    "                     (curves of skill per attempt, assisted and probe flights, and D per\n"
+    "                     scenario; the best run, the trend, every flight), no network needed,\n"
+    "                     printable. Needs --trainee. Never replaces a file without --force\n"
+    "  --force            --html may replace OUT.html\n"
     "  --history LOCATION the history: an SQLite file (PATH or sqlite:PATH; default\n"
     "                     $XDG_DATA_HOME/mixpilot/history.sqlite) or postgresql://...\n"
     "\n"
@@ -122,12 +131,6 @@ std::string cell(std::string_view raw, std::size_t width, bool right = false) {
   }
   const std::string pad(width - cols, ' ');
   return right ? pad + out : out + pad;
-}
-
-std::optional<double> metric_of(const history::StoredFlight& f, std::string_view name) {
-  for (const auto& [k, v] : f.metrics)
-    if (k == name) return v;
-  return std::nullopt;
 }
 
 std::string number(double v, const char* format = "%.17g") {
@@ -412,7 +415,8 @@ int history_command(int argc, char** argv) {
   const char* cmd = "history";
   history::Query q;
   std::string location, import_dir, trainee_for_import;
-  bool as_csv = false, as_json = false, importing = false;
+  std::string html;
+  bool as_csv = false, as_json = false, importing = false, force = false;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   int first = 2;
   if (argc > 2 && std::string_view(argv[2]) == "import") {
@@ -458,6 +462,10 @@ int history_command(int argc, char** argv) {
       as_csv = true;
     } else if (!importing && a == "--json") {
       as_json = true;
+    } else if (!importing && a == "--html") {
+      html = value();
+    } else if (!importing && a == "--force") {
+      force = true;
     } else if (importing && a == "--jobs") {
       const std::string v = value();
       char* end = nullptr;
@@ -472,12 +480,38 @@ int history_command(int argc, char** argv) {
       usage_error(cmd, "unexpected '" + escape_controls(a) + "'");
     }
   }
-  if (as_csv && as_json) usage_error(cmd, "--csv or --json, not both");
+  if (int(as_csv) + int(as_json) + int(!html.empty()) > 1)
+    usage_error(cmd, "one of --csv, --json and --html");
+  if (!html.empty() && q.trainee.empty())
+    usage_error(cmd, "--html is one trainee's report: say whose (--trainee NAME)");
   if (importing && import_dir.empty())
     usage_error(cmd, "which folder? (mixpilot history import DIR)");
   std::string error;
   std::vector<history::StoredFlight> rows;
+  // The report's file is checked before any work (never clobbered without --force).
+  OutputFile report;
+  if (!html.empty() && !report.open(html, force, error)) {
+    std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
   const auto print = [&] {
+    if (!html.empty()) {
+      const std::string text = progress_html(
+          q.trainee, rows,
+          std::chrono::duration_cast<std::chrono::milliseconds>(
+              std::chrono::system_clock::now().time_since_epoch())
+              .count());
+      if (std::fwrite(text.data(), 1, text.size(), report.stream()) != text.size() ||
+          !report.commit(error)) {
+        if (error.empty()) error = html + ": cannot write: " + report.keep_partial();
+        std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+        return kExitError;
+      }
+      std::printf("mixpilot history: %s's progress report (%zu flight%s) in %s\n",
+                  escape_controls(q.trainee).c_str(), rows.size(), rows.size() == 1 ? "" : "s",
+                  escape_controls(html).c_str());
+      return kExitOk;
+    }
     if (as_csv)
       print_csv(rows);
     else if (as_json)
@@ -496,11 +530,13 @@ int history_command(int argc, char** argv) {
   }
   const auto store = history::open_history(location, error);
   if (!store) {
+    report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
   if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
   if (!store->query(q, rows, error)) {
+    report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
