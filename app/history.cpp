@@ -535,6 +535,9 @@ int history_command(int argc, char** argv) {
     return kExitError;
   }
   if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
+  // The table shows one score field: reading the others (twenty a flight) is what would make a
+  // long history slow to list.
+  if (!as_csv && !as_json && html.empty()) q.metrics = {"skill"};
   if (!store->query(q, rows, error)) {
     report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());

@@ -328,18 +328,24 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       at.emplace(out[i].id, i);
       first = std::min(first, out[i].id);
     }
-    // The metrics of the same filter (those of flights past the limit are skipped by id).
+    // The metrics of the same filter (those of flights past the limit are skipped by id), only
+    // the names asked for when some are.
+    std::string sql =
+        "SELECT m.flight_id, m.name, m.value FROM metrics m"
+        " JOIN flights f ON f.id = m.flight_id JOIN trainees t ON t.id = f.trainee_id"
+        " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
+        " AND f.started_unix_ms >= ?3 AND f.id >= ?4";
+    if (!q.metrics.empty()) {
+      sql += " AND m.name IN (";
+      for (std::size_t i = 0; i < q.metrics.size(); ++i) sql += i ? ", ?" : "?";
+      sql += ")";
+    }
+    sql += " ORDER BY m.flight_id, m.position";
     Stmt s;
-    if (!prepare(s,
-                 "SELECT m.flight_id, m.name, m.value FROM metrics m"
-                 " JOIN flights f ON f.id = m.flight_id JOIN trainees t ON t.id = f.trainee_id"
-                 " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
-                 " AND f.started_unix_ms >= ?3 AND f.id >= ?4"
-                 " ORDER BY m.flight_id, m.position",
-                 error))
-      return rollback(), false;
+    if (!prepare(s, sql.c_str(), error)) return rollback(), false;
     bind_filter(s.get());
     sqlite3_bind_int64(s.get(), 4, first);
+    for (std::size_t i = 0; i < q.metrics.size(); ++i) bind_text(s.get(), int(5 + i), q.metrics[i]);
     int rc;
     while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
       const auto it = at.find(sqlite3_column_int64(s.get(), 0));
