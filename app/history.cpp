@@ -104,9 +104,35 @@ std::string local_time(std::int64_t unix_ms, const char* format) {
   return std::strftime(text, sizeof text, format, &tm) ? text : "";
 }
 
+// The table's "YYYY-MM-DD HH:MM" of a flight, the local time zone looked up once per quarter
+// hour (every zone's offset changes on a quarter hour): a long listing spends no time there.
+std::string table_minutes(std::int64_t unix_ms) {
+  static std::int64_t block = -1;
+  static std::tm start{};
+  const std::int64_t s = unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000;
+  const std::int64_t b = s >= 0 ? s / 900 : (s - 899) / 900;
+  if (b != block) {
+    block = b;
+    const std::time_t t = std::time_t(b * 900);
+    localtime_r(&t, &start);
+  }
+  const int minutes = start.tm_min + int((s - b * 900) / 60);
+  char text[32];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d", start.tm_year + 1900,
+                start.tm_mon + 1, start.tm_mday, start.tm_hour, minutes);
+  return text;
+}
+
 // `text` in a terminal column of `width` characters: control characters escaped, cut with an
 // ellipsis when longer, padded with spaces (UTF-8 code points counted as one column each).
 std::string cell(std::string_view raw, std::size_t width, bool right = false) {
+  // Printable ASCII that fits, the common case: padded as it is.
+  if (raw.size() <= width &&
+      std::all_of(raw.begin(), raw.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
+    std::string out(width, ' ');
+    raw.copy(out.data() + (right ? width - raw.size() : 0), raw.size());
+    return out;
+  }
   const std::string text = escape_controls(raw);
   std::string out;
   std::size_t cols = 0, i = 0;
@@ -140,25 +166,60 @@ std::string number(double v, const char* format = "%.17g") {
   return text;
 }
 
+// A path for the terminal: as it is when it is printable ASCII (the common case), else with
+// its control characters escaped.
+std::string printable_path(const std::string& p) {
+  return std::all_of(p.begin(), p.end(), [](char c) { return c >= 0x20 && c < 0x7F; })
+             ? p
+             : escape_controls(p);
+}
+
 void print_table(const std::vector<history::StoredFlight>& rows) {
-  std::printf("%s %s %s %s %s %s %s %s %s %s\n", cell("id", 6, true).c_str(),
-              cell("started", 16).c_str(), cell("trainee", 16).c_str(),
-              cell("scenario", 18).c_str(), cell("pilot", 12).c_str(),
-              cell("time_s", 7, true).c_str(), cell("ended", 11).c_str(),
-              cell("skill", 6, true).c_str(), cell("from", 7).c_str(), "recording");
+  // Each row's cells appended to one line buffer (its capacity kept): a long history prints
+  // without a string per cell.
+  std::string line;
+  const auto add = [&line](std::string_view text, std::size_t width, bool right = false) {
+    if (text.size() <= width &&
+        std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
+      if (right) line.append(width - text.size(), ' ');
+      line.append(text);
+      if (!right) line.append(width - text.size(), ' ');
+    } else {
+      line += cell(text, width, right);
+    }
+    line += ' ';
+  };
+  add("id", 6, true);
+  add("started", 16);
+  add("trainee", 16);
+  add("scenario", 18);
+  add("pilot", 12);
+  add("time_s", 7, true);
+  add("ended", 11);
+  add("skill", 6, true);
+  add("from", 7);
+  line += "recording\n";
+  std::fputs(line.c_str(), stdout);
+  char number_text[32];
   for (const history::StoredFlight& f : rows) {
+    line.clear();
+    std::snprintf(number_text, sizeof number_text, "%lld", static_cast<long long>(f.id));
+    add(number_text, 6, true);
+    add(table_minutes(f.started_unix_ms), 16);
+    add(f.trainee, 16);
+    add(f.scenario, 18);
+    add(f.pilot.empty() ? "-" : f.pilot, 12);
+    add(number(f.duration_s, "%.1f"), 7, true);
+    std::string_view ended = history::to_string(f.ended);
+    std::snprintf(number_text, sizeof number_text, "%.*s%s", int(ended.size()), ended.data(),
+                  f.probe ? "*" : "");
+    add(number_text, 11);
     const auto skill = metric_of(f, "skill");
-    std::string ended = history::to_string(f.ended);
-    if (f.probe) ended += "*";
-    std::printf("%s %s %s %s %s %s %s %s %s %s\n",
-                cell(std::to_string(f.id), 6, true).c_str(),
-                cell(local_time(f.started_unix_ms, "%Y-%m-%d %H:%M"), 16).c_str(),
-                cell(f.trainee, 16).c_str(), cell(f.scenario, 18).c_str(),
-                cell(f.pilot.empty() ? "-" : f.pilot, 12).c_str(),
-                cell(number(f.duration_s, "%.1f"), 7, true).c_str(), cell(ended, 11).c_str(),
-                cell(skill ? number(*skill, "%.1f") : "-", 6, true).c_str(),
-                cell(f.front_end, 7).c_str(),
-                escape_controls(f.recording_path.empty() ? "-" : f.recording_path).c_str());
+    add(skill ? number(*skill, "%.1f") : "-", 6, true);
+    add(f.front_end, 7);
+    line += f.recording_path.empty() ? "-" : printable_path(f.recording_path);
+    line += '\n';
+    std::fputs(line.c_str(), stdout);
   }
   std::printf("%zu flight%s%s\n", rows.size(), rows.size() == 1 ? "" : "s",
               std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.probe; })
