@@ -593,11 +593,15 @@ TEST_F(App, TheInputSettingsPanel) {
 }
 
 // A trainee's history in the user's data folder: 14 flights of mi_helix (every fifth a probe),
-// the skill rising and D falling, as a learning pilot's would; and a second trainee.
+// the skill rising and D falling, as a learning pilot's would, the last ones recorded (files
+// that stand for their recordings); and a second trainee.
 void fill_history() {
   std::string error;
   auto store = history::open_history("", error);
   ASSERT_TRUE(store) << error;
+  const std::filesystem::path recordings =
+      std::filesystem::path(std::getenv("XDG_DATA_HOME")) / "mixpilot" / "recordings";
+  std::filesystem::create_directories(recordings);
   for (int i = 0; i < 14; ++i) {
     history::FlightRecord f;
     f.trainee = "Ada Lovelace";
@@ -614,6 +618,11 @@ void fill_history() {
     const double skill = 35.0 + 3.2 * i + (i % 3 == 1 ? 4.0 : -2.0) - (f.probe ? 18.0 : 0.0);
     f.metrics = {{"skill", skill}};
     if (!f.probe) f.metrics.emplace_back("assistance_dependence", 0.62 - 0.035 * i);
+    if (i >= 9) {
+      f.recording_path = (recordings / ("mi_helix-" + std::to_string(i) + ".mcap")).string();
+      f.recording_hash = std::to_string(i);
+      std::ofstream(f.recording_path) << "";
+    }
     ASSERT_TRUE(store->add(f, error)) << error;
   }
   history::FlightRecord other;

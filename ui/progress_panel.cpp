@@ -100,16 +100,31 @@ void skill_plot(const ProgressView& v, float height) {
   };
   const float line_w = std::max(1.0f, std::round(scaled(2.0f)));
   const float r = scaled(3.5f);
-  // D first, under the skills: dashed (every other segment), in the planner's colour.
+  // D first, under the skills: dashed, in the planner's colour (told from the skills in
+  // greyscale too).
   if (v.has_dependence) {
+    const float on = scaled(6.0f), off = scaled(4.0f);
     ImVec2 last(0, 0);
     bool have = false;
-    int seg = 0;
+    float phase = 0.0f;  // along the dash pattern, carried from one segment to the next
     for (int i = 0; i < n; ++i) {
       const double d = fl[std::size_t(i)].dependence;
       if (!std::isfinite(d)) continue;
       const ImVec2 p(x_of(i), y_of(100.0 * d));
-      if (have && (seg++ % 2) == 0) dl->AddLine(last, p, kDependence, line_w);
+      if (have) {
+        const float dx = p.x - last.x, dy = p.y - last.y, len = std::sqrt(dx * dx + dy * dy);
+        for (float at = 0.0f; at < len;) {
+          const float in = std::fmod(phase, on + off);
+          const float step = std::min(len - at, in < on ? on - in : on + off - in);
+          if (in < on) {
+            const float a = at / len, b = (at + step) / len;
+            dl->AddLine(ImVec2(last.x + a * dx, last.y + a * dy),
+                        ImVec2(last.x + b * dx, last.y + b * dy), kDependence, line_w);
+          }
+          at += step;
+          phase += step;
+        }
+      }
       dl->AddCircleFilled(p, 0.6f * r, kDependence);
       last = p;
       have = true;
@@ -209,6 +224,7 @@ void draw_progress_panel(const HistoryView& h, bool& open, ImVec2 display, Reque
   ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
                           ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(size, ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.98f);  // the plots behind would show through its text
   if (!ImGui::Begin("Progress (H)", &open,
                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
                         ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize)) {
