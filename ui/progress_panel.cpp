@@ -73,7 +73,9 @@ void skill_plot(const ProgressView& v, float height) {
   ImGui::SetCursorScreenPos(top);
   ImGui::Dummy(ImVec2(width, height));
   ImDrawList* dl = ImGui::GetWindowDrawList();
-  dl->AddRectFilled(min, max, colour::rgb(0x12, 0x14, 0x18));
+  // No fill of its own: the window's background is the plot's (a software rasterizer pays for
+  // every pixel blended twice).
+  dl->AddRect(min, max, colour::kGrid);
   for (int g = 0; g <= 4; ++g) {  // skill 0, 25, ... 100
     const float y = max.y - float(g) / 4.0f * (max.y - min.y);
     dl->AddLine(ImVec2(min.x, y), ImVec2(max.x, y), colour::kGrid, 1.0f);
