@@ -91,9 +91,8 @@ bool FlightRig::record(const std::string& path, const std::string& trainee,
   return true;
 }
 
-void FlightRig::remember(history::HistoryStore* store, std::string trainee,
-                         std::string front_end) {
-  history_ = store;
+void FlightRig::remember(HistoryWriter* writer, std::string trainee, std::string front_end) {
+  history_ = writer;
   trainee_ = std::move(trainee);
   front_end_ = std::move(front_end);
 }
@@ -140,21 +139,22 @@ FlightRig::Closed FlightRig::close(bool interrupted) {
       completed_recording_ = true;
     }
   }
-  // The history's row, after the recording is complete (its hash is the finished file's). A
-  // failure is said by the front end; the flight and its recording stand.
+  // The history's row, after the recording is complete (its hash is the finished file's, taken
+  // on the writer's thread). A failure is said by the front end from the writer's outcome; the
+  // flight and its recording stand.
   if (history_ && started_ && !flight_.recording && flight_.mode->steps_done() > 0) {
     std::string error;
-    std::optional<history::FlightRecord> row = flight_record(interrupted, error);
-    std::optional<history::HistoryStore::Added> added;
-    if (row) added = history_->add(*row, error);
-    c.remembered = added.has_value();
-    if (!added) c.history_error = error;
+    if (std::optional<history::FlightRecord> row = flight_record(interrupted, error, false)) {
+      history_->remember(std::move(*row), completed_recording_ ? record_path_ : std::string());
+      c.remembering = true;
+    }
   }
   return c;
 }
 
 std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
-                                                              std::string& error) const {
+                                                              std::string& error,
+                                                              bool hash) const {
   const Mode& mode = *flight_.mode;
   history::FlightRecord r;
   const auto meta = [this](const char* key) {
@@ -187,9 +187,11 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
     std::error_code ec;
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);
     r.recording_path = ec ? record_path_ : abs.lexically_normal().string();
-    const auto hash = history::sha256_file(record_path_, error);
-    if (!hash) return std::nullopt;
-    r.recording_hash = *hash;
+    if (hash) {
+      const auto h = history::sha256_file(record_path_, error);
+      if (!h) return std::nullopt;
+      r.recording_hash = *h;
+    }
   }
   r.metrics = metrics();
   return r;

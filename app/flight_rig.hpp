@@ -6,7 +6,7 @@
 // here: the window's live flights (app/trainer.cpp), `fly --headless` (app/fly.cpp), a replay's
 // tape (app/replay_tape.cpp, the window's and `replay --headless`'s) and `score`
 // (app/score.cpp); the tests drive the same class. A live flight is remembered in the trainee's
-// history (SPEC §10) when it closes: remember(). Errors come back as values with an exit
+// history (SPEC §10) when it closes: remember() hands its row to the history's thread. Errors come back as values with an exit
 // status; nothing here exits.
 //
 // The threads mixpilot starts, and who owns them (each is joined by its owner's stop or
@@ -25,6 +25,9 @@
 //                                                                owner); a rig holds a share
 //   replay tape   ReplayTape's loader (app/replay_tape.hpp)      the window's replay
 //   score jobs    score's worker pool (app/score.cpp)            `mixpilot score`
+//   history       HistoryWriter (app/history_writer.hpp): opens  the window's Trainer, or
+//                 the store, hashes recordings, writes rows,    `fly --headless` (which waits
+//                 loads what the window shows of the history    for it at the end)
 //   vehicle       `mixpilot vehicle`'s plant loop runs on main; its DDS link's threads are
 //                 Cyclone's, under RealtimeThreadsScope
 #include <chrono>
@@ -34,6 +37,7 @@
 #include <string>
 
 #include "app/flight.hpp"
+#include "app/history_writer.hpp"
 #include "core/history/history.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
@@ -75,12 +79,13 @@ class FlightRig {
   [[nodiscard]] bool record(const std::string& path, const std::string& trainee,
                             const RecordingSink::Settings& settings, bool overwrite,
                             std::string& error);
-  // The flight goes into `store` when it closes (SPEC §10: every flight one row), flown by
+  // The flight goes into the history when it closes (SPEC §10: every flight one row), flown by
   // `trainee` ("" → the account's login name) from `front_end` ("window", "fly"; "vehicle"
   // whenever a remote vehicle flies it). Not a replay (it is no new flight: `history import`
-  // adds recordings), nor a flight that never started. `store` outlives the rig; the write
-  // happens in close(), on the caller's thread, never on the control thread.
-  void remember(history::HistoryStore* store, std::string trainee, std::string front_end);
+  // adds recordings), nor a flight that never started. close() hands the row to `writer`
+  // (which outlives the rig): its recording is hashed and the row written on the writer's
+  // thread, so neither the control thread nor the UI ever waits for the history.
+  void remember(HistoryWriter* writer, std::string trainee, std::string front_end);
   // Another sink (screenshots, a replay's tape), called on the thread that steps the session.
   void watch(TelemetrySink& sink) { session_->add_sink(&sink); }
 
@@ -105,10 +110,8 @@ class FlightRig {
     std::string error;           // the recording could not be completed ("" when fine)
     bool published = false;      // --publish: the publisher's counts
     std::uint64_t published_steps = 0, publish_dropped = 0;
-    // remember(): the flight's row in the history, or why it is not there ("" when remembered
-    // or not asked for). The flight itself is fine either way.
-    bool remembered = false;
-    std::string history_error;
+    // remember(): the flight's row was handed to the writer (its outcome comes from there).
+    bool remembering = false;
   };
   // Stops the runner, the publisher and the vehicle link, and completes the recording
   // (`interrupted`: the flight stopped before its end). Once; later calls return {}.
@@ -123,9 +126,11 @@ class FlightRig {
   // The flight's history row as it stands: its labels, metrics, times, the scenario's and
   // input settings' hashes; the recording's path and hash once close() has completed it.
   // A replay's row describes the recorded flight (trainee and pilot from the recording).
-  // nullopt with the reason (the recording cannot be read to hash it).
+  // nullopt with the reason (the recording cannot be read to hash it). Without `hash` the
+  // recording's hash is left empty, for the writer to fill in off this thread.
   [[nodiscard]] std::optional<history::FlightRecord> flight_record(bool interrupted,
-                                                                   std::string& error) const;
+                                                                   std::string& error,
+                                                                   bool hash = true) const;
   std::string recording_path() const { return record_path_; }
 
   Mode& mode() { return *flight_.mode; }
@@ -152,7 +157,7 @@ class FlightRig {
   std::chrono::steady_clock::time_point vehicle_deadline_;
   bool started_ = false, closed_ = false;
   std::int64_t started_unix_ms_ = 0;       // the wall-clock time of start()
-  history::HistoryStore* history_ = nullptr;  // remember()
+  HistoryWriter* history_ = nullptr;        // remember()
   std::string trainee_, front_end_;
   bool completed_recording_ = false;        // close() completed record_path_
 };

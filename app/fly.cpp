@@ -216,7 +216,8 @@ double fly_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
 // The summary on stdout after the flight, the report and the screenshots written; the exit
 // status.
 int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screenshots,
-                    double wall, const std::optional<RealtimeStats>& realtime) {
+                    double wall, const std::optional<RealtimeStats>& realtime,
+                    HistoryWriter* history) {
   const Mode& mode = rig.mode();
   const bool stopped = interrupted() && !mode.finished();
   int status = kExitOk;
@@ -254,10 +255,17 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
     for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
   }
   if (!closed.recorded.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
-  // The history never changes the exit status: the flight is fine without it.
-  if (!closed.history_error.empty())
-    std::fprintf(stderr, "mixpilot %s: history: %s; this flight is flown but not remembered\n",
-                 o.command, closed.history_error.c_str());
+  // The history never changes the exit status: the flight is fine without it. Its row is
+  // written on the writer's thread, as in the window; here the command waits for it.
+  if (history && closed.remembering) {
+    history->wait_idle();
+    std::vector<HistoryWriter::Outcome> outcomes;
+    (void)history->poll(outcomes);
+    for (const HistoryWriter::Outcome& r : outcomes)
+      if (!r.remembered)
+        std::fprintf(stderr, "mixpilot %s: history: %s; this flight is flown but not remembered\n",
+                     o.command, r.error.c_str());
+  }
   if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
   if (stopped) {
     std::printf("  interrupted at t = %.3f s\n", flown);
@@ -289,8 +297,8 @@ int run_fly(const FlyOptions& o) {
   if (!o.headless) return run_in_window(o);
   if (o.replay) return run_replay_headless(o);
   int status = kExitOk;
-  // Declared before the rig, which writes to it when it closes.
-  std::unique_ptr<history::HistoryStore> store;
+  // Declared before the rig, which hands it its row when it closes.
+  std::optional<HistoryWriter> history;
   const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
   if (!rig) {
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
@@ -332,19 +340,16 @@ int run_fly(const FlyOptions& o) {
       return kExitError;
     }
   }
+  // The store is opened on the writer's thread while the flight flies; a failure to open it is
+  // said at the end, with the row it cost.
   if (o.history != "off" && !rig->flight().recording) {
-    std::string why;
-    store = history::open_history(o.history, why);
-    if (store)
-      rig->remember(store.get(), o.trainee, "fly");
-    else
-      std::fprintf(stderr, "mixpilot %s: history: %s; this flight is flown but not remembered\n",
-                   o.command, why.c_str());
+    history.emplace(o.history);
+    rig->remember(&*history, o.trainee, "fly");
   }
   ScreenshotSink* shots = screenshots ? &*screenshots : nullptr;
   std::optional<RealtimeStats> realtime;
   const double wall = fly_headless(*rig, o, shots, realtime);
-  return finish_headless(*rig, o, shots, wall, realtime);
+  return finish_headless(*rig, o, shots, wall, realtime, history ? &*history : nullptr);
 }
 
 // --screenshot, --size, --scale and --exit-at-end, shared by fly and replay: true when `a` is one of them

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,9 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight_rig.hpp"
+#include "app/progress.hpp"
+#include "app/progress_html.hpp"
+#include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
@@ -35,6 +39,7 @@ namespace fs = std::filesystem;
 constexpr const char* kHistoryUsage =
     "usage: mixpilot history [--trainee NAME] [--scenario NAME] [--since DATE] [--limit N]\n"
     "                        [--csv | --json] [--history LOCATION]\n"
+    "       mixpilot history --trainee NAME --html OUT.html [--force] [--scenario NAME] ...\n"
     "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--history LOCATION]\n"
     "       mixpilot history push postgresql://[USER@]HOST[:PORT]/DATABASE [--history LOCATION]\n"
     "\n"
@@ -49,7 +54,11 @@ constexpr const char* kHistoryUsage =
     "  --limit N          only the newest N flights\n"
     "  --csv              comma-separated values, a header line and one line per flight, every\n"
     "                     score field in a column of its own (metrics.NAME)\n"
-    "  --json             a JSON array, one object per flight, its score fields in \"metrics\"\n"
+    "  --json             a JSON array, one object per flight, its score fields in \"metrics\"\n"    "  --html OUT.html    the trainee's progress report to take home: one self-contained file\n"
+    "                     (curves of skill per attempt, assisted and probe flights, and D per\n"
+    "                     scenario; the best run, the trend, every flight), no network needed,\n"
+    "                     printable. Needs --trainee. Never replaces a file without --force\n"
+    "  --force            --html may replace OUT.html\n"
     "  --history LOCATION the history: an SQLite file (PATH or sqlite:PATH; default\n"
     "                     $XDG_DATA_HOME/mixpilot/history.sqlite) or postgresql://...\n"
     "\n"
@@ -106,9 +115,35 @@ std::string local_time(std::int64_t unix_ms, const char* format) {
   return std::strftime(text, sizeof text, format, &tm) ? text : "";
 }
 
+// The table's "YYYY-MM-DD HH:MM" of a flight, the local time zone looked up once per quarter
+// hour (every zone's offset changes on a quarter hour): a long listing spends no time there.
+std::string table_minutes(std::int64_t unix_ms) {
+  static std::int64_t block = -1;
+  static std::tm start{};
+  const std::int64_t s = unix_ms >= 0 ? unix_ms / 1000 : (unix_ms - 999) / 1000;
+  const std::int64_t b = s >= 0 ? s / 900 : (s - 899) / 900;
+  if (b != block) {
+    block = b;
+    const std::time_t t = std::time_t(b * 900);
+    localtime_r(&t, &start);
+  }
+  const int minutes = start.tm_min + int((s - b * 900) / 60);
+  char text[32];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d", start.tm_year + 1900,
+                start.tm_mon + 1, start.tm_mday, start.tm_hour, minutes);
+  return text;
+}
+
 // `text` in a terminal column of `width` characters: control characters escaped, cut with an
 // ellipsis when longer, padded with spaces (UTF-8 code points counted as one column each).
 std::string cell(std::string_view raw, std::size_t width, bool right = false) {
+  // Printable ASCII that fits, the common case: padded as it is.
+  if (raw.size() <= width &&
+      std::all_of(raw.begin(), raw.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
+    std::string out(width, ' ');
+    raw.copy(out.data() + (right ? width - raw.size() : 0), raw.size());
+    return out;
+  }
   const std::string text = escape_controls(raw);
   std::string out;
   std::size_t cols = 0, i = 0;
@@ -135,12 +170,6 @@ std::string cell(std::string_view raw, std::size_t width, bool right = false) {
   return right ? pad + out : out + pad;
 }
 
-std::optional<double> metric_of(const history::StoredFlight& f, std::string_view name) {
-  for (const auto& [k, v] : f.metrics)
-    if (k == name) return v;
-  return std::nullopt;
-}
-
 std::string number(double v, const char* format = "%.17g") {
   if (!std::isfinite(v)) return "";
   char text[40];
@@ -148,25 +177,60 @@ std::string number(double v, const char* format = "%.17g") {
   return text;
 }
 
+// A path for the terminal: as it is when it is printable ASCII (the common case), else with
+// its control characters escaped.
+std::string printable_path(const std::string& p) {
+  return std::all_of(p.begin(), p.end(), [](char c) { return c >= 0x20 && c < 0x7F; })
+             ? p
+             : escape_controls(p);
+}
+
 void print_table(const std::vector<history::StoredFlight>& rows) {
-  std::printf("%s %s %s %s %s %s %s %s %s %s\n", cell("id", 6, true).c_str(),
-              cell("started", 16).c_str(), cell("trainee", 16).c_str(),
-              cell("scenario", 18).c_str(), cell("pilot", 12).c_str(),
-              cell("time_s", 7, true).c_str(), cell("ended", 11).c_str(),
-              cell("skill", 6, true).c_str(), cell("from", 7).c_str(), "recording");
+  // Each row's cells appended to one line buffer (its capacity kept): a long history prints
+  // without a string per cell.
+  std::string line;
+  const auto add = [&line](std::string_view text, std::size_t width, bool right = false) {
+    if (text.size() <= width &&
+        std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
+      if (right) line.append(width - text.size(), ' ');
+      line.append(text);
+      if (!right) line.append(width - text.size(), ' ');
+    } else {
+      line += cell(text, width, right);
+    }
+    line += ' ';
+  };
+  add("id", 6, true);
+  add("started", 16);
+  add("trainee", 16);
+  add("scenario", 18);
+  add("pilot", 12);
+  add("time_s", 7, true);
+  add("ended", 11);
+  add("skill", 6, true);
+  add("from", 7);
+  line += "recording\n";
+  std::fputs(line.c_str(), stdout);
+  char number_text[32];
   for (const history::StoredFlight& f : rows) {
+    line.clear();
+    std::snprintf(number_text, sizeof number_text, "%lld", static_cast<long long>(f.id));
+    add(number_text, 6, true);
+    add(table_minutes(f.started_unix_ms), 16);
+    add(f.trainee, 16);
+    add(f.scenario, 18);
+    add(f.pilot.empty() ? "-" : f.pilot, 12);
+    add(number(f.duration_s, "%.1f"), 7, true);
+    std::string_view ended = history::to_string(f.ended);
+    std::snprintf(number_text, sizeof number_text, "%.*s%s", int(ended.size()), ended.data(),
+                  f.probe ? "*" : "");
+    add(number_text, 11);
     const auto skill = metric_of(f, "skill");
-    std::string ended = history::to_string(f.ended);
-    if (f.probe) ended += "*";
-    std::printf("%s %s %s %s %s %s %s %s %s %s\n",
-                cell(std::to_string(f.id), 6, true).c_str(),
-                cell(local_time(f.started_unix_ms, "%Y-%m-%d %H:%M"), 16).c_str(),
-                cell(f.trainee, 16).c_str(), cell(f.scenario, 18).c_str(),
-                cell(f.pilot.empty() ? "-" : f.pilot, 12).c_str(),
-                cell(number(f.duration_s, "%.1f"), 7, true).c_str(), cell(ended, 11).c_str(),
-                cell(skill ? number(*skill, "%.1f") : "-", 6, true).c_str(),
-                cell(f.front_end, 7).c_str(),
-                escape_controls(f.recording_path.empty() ? "-" : f.recording_path).c_str());
+    add(skill ? number(*skill, "%.1f") : "-", 6, true);
+    add(f.front_end, 7);
+    line += f.recording_path.empty() ? "-" : printable_path(f.recording_path);
+    line += '\n';
+    std::fputs(line.c_str(), stdout);
   }
   std::printf("%zu flight%s%s\n", rows.size(), rows.size() == 1 ? "" : "s",
               std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.probe; })
@@ -494,7 +558,8 @@ int history_command(int argc, char** argv) {
   const char* cmd = "history";
   history::Query q;
   std::string location, import_dir, trainee_for_import;
-  bool as_csv = false, as_json = false, importing = false;
+  std::string html;
+  bool as_csv = false, as_json = false, importing = false, force = false;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   int first = 2;
   if (argc > 2 && std::string_view(argv[2]) == "import") {
@@ -538,6 +603,10 @@ int history_command(int argc, char** argv) {
       as_csv = true;
     } else if (!importing && a == "--json") {
       as_json = true;
+    } else if (!importing && a == "--html") {
+      html = value();
+    } else if (!importing && a == "--force") {
+      force = true;
     } else if (importing && a == "--jobs") {
       const std::string v = value();
       char* end = nullptr;
@@ -552,12 +621,38 @@ int history_command(int argc, char** argv) {
       usage_error(cmd, "unexpected '" + escape_controls(a) + "'");
     }
   }
-  if (as_csv && as_json) usage_error(cmd, "--csv or --json, not both");
+  if (int(as_csv) + int(as_json) + int(!html.empty()) > 1)
+    usage_error(cmd, "one of --csv, --json and --html");
+  if (!html.empty() && q.trainee.empty())
+    usage_error(cmd, "--html is one trainee's report: say whose (--trainee NAME)");
   if (importing && import_dir.empty())
     usage_error(cmd, "which folder? (mixpilot history import DIR)");
   std::string error;
   std::vector<history::StoredFlight> rows;
+  // The report's file is checked before any work (never clobbered without --force).
+  OutputFile report;
+  if (!html.empty() && !report.open(html, force, error)) {
+    std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
   const auto print = [&] {
+    if (!html.empty()) {
+      const std::string text = progress_html(
+          q.trainee, rows,
+          std::chrono::duration_cast<std::chrono::milliseconds>(
+              std::chrono::system_clock::now().time_since_epoch())
+              .count());
+      if (std::fwrite(text.data(), 1, text.size(), report.stream()) != text.size() ||
+          !report.commit(error)) {
+        if (error.empty()) error = html + ": cannot write: " + report.keep_partial();
+        std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
+        return kExitError;
+      }
+      std::printf("mixpilot history: %s's progress report (%zu flight%s) in %s\n",
+                  escape_controls(q.trainee).c_str(), rows.size(), rows.size() == 1 ? "" : "s",
+                  escape_controls(html).c_str());
+      return kExitOk;
+    }
     if (as_csv)
       print_csv(rows);
     else if (as_json)
@@ -575,11 +670,16 @@ int history_command(int argc, char** argv) {
   }
   const auto store = history::open_history(location, error);
   if (!store) {
+    report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
   if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
+  // The table shows one score field: reading the others (twenty a flight) is what would make a
+  // long history slow to list.
+  if (!as_csv && !as_json && html.empty()) q.metrics = {"skill"};
   if (!store->query(q, rows, error)) {
+    report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }

@@ -146,18 +146,25 @@ void LiveController::close_live(LiveFlight& f) {
     status_line_.say(c.error, true);
     status_ = kExitError;
   }
-  if (!c.history_error.empty()) history_problem(c.history_error);
 }
 
-history::HistoryStore* LiveController::history_store() {
-  if (options_.history == "off") return nullptr;
-  if (!history_opened_) {
-    history_opened_ = true;  // once: a failing open (a lock) would stall every Start
-    std::string why;
-    history_ = history::open_history(options_.history, why);
-    if (!history_) history_problem(why);
+void LiveController::history_outcome(const HistoryWriter::Outcome& o) {
+  if (!o.remembered) {
+    history_problem(o.error);
+    return;
   }
-  return history_.get();
+  history_said_.clear();  // it works again: a new failure is news
+  status_line_.add("remembered in the history (" + o.trainee + ", " + o.scenario + ")");
+}
+
+void LiveController::show_progress() {
+  if (!history_ || !live_) return;
+  std::string trainee = choices_.trainee.empty() ? history::login_name() : choices_.trainee;
+  std::string scenario = live_->mode().scenario_name();
+  if (trainee == shown_trainee_ && scenario == shown_scenario_) return;
+  shown_trainee_ = trainee;
+  shown_scenario_ = scenario;
+  history_->show(std::move(trainee), std::move(scenario));
 }
 
 void LiveController::history_problem(const std::string& why) {
@@ -214,8 +221,9 @@ int LiveController::finish() {
 
 // ---- The session: which flight, its start, its choices -----------------------------------
 
-LiveController::LiveController(FlyOptions o, InputController& input, StatusLine& status)
-    : options_(std::move(o)), input_(input), status_line_(status) {
+LiveController::LiveController(FlyOptions o, InputController& input, StatusLine& status,
+                               HistoryWriter* history)
+    : options_(std::move(o)), history_(history), input_(input), status_line_(status) {
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
   scenario_paths_ = shipped_scenarios();
@@ -286,6 +294,7 @@ void LiveController::refresh_choices() {
   const ModeIdentity id = live_->mode().identity();
   choices_.assist_choosable = !id.pilot.empty() && !live_->flight().recording;
   choices_.assist = !id.probe;
+  show_progress();
 }
 
 void LiveController::fly_scenario(std::size_t index) {
@@ -364,7 +373,7 @@ void LiveController::start() {
   live_->history.clear();  // the initial state shown while ready
   live_->rig->start();
   status_line_.say("");
-  if (history::HistoryStore* h = history_store()) live_->rig->remember(h, choices_.trainee, "window");
+  if (history_) live_->rig->remember(history_, choices_.trainee, "window");
 }
 
 void LiveController::handle(const ui::LiveRequest& r) {
@@ -420,7 +429,10 @@ void LiveController::handle(const ui::LiveRequest& r) {
             choices_.record = s.on;
             choices_.record_to = choices_.record ? next_record_path() : "";
           },
-          [&](const ui::SetTrainee& t) { choices_.trainee = t.name; },
+          [&](const ui::SetTrainee& t) {
+            choices_.trainee = t.name;
+            show_progress();
+          },
           [&](const ui::SetAssist& a) {
             // The unstarted flight is made again with the choice, as for a pilot.
             if (is_flying(*live_) || !choices_.assist_choosable) return;

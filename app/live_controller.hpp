@@ -46,7 +46,10 @@ class LiveController {
  public:
   // `o`: the command line's flight (scenario, pilot, --record, --report, ...); the input
   // settings and the gamepad are `input`'s.
-  LiveController(FlyOptions o, InputController& input, StatusLine& status);
+  // `history`: where flights are remembered and what the window shows of the history
+  // (nullptr: --history off); it outlives the controller.
+  LiveController(FlyOptions o, InputController& input, StatusLine& status,
+                 HistoryWriter* history);
   ~LiveController();
   LiveController(const LiveController&) = delete;
   LiveController& operator=(const LiveController&) = delete;
@@ -81,6 +84,9 @@ class LiveController {
   [[nodiscard]] int finish();
   // kExitError once a recording could not be completed, else kExitOk.
   int status() const { return status_; }
+  // What the history's writer did with a flight handed over: said on the status line (a
+  // failure once, however many flights it costs).
+  void history_outcome(const HistoryWriter::Outcome& o);
 
  private:
   // The flight's assembly (live_controller.cpp's first section).
@@ -92,16 +98,15 @@ class LiveController {
   void fly_scenario(std::size_t index);  // the next flight flies scenario_paths_[index]
   void refresh_choices();
   std::string next_record_path() const;
-  // The history the flights go into (SPEC §10), opened at the first start; nullptr with
-  // --history off or when it cannot be opened (said once on the status line).
-  history::HistoryStore* history_store();
   // A history failure, said on the status line once (the same failure again is not repeated).
   void history_problem(const std::string& why);
+  // The history's snapshot follows the session: the trainee and the scenario flown next.
+  void show_progress();
 
   FlyOptions options_;
-  std::unique_ptr<history::HistoryStore> history_;  // before live_: its rig writes to it
-  bool history_opened_ = false;
+  HistoryWriter* history_;  // outlives live_: its rig hands its row over at close
   std::string history_said_;
+  std::string shown_trainee_, shown_scenario_;  // what the snapshot was asked for
   InputController& input_;
   StatusLine& status_line_;
   std::unique_ptr<LiveFlight> live_;

@@ -16,6 +16,12 @@ class StatusLine {
     run_.message = std::move(message);
     run_.message_is_error = error;
   }
+  // Adds to what is said now ("recorded X; remembered ..."), unless that is an error, which
+  // stays until something replaces it.
+  void add(const std::string& more) {
+    if (run_.message_is_error) return;
+    run_.message = run_.message.empty() ? more : run_.message + "; " + more;
+  }
 
  private:
   ui::RunInfo& run_;

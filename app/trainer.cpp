@@ -4,7 +4,8 @@ namespace mixpilot::cli {
 
 Trainer::Trainer(FlyOptions o)
     : input_(o.input_settings, status_),
-      live_(o, input_, status_),
+      history_(o.history == "off" ? nullptr : std::make_unique<HistoryWriter>(o.history)),
+      live_(o, input_, status_, history_.get()),
       replay_(o.command, o.allow_mismatch, status_) {}
 
 bool Trainer::open_live(std::string& error, int& status) { return live_.open(error, status); }
@@ -29,6 +30,7 @@ void Trainer::build_frame(double wall_dt) {
                 wizard_.running());
   wizard_.update(input_.started(), input_.info().wizard);
   run_.input = &input_.info();
+  poll_history();
   if (replay_.is_open()) replay_.update(wall_dt, run_);
   else if (live_.flight()) live_.update(input_.info().connected, run_);
   requests_.clear();
@@ -63,6 +65,12 @@ void Trainer::act(const ui::Request& r) {
                    std::visit(ui::overloaded{
                                   [&](const ui::OpenFile& o) { open_file(o.path); },
                                   [&](const ui::LeaveReplay&) { leave_replay(); },
+                                  [&](const ui::ReplayRecording& p) {
+                                    // As File → Open of that recording.
+                                    std::string error;
+                                    if (open_replay(p.path, error)) ui_.show_progress = false;
+                                    else status_.say(error, true);
+                                  },
                               },
                               a);
                  },
@@ -78,6 +86,15 @@ void Trainer::open_file(const std::string& path) {
   }
   replay_.close();
   live_.open_scenario(path);
+}
+
+void Trainer::poll_history() {
+  if (!history_) return;
+  outcomes_.clear();
+  if (history_->poll(outcomes_))
+    for (const HistoryWriter::Outcome& o : outcomes_) live_.history_outcome(o);
+  history_view_ = history_->view();
+  run_.history = history_view_.get();
 }
 
 void Trainer::leave_replay() {

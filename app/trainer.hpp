@@ -6,9 +6,12 @@
 // (ui::RunInfo), the screen draws it, and each request the user made goes to the controller it
 // concerns. The window (app/window.cpp), the headless renderer and the tests drive the same
 // object.
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "app/flight.hpp"
+#include "app/history_writer.hpp"
 #include "app/input_controller.hpp"
 #include "app/live_controller.hpp"
 #include "app/replay_controller.hpp"
@@ -49,6 +52,7 @@ class Trainer {
   const ui::RunInfo& run_info() const { return run_; }
   const LiveFlight* live() const { return live_.flight(); }
   const ReplayTape* replay() const { return replay_.tape(); }
+  HistoryWriter* history() { return history_.get(); }
 
   // Stops the flight (closing its recording) and the replay; prints the summary, writes the
   // report; returns the exit status (kExitReplayMismatch for a replay that differs).
@@ -56,6 +60,7 @@ class Trainer {
 
  private:
   void open_file(const std::string& path);  // File → Open: a scenario or a recording
+  void poll_history();                       // the writer's outcomes and newest snapshot
   void leave_replay();
 
   // Declared before the controllers, which say things into it and outlive none of it.
@@ -63,6 +68,10 @@ class Trainer {
   StatusLine status_{run_};
   InputController input_;
   WizardController wizard_;
+  // Before live_: a flight closing hands its row to it (nullptr: --history off).
+  std::unique_ptr<HistoryWriter> history_;
+  std::vector<HistoryWriter::Outcome> outcomes_;   // polled each frame, capacity kept
+  std::shared_ptr<const ui::HistoryView> history_view_;  // the frame's (run_.history)
   LiveController live_;
   ReplayController replay_;
   ui::UiState ui_;

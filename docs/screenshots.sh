@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display
-# and the input settings panel at 1280x720 (an app test renders the panel).
+# and the input settings and Progress panels at 1280x720 (app tests render them). The flights
+# flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 m=${1:-build/release/app/mixpilot}
 out=docs/screenshots
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+export XDG_DATA_HOME="$tmp/data"
 "$m" fly --scenario scenarios/mi_helix.toml --pilot novice --headless --duration 8 \
   --screenshot 7.5:$out/mixed_initiative.png --size 800x450 --force >/dev/null
 # What a 150 % display (Xft.dpi 144) shows in a 1280x720 window.
@@ -19,8 +23,6 @@ out=docs/screenshots
 "$m" fly --scenario scenarios/obstacles_thrown_balls.toml --headless --duration 4 \
   --screenshot 3.5:$out/obstacles.png --size 800x450 --force >/dev/null
 # A replay: a recording of the reckless pilot shown at 6 s, with the timeline and its events.
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
 "$m" fly --scenario scenarios/mi_helix.toml --pilot reckless --headless --duration 12 \
   --record "$tmp/reckless.mcap" >/dev/null
 "$m" replay "$tmp/reckless.mcap" --headless --screenshot 6:$out/replay.png --size 800x450 \
@@ -30,9 +32,11 @@ printf 't,left_x,left_y,right_x,right_y\n0,0,0,0.3,0\n1.0,unplug\n' >"$tmp/unplu
 XDG_CONFIG_HOME="$tmp/config" "$m" fly --scenario scenarios/mi_helix.toml --pilot gamepad \
   --gamepad-script "$tmp/unplug.csv" --headless --realtime --duration 2 \
   --screenshot 1.6:$out/input_lost.png --size 800x450 --force >/dev/null
-# The input settings panel, from the app test that opens it (MIXPILOT_SHOT_DIR).
+# The input settings and Progress panels, from the app tests that open them (MIXPILOT_SHOT_DIR;
+# the Progress panel over a trainee's history the test makes in its own data folder).
 tests=$(dirname "$m")/../tests
 MIXPILOT_SHOT_DIR="$tmp" XDG_CONFIG_HOME="$tmp/config" "$tests/test_app" \
-  --gtest_filter=App.TheInputSettingsPanel >/dev/null
+  --gtest_filter='App.TheInputSettingsPanel:App.TheProgressPanel' >/dev/null
 cp "$tmp/input_settings.png" $out/input_settings.png
+cp "$tmp/progress.png" $out/progress.png
 ls -l $out

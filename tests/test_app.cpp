@@ -25,6 +25,7 @@
 #include "app/offscreen.hpp"
 #include "core/recording/replay.hpp"
 #include "app/trainer.hpp"
+#include "core/history/history.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "input/keyboard.hpp"
@@ -632,6 +633,80 @@ TEST_F(App, TheInputSettingsPanel) {
   EXPECT_FALSE(app.ui_state().show_settings);
 }
 
+// A trainee's history in the user's data folder: 14 flights of mi_helix (every fifth a probe),
+// the skill rising and D falling, as a learning pilot's would, the last ones recorded (files
+// that stand for their recordings); and a second trainee.
+void fill_history() {
+  std::string error;
+  auto store = history::open_history("", error);
+  ASSERT_TRUE(store) << error;
+  const std::filesystem::path recordings =
+      std::filesystem::path(std::getenv("XDG_DATA_HOME")) / "mixpilot" / "recordings";
+  std::filesystem::create_directories(recordings);
+  for (int i = 0; i < 14; ++i) {
+    history::FlightRecord f;
+    f.trainee = "Ada Lovelace";
+    f.station = "station-1";
+    f.scenario = "mi_helix";
+    f.scenario_hash = "0";
+    f.mode = "mixed_initiative";
+    f.pilot = "gamepad";
+    f.started_unix_ms = 1'714'000'000'000 + std::int64_t(i) * 86'400'000 / 3;
+    f.duration_s = 30.0;
+    f.probe = i % 5 == 4;
+    f.app_version = "mixpilot test";
+    f.front_end = "window";
+    const double skill = 35.0 + 3.2 * i + (i % 3 == 1 ? 4.0 : -2.0) - (f.probe ? 18.0 : 0.0);
+    f.metrics = {{"skill", skill}};
+    if (!f.probe) f.metrics.emplace_back("assistance_dependence", 0.62 - 0.035 * i);
+    if (i >= 9) {
+      f.recording_path = (recordings / ("mi_helix-" + std::to_string(i) + ".mcap")).string();
+      f.recording_hash = std::to_string(i);
+      std::ofstream(f.recording_path) << "";
+    }
+    ASSERT_TRUE(store->add(f, error)) << error;
+  }
+  history::FlightRecord other;
+  other.trainee = "Grace";
+  other.scenario = "mi_helix";
+  other.mode = "mixed_initiative";
+  other.front_end = "window";
+  ASSERT_TRUE(store->add(other, error)) << error;
+}
+
+// The Progress panel (H): the trainee picked, their flights of the scenario loaded off the UI
+// thread, drawn with the best run, the trend, and a table of the flights.
+TEST_F(App, TheProgressPanel) {
+  fresh_user_dirs("progress");
+  fill_history();
+  cli::Trainer app(live_options("mi_helix.toml", 2.0));
+  std::string error;
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  app.act(ui::LiveRequest{ui::SetTrainee{"Ada Lovelace"}});
+  const auto loaded = [&] {
+    const ui::HistoryView* h = app.run_info().history;
+    return h && h->loaded && h->progress.trainee == "Ada Lovelace" && !h->progress.flights.empty();
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!loaded() && std::chrono::steady_clock::now() < deadline) frame(app);
+  ASSERT_TRUE(loaded());
+  const ui::HistoryView& h = *app.run_info().history;
+  EXPECT_EQ(h.trainees, (std::vector<std::string>{"Ada Lovelace", "Grace"}));
+  EXPECT_EQ(h.progress.flights.size(), 14u);
+  EXPECT_EQ(h.progress.probes, 2);
+  EXPECT_GT(h.progress.assisted_trend.slope, 0.0);
+  key(app, ui::Key::h);
+  EXPECT_TRUE(app.ui_state().show_progress);
+  frame(app);
+  frame(app);
+  const ImGuiWindow* panel = ImGui::FindWindowByName("Progress (H)");
+  ASSERT_TRUE(panel && panel->Active);
+  save_shot(screen_, "progress");
+  key(app, ui::Key::escape);
+  EXPECT_FALSE(app.ui_state().show_progress);
+}
+
 // A broken settings file: the app starts with the defaults and says what is wrong, where.
 TEST_F(App, ABrokenSettingsFileGivesTheDefaultsAndSaysWhy) {
   fresh_user_dirs("broken_settings");
@@ -815,6 +890,7 @@ TEST_F(App, TheMappingWizardMakesAnUnknownJoystickAGamepad) {
 // MIXPILOT_SHOT_DIR set, each state is saved as layout_<state>_<W>x<H>_<percent>.png.
 TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
   fresh_user_dirs("layout");
+  fill_history();  // the session panel's picker and the Progress panel with a trainee's flights
   const std::string rec = record("mi_helix.toml", 3.0, "reckless", "layout.mcap");
   struct Display {
     int w, h;
@@ -847,10 +923,18 @@ TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
       cli::Trainer app(live_options("mi_helix.toml", 0.6));
       int status = 0;
       ASSERT_TRUE(app.open_live(error, status)) << error;
+      app.act(ui::LiveRequest{ui::SetTrainee{"Ada Lovelace"}});
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (!(app.run_info().history && !app.run_info().history->progress.flights.empty()) &&
+             std::chrono::steady_clock::now() < deadline)
+        frames(app, 1);
       frames(app);
       check("ready");
       press(app, ui::Key::f1);
       check("help");
+      press(app, ui::Key::escape);
+      press(app, ui::Key::h);
+      check("progress");
       press(app, ui::Key::escape);
       press(app, ui::Key::o, true);
       check("open");
@@ -863,8 +947,8 @@ TEST(AppLayout, NothingOverlapsOrIsCutAtAnyDisplayScale) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       frames(app);
       check("flying");
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-      while (!app.over() && std::chrono::steady_clock::now() < deadline) {
+      const auto over_by = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      while (!app.over() && std::chrono::steady_clock::now() < over_by) {
         frames(app, 1);
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }

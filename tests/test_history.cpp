@@ -20,6 +20,10 @@
 #include <vector>
 
 #include "app/flight_rig.hpp"
+#include "app/history_writer.hpp"
+#include "app/offscreen.hpp"
+#include "app/progress.hpp"
+#include "app/progress_html.hpp"
 #include "app/trainer.hpp"
 #include "core/history/content_hash.hpp"
 #include "core/history/history.hpp"
@@ -749,8 +753,16 @@ TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
   history::SqliteSettings s;
   s.busy_timeout_ms = 200;
   std::string error;
-  auto store = history::open_sqlite(db.string(), error, s);
-  ASSERT_TRUE(store) << error;
+  { ASSERT_TRUE(history::open_sqlite(db.string(), error, s)) << error; }
+  cli::HistoryWriter writer([&](std::string& why) { return history::open_sqlite(db.string(), why, s); });
+  // The writer's outcome of the flight just closed.
+  const auto outcome = [&] {
+    writer.wait_idle();
+    std::vector<cli::HistoryWriter::Outcome> out;
+    EXPECT_TRUE(writer.poll(out));
+    EXPECT_EQ(out.size(), 1u);
+    return out.empty() ? cli::HistoryWriter::Outcome{} : out.back();
+  };
   const auto fly = [&](const fs::path& rec) {
     cli::FlyOptions o;
     o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
@@ -761,7 +773,7 @@ TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
     auto rig = cli::FlightRig::assemble(o, why, status);
     EXPECT_TRUE(rig) << why;
     EXPECT_TRUE(rig->record(rec.string(), "Lena", {}, true, why)) << why;
-    rig->remember(store.get(), "Lena", "fly");
+    rig->remember(&writer, "Lena", "fly");
     rig->start();
     while (rig->step()) {
     }
@@ -773,12 +785,15 @@ TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
   const auto locked = fly(dir / "locked.mcap");
   EXPECT_EQ(locked.recorded, (dir / "locked.mcap").string());
   EXPECT_EQ(locked.error, "");
-  EXPECT_FALSE(locked.remembered);
-  EXPECT_NE(locked.history_error.find("locked"), std::string::npos) << locked.history_error;
+  EXPECT_TRUE(locked.remembering);
+  const auto locked_row = outcome();
+  EXPECT_FALSE(locked_row.remembered);
+  EXPECT_NE(locked_row.error.find("locked"), std::string::npos) << locked_row.error;
   sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
   sqlite3_close(holder);
-  const auto free = fly(dir / "free.mcap");
-  EXPECT_TRUE(free.remembered) << free.history_error;
+  (void)fly(dir / "free.mcap");
+  const auto free_row = outcome();
+  EXPECT_TRUE(free_row.remembered) << free_row.error;
   EXPECT_EQ(rows_in(db), 1);
   // A replay of it: the rig is given the store, and adds nothing.
   cli::FlyOptions o;
@@ -787,12 +802,13 @@ TEST(HistoryFrontEnds, ALockedHistoryCostsOnlyTheRow) {
   int status = 0;
   auto rig = cli::FlightRig::assemble(o, error, status);
   ASSERT_TRUE(rig) << error;
-  rig->remember(store.get(), "Lena", "fly");
+  rig->remember(&writer, "Lena", "fly");
   rig->start();
   while (rig->step()) {
   }
   const auto replayed = rig->close(false);
-  EXPECT_FALSE(replayed.remembered);
+  EXPECT_FALSE(replayed.remembering);
+  writer.wait_idle();
   EXPECT_EQ(rows_in(db), 1);
 }
 
@@ -844,6 +860,226 @@ TEST(HistoryFrontEnds, TheWindowsLiveFlightIsRememberedOnce) {
   EXPECT_NEAR(rows[0].duration_s, 1.5, 0.02);
   EXPECT_EQ(rows[0].recording_path, o.record);
   EXPECT_EQ(rows[0].recording_hash, *history::sha256_file(o.record, error));
+}
+
+// ---- The history's thread, the window's view of it, the report --------------------------------
+
+// The window with another program holding the history locked: a flight closes and its row
+// waits on the writer's thread while every frame is drawn in time; once the lock is gone the
+// row lands and the status line says so.
+TEST(HistoryWindow, ALockedHistoryNeverStallsAFrame) {
+  const fs::path home = fresh_home("window_locked");
+  setenv("XDG_CONFIG_HOME", (home / "config").c_str(), 1);
+  setenv("XDG_DATA_HOME", (home / "data").c_str(), 1);
+  const fs::path db = default_history(home);
+  std::string error;
+  { ASSERT_TRUE(history::open_sqlite(db.string(), error)) << error; }
+  cli::Offscreen screen;
+  if (!screen.open(640, 360, error)) GTEST_SKIP() << "no EGL device: " << error;
+  cli::FlyOptions o;
+  o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+  o.pilot = "novice";
+  o.duration = 1.0;
+  o.record = (home / "w.mcap").string();
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &holder), SQLITE_OK);
+  cli::Trainer app(o);
+  int status = 0;
+  ASSERT_TRUE(app.open_live(error, status)) << error;
+  app.act(ui::LiveRequest{ui::SetTrainee{"Ada"}});
+  double longest = 0.0;
+  const auto frame = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    screen.frame([&] { app.build_frame(1.0 / 60.0); });
+    longest = std::max(longest, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  };
+  for (int i = 0; i < 5; ++i) screen.frame([&] { app.build_frame(1.0 / 60.0); });  // fonts, first layout
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  app.start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!app.over() && std::chrono::steady_clock::now() < deadline) frame();
+  ASSERT_TRUE(app.over());
+  // The row waits for the lock (the store's busy timeout is 5 s): frames go on meanwhile.
+  const auto held_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
+  while (std::chrono::steady_clock::now() < held_until) frame();
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM flights"), 0);  // WAL: a reader is not blocked
+  EXPECT_EQ(app.run_info().message.find("remembered"), std::string::npos) << app.run_info().message;
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  const auto landed = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (app.run_info().message.find("remembered") == std::string::npos &&
+         std::chrono::steady_clock::now() < landed)
+    frame();
+  EXPECT_NE(app.run_info().message.find("remembered in the history (Ada, "), std::string::npos)
+      << app.run_info().message;
+  EXPECT_EQ(rows_in(db), 1);
+  EXPECT_LT(longest, 0.050) << "a frame took " << longest * 1e3 << " ms";
+  testing::internal::CaptureStdout();
+  (void)app.finish();
+  testing::internal::GetCapturedStdout();
+}
+
+// The writer past the store's busy timeout: each flight's outcome says why, and the window's
+// status line says it once however many flights it costs.
+TEST(HistoryWriter, ALockedHistoryIsSaidOnce) {
+  const fs::path dir = test::fresh_path("history", "writer_locked");
+  fs::create_directories(dir);
+  const fs::path db = dir / "h.sqlite";
+  history::SqliteSettings s;
+  s.busy_timeout_ms = 100;
+  std::string error;
+  { ASSERT_TRUE(history::open_sqlite(db.string(), error, s)) << error; }
+  sqlite3* holder = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &holder), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(holder, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  cli::HistoryWriter writer([&](std::string& why) { return history::open_sqlite(db.string(), why, s); });
+  writer.remember(sample_flight("Ada", 1), "");
+  writer.remember(sample_flight("Ada", 2), "");
+  writer.wait_idle();
+  std::vector<cli::HistoryWriter::Outcome> out;
+  ASSERT_TRUE(writer.poll(out));
+  ASSERT_EQ(out.size(), 2u);
+  for (const auto& o : out) {
+    EXPECT_FALSE(o.remembered);
+    EXPECT_NE(o.error.find("locked"), std::string::npos) << o.error;
+  }
+  EXPECT_FALSE(writer.poll(out)) << "outcomes are handed over once";
+  // The window's status line: the same failure twice is said once.
+  ui::RunInfo run;
+  cli::StatusLine status(run);
+  cli::FlyOptions fo;
+  cli::InputController input("", status);
+  cli::LiveController live(fo, input, status, &writer);
+  live.history_outcome(out[0]);
+  const std::string said = run.message;
+  EXPECT_NE(said.find("history: "), std::string::npos) << said;
+  status.say("recorded x.mcap");
+  live.history_outcome(out[1]);
+  EXPECT_EQ(run.message, "recorded x.mcap") << "said twice";
+  sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_close(holder);
+  // Once the lock is gone the next flight lands.
+  writer.remember(sample_flight("Ada", 3), "");
+  writer.wait_idle();
+  out.clear();
+  ASSERT_TRUE(writer.poll(out));
+  EXPECT_TRUE(out.back().remembered) << out.back().error;
+}
+
+// The session panel's picker: the trainees the history knows, loaded on the writer's thread
+// into the snapshot, and the chosen trainee's progress on the chosen scenario.
+TEST(HistoryWriter, TheSnapshotHoldsTheTraineesAndTheProgress) {
+  const fs::path dir = test::fresh_path("history", "writer_view");
+  fs::create_directories(dir);
+  const fs::path db = dir / "h.sqlite";
+  cli::HistoryWriter writer(db.string());
+  writer.show("Bo", "mi_helix");
+  writer.wait_idle();
+  ASSERT_TRUE(writer.view());
+  EXPECT_TRUE(writer.view()->trainees.empty());
+  EXPECT_FALSE(fs::exists(db)) << "showing the history created it";
+  for (const char* who : {"Zoë", "Bo", "Ada", "Bo"}) writer.remember(sample_flight(who, std::rand()), "");
+  writer.wait_idle();
+  const auto v = writer.view();
+  ASSERT_TRUE(v);
+  EXPECT_EQ(v->trainees, (std::vector<std::string>{"Ada", "Bo", "Zoë"}));
+  EXPECT_EQ(v->progress.trainee, "Bo");
+  EXPECT_EQ(v->progress.flights.size(), 2u);
+  EXPECT_EQ(v->progress.error, "");
+}
+
+history::StoredFlight attempt(int i, double skill, bool probe, double d = NAN) {
+  history::StoredFlight f;
+  static_cast<FlightRecord&>(f) = sample_flight("Ada", 1'700'000'000'000 + i * 60'000);
+  f.id = i + 1;
+  f.probe = probe;
+  f.metrics = {{"skill", skill}};
+  if (!std::isnan(d)) f.metrics.emplace_back("assistance_dependence", d);
+  return f;
+}
+
+// The Progress panel's numbers: the trend's sign and words, the best run, D only where rows
+// have it.
+TEST(HistoryProgress, TrendSignAndBestRun) {
+  std::vector<history::StoredFlight> rows;
+  for (int i = 0; i < 12; ++i) rows.push_back(attempt(i, 40.0 + 3.0 * i + (i % 2 ? 2.0 : -2.0), false, 0.6 - 0.04 * i));
+  rows.push_back(attempt(12, 30.0, true));
+  rows.push_back(attempt(13, 20.0, true));
+  rows.push_back(attempt(14, 10.0, true));
+  const ui::ProgressView v = cli::progress_view(rows, "Ada", "mi_helix", false);
+  EXPECT_EQ(v.assisted, 12);
+  EXPECT_EQ(v.probes, 3);
+  EXPECT_GT(v.assisted_trend.slope, 2.0);
+  EXPECT_EQ(v.assisted_trend.over, cli::kTrendAttempts);
+  EXPECT_TRUE(v.assisted_trend.words.starts_with("rising")) << v.assisted_trend.words;
+  EXPECT_LT(v.probe_trend.slope, 0.0);
+  EXPECT_TRUE(v.probe_trend.words.starts_with("falling")) << v.probe_trend.words;
+  EXPECT_EQ(v.best, 11);  // 40 + 33 + 2
+  EXPECT_NEAR(v.flights[11].skill, 75.0, 1e-9);
+  EXPECT_TRUE(v.has_dependence);
+  EXPECT_TRUE(std::isnan(v.flights[12].dependence));
+  // Too few for a trend; no D anywhere.
+  const ui::ProgressView few = cli::progress_view({attempt(0, 50, false), attempt(1, 60, false)},
+                                                  "Ada", "mi_helix", false);
+  EXPECT_TRUE(std::isnan(few.assisted_trend.slope));
+  EXPECT_TRUE(few.assisted_trend.words.starts_with("no trend yet")) << few.assisted_trend.words;
+  EXPECT_FALSE(few.has_dependence);
+  EXPECT_EQ(few.best, 1);
+  const std::vector<double> flat = {5, 5, 5, 5};
+  EXPECT_NEAR(*cli::least_squares_slope(flat), 0.0, 1e-12);
+  const std::vector<double> line = {1, 3, 5, 7};
+  EXPECT_NEAR(*cli::least_squares_slope(line), 2.0, 1e-12);
+}
+
+// The report to take home: every string from the database escaped, nothing fetched from
+// anywhere, a curve per scenario.
+TEST(HistoryHtml, EscapesEveryStringAndFetchesNothing) {
+  const std::string evil = "<script>alert(\"x\")</script> & 'O'Brien'";
+  std::vector<history::StoredFlight> rows;
+  for (int i = 0; i < 4; ++i) {
+    auto f = attempt(i, 50.0 + i, i == 3, 0.5);
+    f.trainee = evil;
+    f.scenario = i < 2 ? "<b>bold</b>" : "mi_helix";
+    f.recording_path = "/tmp/\"quoted\" & <odd>.mcap";
+    rows.push_back(f);
+  }
+  const std::string html = cli::progress_html(evil, rows, 1'700'000'000'000);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("<b>"), std::string::npos);
+  EXPECT_EQ(html.find("<odd>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt; &amp; &#39;O&#39;Brien&#39;"),
+            std::string::npos);
+  EXPECT_NE(html.find("/tmp/&quot;quoted&quot; &amp; &lt;odd&gt;.mcap"), std::string::npos);
+  for (const char* fetch : {"src=", "href=", "<link", "@import", "url(", "https:"})
+    EXPECT_EQ(html.find(fetch), std::string::npos) << fetch;
+  EXPECT_EQ(count_of(html, "<svg"), 2);
+  EXPECT_EQ(count_of(html, "<section>"), 2);
+  EXPECT_NE(html.find("@media print"), std::string::npos);
+  EXPECT_EQ(cli::html_escape("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
+}
+
+// `history --html`: written through the outputs' rules (never replaced without --force), and
+// only for one trainee.
+TEST(HistoryHtml, TheCommandWritesOneFileAndNeverClobbers) {
+  const fs::path home = fresh_home("html");
+  const fs::path db = home / "h.sqlite", out = home / "ada.html";
+  {
+    auto store = open_store(db);
+    ASSERT_TRUE(store);
+    std::string error;
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(store->add(sample_flight("Ada <3", 1'700'000'000'000 + i), error)) << error;
+  }
+  const std::string base = "history --history " + db.string() + " --trainee 'Ada <3' --html " + out.string();
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, base, home), 0) << test::read_file(home / "out.txt");
+  const std::string html = test::read_file(out);
+  EXPECT_NE(html.find("Progress report: Ada &lt;3"), std::string::npos);
+  EXPECT_EQ(count_of(html, "<tr>") + count_of(html, "<tr class"), 4);  // the header and 3 flights
+  EXPECT_NE(test::run_mixpilot(kMixpilot, base, home), 0);
+  EXPECT_NE(test::read_file(home / "out.txt").find("exists"), std::string::npos)
+      << test::read_file(home / "out.txt");
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, base + " --force", home), 0);
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history --history " + db.string() + " --html " +
+                                              (home / "x.html").string(), home), 2);
 }
 
 }  // namespace

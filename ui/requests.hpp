@@ -85,7 +85,10 @@ struct OpenFile {
   std::string path;               // a scenario (.toml) or a recording (.mcap)
 };
 struct LeaveReplay {};            // back to the live flight (Esc)
-using AppRequest = std::variant<OpenFile, LeaveReplay>;
+struct ReplayRecording {          // a flight of the Progress panel: its recording, replayed
+  std::string path;
+};
+using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording>;
 
 // Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
 using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;

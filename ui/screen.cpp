@@ -390,11 +390,12 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"mouse drag, wheel", "orbit the arena, zoom"},
       {"D", "show / hide the sticks"},
       {"P", "pause / resume the plots"},
+      {"H", "progress: this trainee's flights of this scenario, best run, trend"},
       {"Left / Right", "replay: step 100 ms (Shift 10 ms, Alt 500 ms)"},
       {"Home / End", "replay: start / end"},
       {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
       {"[  ]", "replay: previous / next event"},
-      {"Esc", "leave the replay; close this sheet"},
+      {"Esc", "leave the replay; close this sheet or the progress"},
       {"F1  ?", "this sheet"},
   };
   std::vector<const char*> what;
@@ -458,6 +459,7 @@ void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
     return;
   }
   if (key_pressed(Key::escape) && ui.show_help) ui.show_help = false;
+  else if (key_pressed(Key::escape) && ui.show_progress) ui.show_progress = false;
   else if (run.replay) replay_keys(run, out);
   else if (key_pressed(Key::escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
   // Space is the transport's: a replay plays or pauses, a live flight starts, pauses or resumes.
@@ -478,6 +480,7 @@ void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
     ui.draft_loaded = false;
   }
   if (key_pressed(Key::p)) set_plots_paused(ui, h, !ui.plots_paused);
+  if (key_pressed(Key::h)) ui.show_progress = !ui.show_progress;
 }
 
 }  // namespace
@@ -654,6 +657,15 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   if (run.metrics.empty()) ui.score_card_closed = false;
   else if (!ui.score_card_closed) score_card(run, ui, d);
   if (ui.show_help) help_sheet(ui, d);
+  if (ui.show_progress) {
+    static const HistoryView kOff = [] {
+      HistoryView v;
+      v.loaded = true;
+      v.progress.error = "no history: this window was opened with --history off";
+      return v;
+    }();
+    draw_progress_panel(run.history ? *run.history : kOff, ui.show_progress, d, out);
+  }
   draw_input_banner(h, run, frame, vmax);
   draw_input_settings(run, ui, out);
   draw_mapping_wizard(run, out);

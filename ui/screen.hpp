@@ -15,6 +15,7 @@
 #include "input/mapping_wizard.hpp"
 #include "input/settings.hpp"
 #include "ui/keys.hpp"
+#include "ui/progress.hpp"
 #include "ui/requests.hpp"
 #include "ui/scene.hpp"
 
@@ -113,6 +114,7 @@ struct RunInfo {
   const SessionChoices* session = nullptr;  // the session panel (nullptr: none, e.g. headless)
   const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
+  const HistoryView* history = nullptr;     // trainees and progress (nullptr: no history)
 };
 
 // What a field of a mode's report means, with its unit ("" for a field it does not know).
@@ -145,6 +147,7 @@ struct UiState {
   double plot_window = 10.0;  // [s]
   bool show_sticks = true;
   bool show_help = false;      // the shortcut sheet (F1, ?)
+  bool show_progress = false;  // the Progress panel (H)
   bool score_card_closed = false;
   OpenDialog open_dialog;
   char trainee[64] = "";

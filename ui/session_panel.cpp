@@ -27,6 +27,40 @@ bool combo(const char* label, const std::vector<std::string>& items, int current
   return changed;
 }
 
+// The trainee: typed (a new name), or picked from those the history knows (the arrow).
+void trainee_field(const RunInfo& run, UiState& ui, float fields, Requests& out) {
+  const SessionChoices& c = *run.session;
+  const std::vector<std::string>* known = run.history ? &run.history->trainees : nullptr;
+  const bool pick = known && !known->empty();
+  const float arrow = pick ? ImGui::GetFrameHeight() : 0.0f;
+  ImGui::SetNextItemWidth(fields - arrow);
+  if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())
+    std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
+  ImGui::InputTextWithHint(pick ? "##trainee" : "trainee", "your name", ui.trainee,
+                           sizeof ui.trainee);
+  if (ImGui::IsItemDeactivatedAfterEdit()) out.push_back(SetTrainee{ui.trainee});
+  if (ImGui::IsItemHovered() && !ImGui::IsItemActive())
+    ImGui::SetTooltip(pick ? "Who flies: type a new name, or pick one the history knows (the "
+                             "arrow). Each flight is remembered under it."
+                           : "Who flies: each flight is remembered under this name (empty: your "
+                             "login name).");
+  if (!pick) return;
+  ImGui::SameLine(0.0f, 0.0f);
+  if (ImGui::BeginCombo("##trainees", nullptr,
+                        ImGuiComboFlags_NoPreview | ImGuiComboFlags_PopupAlignLeft)) {
+    for (const std::string& name : *known) {
+      if (ImGui::Selectable(name.c_str(), name == c.trainee)) {
+        std::snprintf(ui.trainee, sizeof ui.trainee, "%s", name.c_str());
+        out.push_back(SetTrainee{name});
+      }
+    }
+    ImGui::EndCombo();
+  }
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Pick a trainee the history knows");
+  ImGui::SameLine(0.0f, ImGui::GetStyle().ItemInnerSpacing.x);
+  ImGui::TextUnformatted("trainee");
+}
+
 }  // namespace
 
 void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
@@ -57,11 +91,13 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
     ui.draft_loaded = false;
   }
   if (ImGui::Button("Open file... (Ctrl+O)")) ui.open_dialog.open = true;
-  ImGui::SetNextItemWidth(fields);
-  if (ui.trainee[0] == '\0' && !c.trainee.empty() && !ImGui::IsAnyItemActive())
-    std::snprintf(ui.trainee, sizeof ui.trainee, "%s", c.trainee.c_str());
-  ImGui::InputTextWithHint("trainee", "your name", ui.trainee, sizeof ui.trainee);
-  if (ImGui::IsItemDeactivatedAfterEdit()) out.push_back(SetTrainee{ui.trainee});
+  if (run.history) {
+    same_line_or_wrap(button_width("Progress (H)"));
+    if (ImGui::Button("Progress (H)")) ui.show_progress = !ui.show_progress;
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("This trainee's flights of this scenario: skill per attempt, best run, trend");
+  }
+  trainee_field(run, ui, fields, out);
   if (c.assist_choosable) {
     bool assist = c.assist;
     if (ImGui::Checkbox("assistance", &assist)) out.push_back(SetAssist{assist});

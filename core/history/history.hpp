@@ -37,6 +37,10 @@ struct Query {
   std::string trainee, scenario;
   std::int64_t since_unix_ms = 0;
   std::int64_t limit = 0;
+  // The score fields wanted (empty: all of them, in the report's order; else those of them a
+  // flight has, in no set order). A listing that shows one field need not read twenty per
+  // flight; a backend may return more than asked.
+  std::vector<std::string> metrics;
 };
 
 class HistoryStore {

@@ -20,7 +20,7 @@ namespace mixpilot::history {
 enum class Dialect { sqlite, postgresql };
 
 // The schema this build writes and reads.
-inline constexpr int kSchemaVersion = 1;
+inline constexpr int kSchemaVersion = 2;
 
 inline constexpr const char* kCreateVersionTable =
     "CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL PRIMARY KEY, "

@@ -274,13 +274,16 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       " FROM flights f JOIN trainees t ON t.id = f.trainee_id"
       " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
       " AND f.started_unix_ms >= ?3";
+  static constexpr const char* kColumns =
+      "SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, f.pilot, "
+      "f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, f.probe, "
+      "f.recording_path, f.recording_hash, f.app_version, f.front_end";
+  // Without a limit the start-time index gives the order as it is: no sort of every row.
   const std::string flights_sql =
-      std::string("SELECT * FROM (SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, "
-                  "f.mode, f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, "
-                  "f.duration_s, f.ended, f.probe, f.recording_path, f.recording_hash, "
-                  "f.app_version, f.front_end") +
-      kFilter + " ORDER BY f.started_unix_ms DESC, f.id DESC LIMIT ?4)" +
-      " ORDER BY started_unix_ms, id";
+      q.limit > 0 ? std::string("SELECT * FROM (") + kColumns + kFilter +
+                        " ORDER BY f.started_unix_ms DESC, f.id DESC LIMIT ?4)" +
+                        " ORDER BY started_unix_ms, id"
+                  : std::string(kColumns) + kFilter + " ORDER BY f.started_unix_ms, f.id";
   if (!exec("BEGIN", error, "cannot read the history")) return false;
   const auto bind_filter = [&](sqlite3_stmt* s) {
     bind_text(s, 1, q.trainee);
@@ -291,7 +294,7 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
     Stmt s;
     if (!prepare(s, flights_sql.c_str(), error)) return rollback(), false;
     bind_filter(s.get());
-    sqlite3_bind_int64(s.get(), 4, q.limit > 0 ? q.limit : -1);  // -1: no limit
+    if (q.limit > 0) sqlite3_bind_int64(s.get(), 4, q.limit);
     int rc;
     while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
       sqlite3_stmt* p = s.get();
@@ -328,18 +331,30 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       at.emplace(out[i].id, i);
       first = std::min(first, out[i].id);
     }
-    // The metrics of the same filter (those of flights past the limit are skipped by id).
+    // The metrics of the same filter (those of flights past the limit are skipped by id), only
+    // the names asked for when some are.
+    // Every metric: read in the metrics' own order. Some: looked up flight by flight through
+    // the (flight, name) index, not found among every flight's twenty.
+    std::string sql;
+    if (q.metrics.empty()) {
+      sql = "SELECT m.flight_id, m.name, m.value FROM metrics m"
+            " JOIN flights f ON f.id = m.flight_id JOIN trainees t ON t.id = f.trainee_id"
+            " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
+            " AND f.started_unix_ms >= ?3 AND f.id >= ?4 ORDER BY m.flight_id, m.position";
+    } else {
+      // A range of the (name, flight, value) index per name; flights the filter left out are
+      // skipped below, so the filter need not be joined again.
+      // (?1 to ?3, the filter's, are bound below but unused here.)
+      sql = "SELECT m.flight_id, m.name, m.value FROM metrics m WHERE m.flight_id >= ?4"
+            " AND m.name IN (";
+      for (std::size_t i = 0; i < q.metrics.size(); ++i) sql += i ? ", ?" : "?";  // ?5, ?6, ...
+      sql += ")";
+    }
     Stmt s;
-    if (!prepare(s,
-                 "SELECT m.flight_id, m.name, m.value FROM metrics m"
-                 " JOIN flights f ON f.id = m.flight_id JOIN trainees t ON t.id = f.trainee_id"
-                 " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
-                 " AND f.started_unix_ms >= ?3 AND f.id >= ?4"
-                 " ORDER BY m.flight_id, m.position",
-                 error))
-      return rollback(), false;
+    if (!prepare(s, sql.c_str(), error)) return rollback(), false;
     bind_filter(s.get());
     sqlite3_bind_int64(s.get(), 4, first);
+    for (std::size_t i = 0; i < q.metrics.size(); ++i) bind_text(s.get(), int(5 + i), q.metrics[i]);
     int rc;
     while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
       const auto it = at.find(sqlite3_column_int64(s.get(), 0));

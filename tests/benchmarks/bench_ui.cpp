@@ -14,7 +14,36 @@
 namespace mixpilot {
 namespace {
 
-void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera) {
+// A trainee's 50 flights of a scenario, as the Progress panel shows them.
+ui::HistoryView progress_of_50() {
+  ui::HistoryView v;
+  v.loaded = true;
+  v.trainees = {"Ada", "Bo", "Zoë"};
+  ui::ProgressView& p = v.progress;
+  p.trainee = "Ada";
+  p.scenario = "mi_helix";
+  for (int i = 0; i < 50; ++i) {
+    ui::ProgressFlight f;
+    f.attempt = i + 1;
+    f.probe = i % 5 == 4;
+    f.skill = 30.0 + i + (i % 3) * 4.0 - (f.probe ? 15.0 : 0.0);
+    f.dependence = f.probe ? ui::kNoValue : 0.7 - 0.01 * i;
+    f.duration_s = 30.0;
+    f.when = "2024-05-01 14:03";
+    f.ended = "completed";
+    f.recording = "/home/ada/.local/share/mixpilot/recordings/mi_helix-2024.mcap";
+    (f.probe ? p.probes : p.assisted)++;
+    p.flights.push_back(f);
+  }
+  p.best = 47;
+  p.has_dependence = true;
+  p.assisted_trend = {10, 1.1, "rising: +1.1 skill per attempt over the last 10 assisted flights"};
+  p.probe_trend = {10, 1.0, "rising: +1.0 skill per attempt over the last 10 probe flights"};
+  return v;
+}
+
+// `progress`: the Progress panel open over the flight (the same frame otherwise).
+void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera, bool progress) {
   ModeRequest request;
   request.duration = 5.0;
   std::string error;
@@ -43,6 +72,11 @@ void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera
   st.camera = camera;
   ui::RunInfo run;
   run.state = ui::RunState::flying;
+  const ui::HistoryView view = progress_of_50();
+  if (progress) {
+    run.history = &view;
+    st.show_progress = true;
+  }
   ui::Requests requests;
   for (auto _ : state) {
     requests.clear();
@@ -50,13 +84,15 @@ void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera
   }
 }
 
-BENCHMARK_CAPTURE(BM_UiFrame, mi_chase, "mi_helix.toml", ui::Camera::chase)
+BENCHMARK_CAPTURE(BM_UiFrame, mi_chase, "mi_helix.toml", ui::Camera::chase, false)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_UiFrame, mi_orbit, "mi_helix.toml", ui::Camera::orbit)
+BENCHMARK_CAPTURE(BM_UiFrame, mi_orbit, "mi_helix.toml", ui::Camera::orbit, false)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_UiFrame, pendubot, "pendubot_swingup.toml", ui::Camera::chase)
+BENCHMARK_CAPTURE(BM_UiFrame, pendubot, "pendubot_swingup.toml", ui::Camera::chase, false)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_UiFrame, obstacles, "obstacles_thrown_balls.toml", ui::Camera::chase)
+BENCHMARK_CAPTURE(BM_UiFrame, obstacles, "obstacles_thrown_balls.toml", ui::Camera::chase, false)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_UiFrame, mi_chase_progress, "mi_helix.toml", ui::Camera::chase, true)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

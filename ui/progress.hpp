@@ -1,0 +1,61 @@
+#pragma once
+// The trainee's progress as the window shows it (SPEC §10): plain snapshot structs, filled by
+// the app from the history off the UI thread (app/history_writer.hpp), and the Progress panel
+// that draws one. ui/ never reads the history itself: a frame only draws what was loaded.
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+
+#include "ui/requests.hpp"
+
+namespace mixpilot::ui {
+
+inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
+
+// One flight of the trainee on the scenario, its texts formatted when loaded (a frame formats
+// only numbers, into fixed buffers).
+struct ProgressFlight {
+  int attempt = 0;                 // 1, 2, ...: its place among the trainee's flights of it
+  bool probe = false;              // unassisted: the pilot's own skill
+  double skill = kNoValue;         // 0-100
+  double dependence = kNoValue;    // D, the share of the flight the planner flew (0-1)
+  double duration_s = 0.0;
+  std::string when;                // local time, "YYYY-MM-DD HH:MM"
+  std::string ended;               // completed | interrupted | lost
+  std::string recording;           // its recording ("" none, or no longer on this disk)
+};
+
+// A least-squares line through the last `over` skills of one kind of flight.
+struct Trend {
+  int over = 0;                    // flights it was fitted to (< 3: no trend)
+  double slope = kNoValue;         // skill per attempt
+  std::string words;               // what it means, for a newcomer
+};
+
+struct ProgressView {
+  std::string trainee, scenario;
+  std::vector<ProgressFlight> flights;  // oldest first
+  int assisted = 0, probes = 0;
+  int best = -1;                   // index into flights: the highest skill
+  bool has_dependence = false;     // some flight's row holds D
+  Trend assisted_trend, probe_trend;
+  std::string error;               // why the history could not be read ("" fine)
+};
+
+// What the app knows of the history: its trainees (the session panel's picker) and the progress
+// of the chosen trainee on the chosen scenario. Immutable once published.
+struct HistoryView {
+  bool loaded = false;             // false until the first load finished
+  std::vector<std::string> trainees;  // sorted
+  ProgressView progress;
+};
+
+// The Progress panel (ui.show_progress, H): skill per attempt (assisted and probe flights), D,
+// the best run, the trend, the last flights with a button that replays a recording
+// (ReplayRecording). `open` is cleared when the user closes it.
+void draw_progress_panel(const HistoryView& h, bool& open, ImVec2 display, Requests& out);
+
+}  // namespace mixpilot::ui
