@@ -128,7 +128,7 @@ std::string table_minutes(std::int64_t unix_ms) {
     localtime_r(&t, &start);
   }
   const int minutes = start.tm_min + int((s - b * 900) / 60);
-  char text[32];
+  char text[64];  // room for any int the compiler can imagine in each field
   std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d", start.tm_year + 1900,
                 start.tm_mon + 1, start.tm_mday, start.tm_hour, minutes);
   return text;
