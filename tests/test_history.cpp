@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <functional>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <thread>
 #include <string>
 #include <vector>
@@ -285,6 +287,31 @@ TEST(HistoryStore, HostileTraineeNames) {
   }
   EXPECT_EQ(all(*store).size(), stored.size());  // the tables are all still there
   EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
+}
+
+// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
+// row) is brought forward on open; its flights stay.
+TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
+  const fs::path p = test::fresh_path("history", "migrate.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  std::string error;
+  ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+  store.reset();
+  ASSERT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DELETE FROM schema_version "
+                             "WHERE version > 1", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  ASSERT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), 1);
+  store = open_store(p);
+  ASSERT_TRUE(store);
+  EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  test::expect_same_flight(sample_flight(), rows[0]);
 }
 
 // A newer mixpilot's history is refused with the reason and left as it was, byte for byte.
@@ -670,6 +697,89 @@ TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
   EXPECT_NE(csv.find(",metrics.skill"), std::string::npos) << csv;
   ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --trainee nobody", home), 0);
   EXPECT_NE(test::read_file(home / "out.txt").find("0 flights"), std::string::npos);
+}
+
+// A learning curve that means something: one trainee flies the helix five times as the novice
+// profile, then five times as the experienced one (each attempt with its own position noise, so
+// no two flights are alike), and a probe of each. What `history --json` gives back shows the
+// skill rising and the assistance dependence D falling, each probe marked as one and scoring
+// below the assisted flights of its pilot; the Progress panel's trend says the same.
+TEST(HistoryLearningCurve, TheSkillRisesAndTheDependenceFalls) {
+  const fs::path home = fresh_home("learning_curve");
+  const std::string helix = test::read_file(kSrc + "/scenarios/mi_helix.toml");
+  const auto fly = [&](const std::string& pilot, int seed, bool probe) {
+    std::string toml = helix;
+    const auto set = [&](const std::string& from, const std::string& to) {
+      const std::size_t at = toml.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      toml.replace(at, from.size(), to);
+    };
+    set("\nposition_noise = 0.0", "\nposition_noise = 0.01");
+    set("\nseed = 1", "\nseed = " + std::to_string(seed));
+    const fs::path scenario = home / ("helix_" + std::to_string(seed) + ".toml");
+    std::ofstream(scenario) << toml;
+    ASSERT_EQ(test::run_mixpilot(kMixpilot,
+                                 "fly --scenario " + scenario.string() + " --pilot " + pilot +
+                                     " --headless --duration 15 --trainee Grace" +
+                                     (probe ? " --assist off" : ""),
+                                 home),
+              0)
+        << test::read_file(home / "out.txt");
+  };
+  for (int seed = 1; seed <= 5; ++seed) fly("novice", seed, false);
+  for (int seed = 6; seed <= 10; ++seed) fly("experienced", seed, false);
+  fly("novice", 11, true);
+  fly("experienced", 12, true);
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history --trainee Grace --json", home), 0);
+
+  // One flight per line of the JSON array, oldest first.
+  struct Row { std::string pilot; bool probe; double skill, d; };
+  std::vector<Row> rows;
+  std::istringstream json(test::read_file(home / "out.txt"));
+  for (std::string line; std::getline(json, line);) {
+    if (line.find("\"trainee\": \"Grace\"") == std::string::npos) continue;
+    const auto numbers = test::numbers(line);
+    const bool probe = line.find("\"probe\": true") != std::string::npos;
+    const std::string pilot = line.find("\"pilot\": \"novice\"") != std::string::npos ? "novice"
+                                                                                     : "experienced";
+    rows.push_back({pilot, probe, numbers.at("skill"), numbers.at("assistance_dependence")});
+  }
+  ASSERT_EQ(rows.size(), 12u) << test::read_file(home / "out.txt");
+  std::vector<double> skill, d;
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(rows[i].pilot, i < 5 ? "novice" : "experienced") << i;
+    EXPECT_FALSE(rows[i].probe) << i;
+    skill.push_back(rows[i].skill);
+    d.push_back(rows[i].d);
+  }
+  // Rising and falling: every experienced attempt above (below) every novice one, and the
+  // least-squares line through the ten attempts with the right sign.
+  EXPECT_GT(*std::min_element(skill.begin() + 5, skill.end()),
+            *std::max_element(skill.begin(), skill.begin() + 5));
+  EXPECT_LT(*std::max_element(d.begin() + 5, d.end()), *std::min_element(d.begin(), d.begin() + 5));
+  EXPECT_GT(*cli::least_squares_slope(skill), 0.0);
+  EXPECT_LT(*cli::least_squares_slope(d), 0.0);
+  // The noise makes attempts differ: a curve, not two repeated flights.
+  EXPECT_NE(skill[0], skill[1]);
+  EXPECT_NE(skill[5], skill[6]);
+  // The probes: marked, D = 0, each below every assisted flight of its pilot.
+  for (const int i : {10, 11}) {
+    EXPECT_TRUE(rows[i].probe) << i;
+    EXPECT_EQ(rows[i].d, 0.0) << i;
+    const auto first = skill.begin() + (i == 10 ? 0 : 5);
+    EXPECT_LT(rows[i].skill, *std::min_element(first, first + 5)) << rows[i].pilot;
+  }
+  // The Progress panel's view of the same rows: ten assisted attempts, two probes, a rising trend.
+  std::string error;
+  auto store = history::open_sqlite(default_history(home).string(), error);
+  ASSERT_TRUE(store) << error;
+  const ui::ProgressView v = cli::progress_view(all(*store), "Grace", "mi_helix", false);
+  EXPECT_EQ(v.assisted, 10);
+  EXPECT_EQ(v.probes, 2);
+  EXPECT_GT(v.assisted_trend.slope, 0.0);
+  EXPECT_TRUE(v.assisted_trend.words.starts_with("rising")) << v.assisted_trend.words;
+  ASSERT_GE(v.best, 5);
+  EXPECT_EQ(v.flights[v.best].skill, *std::max_element(skill.begin(), skill.end()));
 }
 
 // history import: recordings flown again and added once, a bad file named with its reason

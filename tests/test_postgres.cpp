@@ -182,6 +182,32 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
             std::to_string(history::kSchemaVersion));
 }
 
+// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
+// row) is brought forward on open by the same migrations SQLite runs; its flights stay.
+TEST(Postgres, AnOlderSchemaIsMigratedForward) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "migrate");
+  auto store = open_store(url);
+  ASSERT_TRUE(store);
+  std::string error;
+  ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+  store.reset();
+  ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
+  ASSERT_TRUE(server->exec("migrate", "DELETE FROM schema_version WHERE version > 1", error))
+      << error;
+  ASSERT_EQ(sql(*server, "migrate", "SELECT max(version) FROM schema_version"), "1");
+  store = open_store(url);
+  ASSERT_TRUE(store);
+  EXPECT_EQ(sql(*server, "migrate", "SELECT max(version) FROM schema_version"),
+            std::to_string(history::kSchemaVersion));
+  EXPECT_EQ(sql(*server, "migrate",
+                "SELECT count(*) FROM pg_indexes WHERE indexname = 'metrics_by_name'"),
+            "1");
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 1u);
+  expect_same_flight(sample_flight(), rows[0]);
+}
+
 // A recording is one flight: the same hash again is already known and adds nothing; flights
 // without a recording are each their own.
 TEST(Postgres, ARecordingIsAddedOnce) {

@@ -1,6 +1,10 @@
 // One full UI frame (SPEC §8): ImGui's draw data built from a flight's scene and history and
 // rendered offscreen at 1280x720 by Mesa (llvmpipe when there is no GPU), glFinish included.
+// The `_build` cases time only what the UI thread does before the GPU draws: the panels laid out
+// and their vertices built (ImGui::Render's draw data), without rasterizing it. Without a GPU,
+// llvmpipe's rasterizing is the CPU doing the GPU's work, and grows with the pixels covered.
 #include <benchmark/benchmark.h>
+#include <imgui.h>
 
 #include <memory>
 #include <string>
@@ -42,8 +46,11 @@ ui::HistoryView progress_of_50() {
   return v;
 }
 
+enum class Draw { rendered, built };
+
 // `progress`: the Progress panel open over the flight (the same frame otherwise).
-void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera, bool progress) {
+void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera, bool progress,
+                Draw draw = Draw::rendered) {
   ModeRequest request;
   request.duration = 5.0;
   std::string error;
@@ -78,9 +85,16 @@ void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera
     st.show_progress = true;
   }
   ui::Requests requests;
+  const auto build = [&] { ui::draw_screen(scene, history, run, st, requests); };
   for (auto _ : state) {
     requests.clear();
-    screen.frame([&] { ui::draw_screen(scene, history, run, st, requests); });
+    if (draw == Draw::rendered) {
+      screen.frame(build);
+    } else {
+      screen.layout(build);
+      ImGui::Render();  // the draw data, as the window hands it to the GPU
+      benchmark::DoNotOptimize(ImGui::GetDrawData()->TotalVtxCount);
+    }
   }
 }
 
@@ -93,6 +107,12 @@ BENCHMARK_CAPTURE(BM_UiFrame, pendubot, "pendubot_swingup.toml", ui::Camera::cha
 BENCHMARK_CAPTURE(BM_UiFrame, obstacles, "obstacles_thrown_balls.toml", ui::Camera::chase, false)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_UiFrame, mi_chase_progress, "mi_helix.toml", ui::Camera::chase, true)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_UiFrame, mi_chase_build, "mi_helix.toml", ui::Camera::chase, false,
+                  Draw::built)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_UiFrame, mi_chase_progress_build, "mi_helix.toml", ui::Camera::chase, true,
+                  Draw::built)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
