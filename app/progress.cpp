@@ -77,7 +77,9 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
     f.attempt = int(v.flights.size()) + 1;
     f.probe = r.probe;
     f.skill = metric_of(r, "skill").value_or(ui::kNoValue);
-    f.dependence = metric_of(r, "assistance_dependence").value_or(ui::kNoValue);
+    // A probe's D is 0 by construction (λ pinned to 1), not a sign of less reliance: D's curve
+    // and column are the assisted flights'.
+    if (!f.probe) f.dependence = metric_of(r, "assistance_dependence").value_or(ui::kNoValue);
     f.duration_s = r.duration_s;
     f.when = local_minutes(r.started_unix_ms);
     f.ended = history::to_string(r.ended);

@@ -39,4 +39,23 @@ MIXPILOT_SHOT_DIR="$tmp" XDG_CONFIG_HOME="$tmp/config" "$tests/test_app" \
   --gtest_filter='App.TheInputSettingsPanel:App.TheProgressPanel' >/dev/null
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
+# The progress report to take home (history --html) of a trainee who flew the helix three times
+# as the novice, three times as the experienced pilot (each attempt with its own position noise)
+# and once unassisted, as headless Chromium prints it (Debian's chromium package).
+for i in 1 2 3 4 5 6 7; do
+  pilot=novice assist=on
+  [ "$i" -gt 3 ] && pilot=experienced
+  [ "$i" -eq 7 ] && assist=off
+  sed "s/^position_noise = 0.0/position_noise = 0.01/; s/^seed = 1/seed = $i/" \
+    scenarios/mi_helix.toml >"$tmp/helix.toml"
+  "$m" fly --scenario "$tmp/helix.toml" --pilot $pilot --assist $assist --headless \
+    --trainee "Ada Lovelace" --record "$tmp/ada-$i.mcap" >/dev/null
+done
+"$m" history --trainee "Ada Lovelace" --html "$tmp/ada.html" >/dev/null
+if command -v chromium >/dev/null; then
+  chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --window-size=1000,900 \
+    --screenshot="$out/progress_report.png" "file://$tmp/ada.html" >/dev/null 2>&1
+else
+  echo "docs/screenshots.sh: chromium is not installed (apt install chromium): progress_report.png kept" >&2
+fi
 ls -l $out

@@ -780,6 +780,8 @@ TEST(HistoryLearningCurve, TheSkillRisesAndTheDependenceFalls) {
   EXPECT_TRUE(v.assisted_trend.words.starts_with("rising")) << v.assisted_trend.words;
   ASSERT_GE(v.best, 5);
   EXPECT_EQ(v.flights[v.best].skill, *std::max_element(skill.begin(), skill.end()));
+  EXPECT_TRUE(std::isnan(v.flights[10].dependence));  // a probe's D is no measure of reliance
+  EXPECT_NEAR(v.flights[9].dependence, d[9], 1e-12);
 }
 
 // history import: recordings flown again and added once, a bad file named with its reason
@@ -1113,7 +1115,7 @@ history::StoredFlight attempt(int i, double skill, bool probe, double d = NAN) {
 TEST(HistoryProgress, TrendSignAndBestRun) {
   std::vector<history::StoredFlight> rows;
   for (int i = 0; i < 12; ++i) rows.push_back(attempt(i, 40.0 + 3.0 * i + (i % 2 ? 2.0 : -2.0), false, 0.6 - 0.04 * i));
-  rows.push_back(attempt(12, 30.0, true));
+  rows.push_back(attempt(12, 30.0, true, 0.0));  // a probe's D, 0 by construction: not shown
   rows.push_back(attempt(13, 20.0, true));
   rows.push_back(attempt(14, 10.0, true));
   const ui::ProgressView v = cli::progress_view(rows, "Ada", "mi_helix", false);

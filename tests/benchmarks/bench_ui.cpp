@@ -96,6 +96,7 @@ void BM_UiFrame(benchmark::State& state, const char* scenario, ui::Camera camera
       benchmark::DoNotOptimize(ImGui::GetDrawData()->TotalVtxCount);
     }
   }
+  state.counters["vertices"] = ImGui::GetDrawData()->TotalVtxCount;
 }
 
 BENCHMARK_CAPTURE(BM_UiFrame, mi_chase, "mi_helix.toml", ui::Camera::chase, false)
