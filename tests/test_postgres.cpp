@@ -408,6 +408,64 @@ TEST(Postgres, EightProcessesWriteAtOnce) {
   EXPECT_EQ(names, (std::vector<std::string>{"Ada", "Ben"}));
 }
 
+// kill -9 of a writer inside a transaction: the server rolls the open transaction back, every
+// flight the writer had committed is there with all its metrics, none is half written, and the
+// next writer is not kept waiting by a lock the dead one held.
+TEST(Postgres, AWriterKilledMidTransactionLosesNothingCommitted) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "killed");
+  { ASSERT_TRUE(open_store(url)); }
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  constexpr int kMetrics = 3000;  // a long transaction: the kill lands inside one
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::string error;
+    auto store = history::open_history(url, error);
+    if (!store) ::_exit(2);
+    for (int i = 0;; ++i) {
+      FlightRecord f = sample_flight("killed", i);
+      f.metrics.clear();
+      for (int m = 0; m < kMetrics; ++m) f.metrics.emplace_back("m" + std::to_string(m), m);
+      if (store->add(f, error) != HistoryStore::Added::added) ::_exit(3);
+      const std::int32_t done = i;
+      if (::write(fds[1], &done, sizeof done) != sizeof done) ::_exit(4);
+    }
+  }
+  ::close(fds[1]);
+  std::int32_t last = -1, got = 0;
+  while (last < 5 && ::read(fds[0], &got, sizeof got) == sizeof got) last = got;
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // inside the next transaction
+  ::kill(pid, SIGKILL);
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  ASSERT_TRUE(WIFSIGNALED(st)) << "the writer ended before the kill: " << st;
+  while (::read(fds[0], &got, sizeof got) == sizeof got) last = got;  // reported before dying
+  ::close(fds[0]);
+  auto store = open_store(url);
+  ASSERT_TRUE(store);
+  std::string error;
+  ASSERT_EQ(store->add(sample_flight("after", 1'000'000), error), HistoryStore::Added::added)
+      << error;
+  history::Query q;
+  q.trainee = "killed";
+  const auto rows = all(*store, q);
+  ASSERT_GE(rows.size(), std::size_t(last + 1));
+  EXPECT_LE(rows.size(), std::size_t(last + 2));  // at most the one committed unreported
+  EXPECT_EQ(sql(*server, "killed",
+                "SELECT count(*) FROM flights f WHERE (SELECT count(*) FROM metrics m "
+                "WHERE m.flight_id = f.id) <> " + std::to_string(kMetrics) +
+                    " AND f.trainee_id = (SELECT id FROM trainees WHERE name = 'killed')"),
+            "0")
+      << "a flight half written";
+  EXPECT_EQ(sql(*server, "killed",
+                "SELECT count(*) FROM metrics m WHERE NOT EXISTS "
+                "(SELECT 1 FROM flights f WHERE f.id = m.flight_id)"),
+            "0");
+}
+
 // One store shared by threads (a flight closing while a panel reads): every call is served,
 // none is lost.
 TEST(Postgres, ThreadsShareOneStore) {

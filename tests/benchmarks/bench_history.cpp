@@ -81,8 +81,18 @@ std::string filled_history(int flights) {
   return p.string();
 }
 
+// The filled history's folder, removed when the benchmarks end.
+struct TempHistory {
+  std::string path = filled_history(100'000);
+  ~TempHistory() {
+    std::error_code ec;
+    if (!path.empty()) fs::remove_all(fs::path(path).parent_path(), ec);
+  }
+};
+
 void BM_HistoryListing(benchmark::State& state) {
-  static const std::string db = filled_history(100'000);
+  static const TempHistory filled;
+  const std::string& db = filled.path;
   if (db.empty()) {
     state.SkipWithError("cannot fill the history");
     return;
