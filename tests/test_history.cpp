@@ -1011,9 +1011,17 @@ TEST(HistoryWindow, ALockedHistoryNeverStallsAFrame) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (!app.over() && std::chrono::steady_clock::now() < deadline) frame();
   ASSERT_TRUE(app.over());
-  // The row waits for the lock (the store's busy timeout is 5 s): frames go on meanwhile.
-  const auto held_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
-  while (std::chrono::steady_clock::now() < held_until) frame();
+  // The row waits for the lock (the store's busy timeout is 5 s) while it is held for 3 s more:
+  // frames go on meanwhile. A UI thread that waited on the store would show one frame as long
+  // as the rest of the hold; a busy machine only makes each frame slower, never that long.
+  constexpr double kHold = 3.0;  // [s]
+  const auto held_until = std::chrono::steady_clock::now() + std::chrono::duration<double>(kHold);
+  int frames_while_held = 0;
+  while (std::chrono::steady_clock::now() < held_until) {
+    frame();
+    ++frames_while_held;
+  }
+  EXPECT_GE(frames_while_held, 3);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM flights"), 0);  // WAL: a reader is not blocked
   EXPECT_EQ(app.run_info().message.find("remembered"), std::string::npos) << app.run_info().message;
   sqlite3_exec(holder, "COMMIT", nullptr, nullptr, nullptr);
@@ -1025,7 +1033,7 @@ TEST(HistoryWindow, ALockedHistoryNeverStallsAFrame) {
   EXPECT_NE(app.run_info().message.find("remembered in the history (Ada, "), std::string::npos)
       << app.run_info().message;
   EXPECT_EQ(rows_in(db), 1);
-  EXPECT_LT(longest, 0.050) << "a frame took " << longest * 1e3 << " ms";
+  EXPECT_LT(longest, kHold / 3) << "a frame took " << longest * 1e3 << " ms: it waited on the store";
   testing::internal::CaptureStdout();
   (void)app.finish();
   testing::internal::GetCapturedStdout();
