@@ -44,7 +44,9 @@ std::string file_argument(const char* command, const char* what, std::string_vie
 void check_not_an_input(const char* command, const std::string& option, const std::string& output,
                         const std::vector<std::pair<std::string, std::string>>& inputs) {
   for (const auto& [input_option, input] : inputs) {
-    if (input.empty() || !same_file(output, input)) continue;
+    // The same file by any name, or the same path where the input is still to be made (an
+    // SQLite history's -wal and -shm come and go with its connections).
+    if (input.empty() || !same_output_path(output, input)) continue;
     const std::string what = input_option.empty() ? std::string("the input") : input_option;
     usage_error(command, option + " " + output + " is the same file as " + what + " " + input +
                              ": an output never replaces what the command reads");

@@ -11,6 +11,7 @@
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/base/output_file.hpp"
+#include "core/history/history.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "input/mapping.hpp"
 #include "models/crazyflie.hpp"
@@ -326,11 +327,13 @@ Labels report_labels(const Flight& f, bool was_interrupted) {
 }
 
 bool check_outputs(const FlyOptions& o, std::string& error) {
-  const std::vector<std::pair<std::string, std::string>> inputs = {
+  std::vector<std::pair<std::string, std::string>> inputs = {
       {"--scenario", o.scenario_path},
       {o.replay ? "the recording" : "--pilot", o.pilot.ends_with(".mcap") ? o.pilot : ""},
       {"--gamepad-script", o.gamepad_script},
       {"--input-settings", o.input_settings}};
+  for (const std::string& file : history::sqlite_files(o.history))
+    inputs.emplace_back("the history", file);
   if (!o.record.empty()) check_not_an_input(o.command, "--record", o.record, inputs);
   if (!o.report.empty()) check_not_an_input(o.command, "--report", o.report, inputs);
   for (const ScreenshotRequest& shot : o.screenshots)

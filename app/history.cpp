@@ -625,6 +625,12 @@ int history_command(int argc, char** argv) {
     usage_error(cmd, "one of --csv, --json and --html");
   if (!html.empty() && q.trainee.empty())
     usage_error(cmd, "--html is one trainee's report: say whose (--trainee NAME)");
+  if (!html.empty()) {
+    std::vector<std::pair<std::string, std::string>> inputs;
+    for (const std::string& file : history::sqlite_files(location))
+      inputs.emplace_back("the history", file);
+    check_not_an_input(cmd, "--html", html, inputs);
+  }
   if (importing && import_dir.empty())
     usage_error(cmd, "which folder? (mixpilot history import DIR)");
   std::string error;

@@ -132,6 +132,17 @@ std::string default_history_path(std::string* why) {
   return base.empty() ? std::string() : base + "/mixpilot/history.sqlite";
 }
 
+std::vector<std::string> sqlite_files(const std::string& location) {
+  if (location == "off" || location.starts_with("postgresql://") ||
+      location.starts_with("postgres://"))
+    return {};
+  const std::string db = location.empty()                 ? default_history_path()
+                         : location.starts_with("sqlite:") ? location.substr(7)
+                                                           : location;
+  if (db.empty()) return {};
+  return {db, db + "-wal", db + "-shm", db + "-journal"};
+}
+
 std::unique_ptr<HistoryStore> open_history(const std::string& location, std::string& error) {
   if (location.empty()) {
     std::string why;

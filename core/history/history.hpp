@@ -65,6 +65,9 @@ class HistoryStore {
 std::unique_ptr<HistoryStore> open_history(const std::string& location, std::string& error);
 // The default SQLite file; "" with `why` when the user has no home folder.
 std::string default_history_path(std::string* why = nullptr);
+// The files an SQLite history at `location` (as open_history takes it) consists of: the
+// database and its -wal, -shm and -journal companions. None for PostgreSQL, "off" or no home.
+std::vector<std::string> sqlite_files(const std::string& location);
 
 // Names are shown in terminals, tables, HTML and stored in PostgreSQL, which accepts only UTF-8:
 // a trainee's name is 1 to kMaxNameChars characters of valid UTF-8 without control characters.

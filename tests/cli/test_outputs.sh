@@ -68,6 +68,7 @@ expect_usage "joy-publish --from ''" "--from" joy-publish --from ''
 expect_usage "joy-publish --input-settings ''" "--input-settings" joy-publish --from rec.mcap \
   --input-settings ''
 expect_usage "vehicle --scenario ''" "--scenario" vehicle --scenario ''
+expect_usage "history --html ''" "--html" history --trainee Ada --html ''
 check "no empty option wrote anything" test "$(ls "$work" | sort | tr '\n' ' ')" = "rec.mcap rec.orig u.out "
 
 # --- An output never replaces an input of the same command, by any name. ---------------------
@@ -89,6 +90,25 @@ for out in rec.mcap alias.mcap hard.mcap; do
   check "recover rec.mcap -o $out --force: usage error" test $? -eq 2
 done
 check "the recording survived every attempt" cmp -s "$work/rec.mcap" "$work/rec.orig"
+# The history a command writes or reads is an input too: its database and the -wal and -shm
+# that come and go with its connections.
+hist=$work/hist/h.sqlite
+"$mixpilot" fly --scenario "$helix" --headless --duration 0.3 --trainee Ada \
+  --history "sqlite:$hist" >/dev/null 2>&1
+check "a history to protect" test -s "$hist"
+cp "$hist" "$work/hist.orig"
+for out in "$hist" "$hist-wal" "$work/hist/../hist/h.sqlite"; do
+  "$mixpilot" history --history "$hist" --trainee Ada --html "$out" --force >"$work/s.out" 2>&1
+  check "history --html $out --force (the history): usage error" test $? -eq 2
+  check "... saying so" grep -q "is the same file as the history" "$work/s.out"
+  "$mixpilot" "${f[@]}" --history "sqlite:$hist" --record "$out" --force >"$work/s.out" 2>&1
+  check "fly --record $out --force (its history): usage error" test $? -eq 2
+  "$mixpilot" "${f[@]}" --history "$hist" --report "$out" --force >"$work/s.out" 2>&1
+  check "fly --report $out --force (its history): usage error" test $? -eq 2
+done
+check "the history survived every attempt" cmp -s "$hist" "$work/hist.orig"
+check "... and no -wal was made of a report" test ! -s "$hist-wal"
+rm -rf "$work/hist" "$work/hist.orig"
 cp "$helix" "$work/s.toml"
 "$mixpilot" fly --scenario "$work/s.toml" --headless --duration 0.3 --report "$work/s.toml" \
   --force >"$work/s.out" 2>&1
