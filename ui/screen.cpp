@@ -8,6 +8,7 @@
 #include <imgui_internal.h>  // the panes' sizes of the last frame (FindWindowByName)
 
 #include "ui/panels.hpp"
+#include "ui/reason.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -190,6 +191,18 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
     draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min,
                        ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact, sc.probe);
     ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
+    // Why λ fell, while it matters and a moment after (ui/reason.hpp); the safe hold has its
+    // own line below.
+    const std::optional<std::size_t> why = shown_reason(h);
+    if (why && !(s->events & kEventSafeHold)) {
+      const Telemetry& r = h[*why];
+      ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + w);
+      ImGui::PushStyleColor(ImGuiCol_Text,
+                            r.reason.cap == LambdaCap::probe ? colour::kPilot : colour::kPlanner);
+      ImGui::TextUnformatted(reason_text(r, sc.ball_radius).c_str());
+      ImGui::PopStyleColor();
+      ImGui::PopTextWrapPos();
+    }
   }
   ImGui::PushFont(mono_font());
   const float gap = ImGui::CalcTextSize("   ").x;
