@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
-# one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display
-# and the input settings and Progress panels at 1280x720 (app tests render them). The flights
+# one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
+# why λ fell, and the input settings and Progress panels at 1280x720 (app tests render them). The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
@@ -27,6 +27,10 @@ export XDG_DATA_HOME="$tmp/data"
   --record "$tmp/reckless.mcap" >/dev/null
 "$m" replay "$tmp/reckless.mcap" --headless --screenshot 6:$out/replay.png --size 800x450 \
   --force >/dev/null
+# Why λ fell: the reckless pilot at 1.2 s, the planner flying 85 %; the HUD says why and the
+# arena draws the prediction λ came from, its node i*, the ball B there and the gap.
+"$m" fly --scenario scenarios/mi_helix.toml --pilot reckless --headless --duration 2 \
+  --screenshot 1.2:$out/reason.png --size 1280x720 --force >/dev/null
 # A person's gamepad (a scripted SDL virtual pad) unplugged at 1 s: the planner flies.
 printf 't,left_x,left_y,right_x,right_y\n0,0,0,0.3,0\n1.0,unplug\n' >"$tmp/unplug.csv"
 XDG_CONFIG_HOME="$tmp/config" "$m" fly --scenario scenarios/mi_helix.toml --pilot gamepad \

@@ -143,6 +143,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   SolverStatsMsg solver;
   PredictionMsg pred;
   ModeChannelsMsg channels;
+  LambdaReasonMsg reason;
   double lambda = 0;
   for (uint64_t k = 0; k < kSteps; ++k) {
     const double s = static_cast<double>(k);
@@ -167,6 +168,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
     channels = {{}, k, static_cast<uint32_t>(k % 32), {"lambda", "roll MPC"}, {"", "rad"},
                 {lambda, -0.125 * s}};
     ASSERT_TRUE(rec.record_channels(channels));
+    reason = {{}, k, lambda, 0.75 - 0.001 * s, 0.0625 * s, static_cast<int32_t>(k % 11) - 1,
+              0.015 * static_cast<double>(k % 11), {0.6, -0.8, 0.0}, static_cast<uint8_t>(k % 4)};
+    ASSERT_TRUE(rec.record_reason(reason));
   }
   ASSERT_TRUE(rec.close(err)) << err;
 
@@ -181,7 +185,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.begin('{');
   j.key("profile").str("ros2").key("library").str(version()).key("dataSectionCrc").str("ok");
   j.key("statistics").begin('{');
-  j.key("messageCount").num(8.0 * kSteps).key("schemaCount").num(8).key("channelCount").num(8);
+  const double topics = static_cast<double>(recorded_types().size());
+  j.key("messageCount").num(topics * kSteps).key("schemaCount").num(topics);
+  j.key("channelCount").num(topics);
   j.key("metadataCount").num(2).key("messageStartTime").num(0);
   j.key("messageEndTime").num(static_cast<double>((kSteps - 1) * kPeriodNs));
   j.end('}');
@@ -210,6 +216,10 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.key("u").nums(applied.u).key("roll").num(applied.roll).key("pitch").num(applied.pitch);
   j.key("rotor_speed").nums(applied.rotor_speed).end('}');
   j.key("/controller/lambda").begin('{').key("data").num(lambda).end('}');
+  j.key("/controller/lambda_reason").begin('{').stamp(t).key("step").num(reason.step);
+  j.key("lambda").num(reason.lambda).key("ph_index").num(reason.ph_index);
+  j.key("d_res").num(reason.d_res).key("node").num(reason.node).key("ahead").num(reason.ahead);
+  j.key("direction").nums(reason.direction).key("cap").num(reason.cap).end('}');
   j.key("/controller/prediction").begin('{').stamp(t).key("step").num(pred.step);
   j.key("position").nums(pred.position).key("reference").nums(pred.reference).end('}');
   j.key("/controller/solver").begin('{').stamp(t).key("step").num(solver.step);
@@ -278,6 +288,51 @@ TEST(McapIndependentReader, ReadsAPendubotRecording) {
   Json x;
   x.nums(std::vector<double>(last.x.data(), last.x.data() + last.x.size()));
   has(R"("step":249,"x":)" + x.text());  // the last state, decoded from CDR by the reader
+}
+
+// A mixed-initiative flight's /controller/lambda_reason (SPEC §10 "Why λ fell"), as recorded by
+// the sink every step: the independent reader decodes each message with the embedded schema,
+// and the last one holds what the flight's last step said.
+TEST(McapIndependentReader, DecodesTheLambdaReasonOfAFlight) {
+  const std::string node = MIXPILOT_NODE;
+  if (node.empty()) GTEST_SKIP() << "node not found at configure time";
+  const fs::path check_dir = fs::path(MIXPILOT_SOURCE_DIR) / "tests" / "mcap_check";
+  const fs::path file = test::fresh_path("mcap_independent", "reason.mcap");
+  const std::string scenario = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml";
+  std::string err, text;
+  ASSERT_TRUE(read_text_file(scenario, text, err)) << err;
+  ModeRequest request;
+  request.duration = 3.0;  // 200 steps of 15 ms
+  request.pilot_name = "reckless";
+  auto mode = make_mode(text, scenario, std::move(request), err);
+  ASSERT_TRUE(mode) << err;
+  RecordingSink recorder;
+  ASSERT_TRUE(recorder.open(file.string(), *mode,
+                            {"mixed_initiative", text, scenario, 1, "reckless"}, err))
+      << err;
+  Session session(*mode);
+  session.add_sink(&recorder);
+  session.run();
+  ASSERT_TRUE(recorder.close(err)) << err;
+
+  const std::string out =
+      run("'" + node + "' '" + (check_dir / "check.mjs").string() + "' '" + file.string() + "' 2>&1");
+  const auto has = [&](const std::string& s) {
+    EXPECT_NE(out.find(s), std::string::npos) << "missing " << s << " in\n" << out.substr(0, 3000);
+  };
+  has(R"("dataSectionCrc":"ok")");
+  has(R"({"topic":"/controller/lambda_reason","schemaName":"mixpilot_msgs/msg/LambdaReason","schemaEncoding":"ros2msg","messageEncoding":"cdr","messages":200,"statistics":200})");
+  const Telemetry& s = mode->telemetry();
+  const LambdaReason& r = s.reason;
+  ASSERT_GE(r.node, 0);
+  Json last;
+  last.begin('{').stamp(ros_time_from_ns(std::uint64_t(s.step) * kPeriodNs));
+  last.key("step").num(double(s.step)).key("lambda").num(s.lambda).key("ph_index").num(r.ph_index);
+  last.key("d_res").num(r.d_res).key("node").num(r.node).key("ahead").num(r.ahead);
+  // The direction's layout is checked above; its components may be small enough for JavaScript
+  // to print them in exponent form.
+  has(R"("/controller/lambda_reason":)" + last.text() + R"(,"direction":[)");
+  has(R"("cap":)" + std::to_string(int(r.cap)) + R"(},"/controller/prediction")");
 }
 
 }  // namespace

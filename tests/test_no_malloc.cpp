@@ -6,6 +6,7 @@
 #include "core/control/pendubot_reference.hpp"
 #include "core/control/tracking.hpp"
 #include "core/modes/make_mode.hpp"
+#include "core/modes/mi_mode.hpp"
 #include "core/modes/pendubot_mode.hpp"
 #include "core/modes/tracking_mode.hpp"
 #include "core/numerics/integrator_erk4.hpp"
@@ -136,6 +137,51 @@ TEST(NoMalloc, ProbeFlightStep) {
   const GuardedSteps run = step_to_end_without_malloc(*mode, [] {});
   EXPECT_EQ(run.steps, mode->steps_total());
   EXPECT_EQ(run.allocations, 0);
+}
+
+// Why λ fell (SPEC §10) is part of each mixed-initiative step: a flight whose pilot's input is
+// lost for a while (λ held down by the input's cap), then back, computes its reason every step
+// and copies it, with the rest of the telemetry, into a sized slot (as the recorder and the
+// UI's ring do) without allocating.
+TEST(NoMalloc, MiStepWithItsLambdaReason) {
+  struct Dropping final : PilotSource {
+    double hover = 0.0;
+    std::string name() const override { return "drop"; }
+    bool command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) override {
+      const bool lost = step >= 40 && step < 60;
+      out.roll = 0.03;
+      out.pitch = 0.0;
+      out.rotor_speed.setConstant(hover);
+      out.authority = lost ? 0.0 : 1.0;
+      out.input = lost ? InputState::lost : InputState::ok;
+      return true;
+    }
+  };
+  auto source = std::make_unique<Dropping>();
+  source->hover = models::MikroKopter().hover_speed();
+  ModeRequest request;
+  request.duration = 1.2;
+  request.pilot_source = std::move(source);
+  std::string error;
+  auto mode = load_mode(MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml", std::move(request), error);
+  ASSERT_TRUE(mode) << error;
+  Telemetry slot = mode->telemetry();  // sized by a first copy
+  long copy_allocations = 0;
+  int capped = 0, explained = 0;
+  const GuardedSteps run = step_to_end_without_malloc(*mode, [&] {
+    {
+      NoMalloc guard;
+      slot = mode->telemetry();
+      copy_allocations += NoMalloc::count();
+    }
+    capped += slot.reason.cap == LambdaCap::input_lost;
+    explained += slot.reason.node >= 0;
+  });
+  EXPECT_EQ(run.steps, mode->steps_total());
+  EXPECT_EQ(run.allocations, 0);
+  EXPECT_EQ(copy_allocations, 0);
+  EXPECT_EQ(capped, 20);
+  EXPECT_EQ(explained, run.steps - 1);  // all but the first, before any prediction
 }
 
 // Pendubot swing-up: every step() of each path — NMPC tracking and past the reference's end

@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -148,7 +149,7 @@ TEST(RecordingMessages, DecodeRejectsTrailingBytes) {
 
 TEST(RecordingMessages, SchemasAreRos2msgWithDependencies) {
   const auto types = recorded_types();
-  ASSERT_EQ(types.size(), 8u);
+  ASSERT_EQ(types.size(), 9u);
   const std::string sep(80, '=');
   for (const auto& t : types) {
     const std::string text = t.schema_text;
@@ -191,6 +192,9 @@ void record_session(SessionRecorder& rec, uint64_t steps) {
     ASSERT_TRUE(rec.record_prediction({{}, k, std::vector<double>(33, s), std::vector<double>(33, -s)}));
     ASSERT_TRUE(rec.record_channels({{}, k, uint32_t(k % 4), {"lambda", "deviation"}, {"", "m"},
                                      {1.0 / (1.0 + s), 0.01 * s}}));
+    ASSERT_TRUE(rec.record_reason({{}, k, 1.0 / (1.0 + s), 1.0 / (1.0 + s), 0.01 * s,
+                                   int32_t(k % 11) - 1, 0.015 * double(k % 11), {0.0, 0.6, -0.8},
+                                   uint8_t(k % 4)}));
   }
 }
 
@@ -236,6 +240,14 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
     EXPECT_EQ(r->channels[k].events, k % 4);
     EXPECT_EQ(r->channels[k].names[1], "deviation");
     EXPECT_EQ(r->channels[k].values[1], 0.01 * static_cast<double>(k));
+    const LambdaReasonMsg& why = r->reasons[k];
+    EXPECT_EQ(why.step, k);
+    EXPECT_EQ(ros_time_to_ns(why.stamp), k * kPeriodNs);
+    EXPECT_EQ(why.d_res, 0.01 * static_cast<double>(k));
+    EXPECT_EQ(why.node, int32_t(k % 11) - 1);
+    EXPECT_EQ(why.ahead, 0.015 * double(k % 11));
+    EXPECT_EQ(why.direction, (std::array<double, 3>{0.0, 0.6, -0.8}));
+    EXPECT_EQ(why.cap, k % 4);
   }
   // Log times in the container are k·Δt too.
   std::string e2;

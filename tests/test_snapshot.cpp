@@ -223,6 +223,13 @@ std::string difference(const Telemetry& s, const RecordingContents& rec) {
   }
   if (s.mode == ModeKind::mixed_initiative) {
     if (!same_bits(rec.lambda[k].lambda, s.lambda)) return "lambda";
+    if (k >= rec.reasons.size()) return "no reason of lambda was recorded";
+    const LambdaReasonMsg& why = rec.reasons[k];
+    if (!same_bits(why.d_res, s.reason.d_res) || why.node != s.reason.node ||
+        !same_bits(why.ph_index, s.reason.ph_index) ||
+        !same_bits(why.direction.data(), s.reason.direction.data(), 3) ||
+        why.cap != std::uint8_t(s.reason.cap))
+      return "the reason of lambda";
     const PilotCommandMsg& pilot = rec.pilot[k];
     if (!same_bits(pilot.roll, s.pilot.roll) || !same_bits(pilot.pitch, s.pilot.pitch) ||
         !same_bits(pilot.rotor_speed.data(), s.pilot.rotor_speed.data(), 4) ||

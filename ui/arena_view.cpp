@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -7,6 +9,7 @@
 
 #include "models/attitude.hpp"
 #include "ui/panels.hpp"
+#include "ui/reason.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -218,6 +221,82 @@ bool blocks_view(const View& v, const Eigen::Vector3d& c, double r, const Eigen:
   return (v.eye + t / length * sight - c).norm() < r + size;
 }
 
+// Why λ fell (SPEC §10): the prediction λ was computed from (SPEC §5.4: the previous step's),
+// bold up to node i*, node i* marked (a diamond), the ball B around η^r_{i*} and the gap
+// η_{i*} − η^r_{i*}. Nothing when a cap decided λ or the prediction is not in the history.
+// Drawn under the vehicle; returns where node i* is on screen, for its label.
+std::optional<ImVec2> draw_reason(ImDrawList* dl, const View& v, const Scene& sc,
+                                  const History& h, std::size_t i) {
+  const LambdaReason& r = h[i].reason;
+  const Telemetry* p = reason_prediction(h, i);
+  if (r.cap != LambdaCap::none || r.node < 0 || !p || r.node >= p->predicted.cols() ||
+      r.node >= p->predicted_reference.cols())
+    return std::nullopt;
+  const Eigen::Vector3d eta = p->predicted.col(r.node), ref = p->predicted_reference.col(r.node);
+  for (int k = 1; k <= r.node; ++k)
+    line(dl, v, p->predicted.col(k - 1), p->predicted.col(k), colour::kMpc, 4.0f);
+  ImVec2 pr, pe;
+  if (v.project(ref, pr)) {
+    // Dashed, so it is not taken for B around the current reference point.
+    const float rad = float(v.pixels(sc.ball_radius, ref));
+    constexpr int kDashes = 24;
+    for (int j = 0; j < kDashes; ++j) {
+      const float a0 = 2.0f * float(M_PI) * float(2 * j) / (2 * kDashes);
+      dl->PathArcTo(pr, rad, a0, a0 + float(M_PI) / kDashes, 4);
+      dl->PathStroke(colour::rgb(0xEE, 0xEE, 0xEE, 220), 0, scaled(1.5f));
+    }
+    dl->AddCircleFilled(pr, scaled(3.0f), colour::kText, 12);
+  }
+  // Outlined, so it stands out of the trail (the planner's orange where λ is low).
+  line(dl, v, ref, eta, colour::rgb(0xF0, 0xF0, 0xF0, 230), 6.5f);
+  line(dl, v, ref, eta, colour::kCritical, 3.5f);
+  if (!v.project(eta, pe)) return std::nullopt;
+  const float m = scaled(7.0f);
+  const ImVec2 top(pe.x, pe.y - m), right(pe.x + m, pe.y), bottom(pe.x, pe.y + m), left(pe.x - m, pe.y);
+  dl->AddQuadFilled(top, right, bottom, left, colour::kCritical);
+  dl->AddQuad(top, right, bottom, left, colour::kText, scaled(1.5f));
+  return pe;
+}
+
+// Node i*'s label, over the vehicle: the gap and how far ahead, diagonally off the node (clear
+// of the rotors) with a leader to it: up and right, else the first other corner clear of
+// [clear_min, clear_max) (an overlay); inside the pane [min, max) (its text is never cut),
+// where it fits at all.
+void draw_reason_label(ImDrawList* dl, const LambdaReason& r, ImVec2 node, ImVec2 min,
+                       ImVec2 max, ImVec2 clear_min, ImVec2 clear_max) {
+  char label[64];
+  if (r.node > 0)
+    std::snprintf(label, sizeof label, "%.2f m off the reference in %.3g s", r.d_res, r.ahead);
+  else
+    std::snprintf(label, sizeof label, "%.2f m off the reference now", r.d_res);
+  const ImVec2 size = ImGui::CalcTextSize(label);
+  const float pad = scaled(3.0f), m = scaled(7.0f);
+  if (size.x + 4.0f * pad > max.x - min.x || size.y + 4.0f * pad > max.y - min.y) return;
+  const auto place = [&](float sx, float sy) {
+    const float x = sx > 0 ? node.x + 4.0f * m : node.x - 4.0f * m - size.x;
+    const float y = sy < 0 ? node.y - 5.0f * m - size.y : node.y + 5.0f * m;
+    return ImVec2(std::clamp(x, min.x + 2.0f * pad, max.x - 2.0f * pad - size.x),
+                  std::clamp(y, min.y + 2.0f * pad, max.y - 2.0f * pad - size.y));
+  };
+  const auto clear = [&](ImVec2 p) {
+    return p.x + size.x + pad <= clear_min.x || p.x - pad >= clear_max.x ||
+           p.y + size.y + pad <= clear_min.y || p.y - pad >= clear_max.y;
+  };
+  ImVec2 at = place(+1, -1);
+  for (const ImVec2 corner : {ImVec2(-1, -1), ImVec2(-1, +1), ImVec2(+1, +1)})
+    if (!clear(at)) at = place(corner.x, corner.y);
+  if (!clear(at)) at = place(+1, -1);
+  // The leader meets the label's nearest corner.
+  const ImVec2 end(node.x < at.x ? at.x - pad : at.x + size.x + pad,
+                   node.y < at.y ? at.y - pad : at.y + size.y + pad);
+  dl->AddLine(node, end, colour::kText, scaled(1.0f));
+  dl->AddRectFilled(ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad),
+                    colour::rgb(0x10, 0x10, 0x14, 210), pad);
+  dl->AddRect(ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad),
+              colour::kCritical, pad, 0, scaled(1.0f));
+  dl->AddText(at, colour::kText, label);
+}
+
 }  // namespace
 
 bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& ui, ImVec2 min,
@@ -227,7 +306,7 @@ bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& u
 }
 
 void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max,
-                ImVec2 frame) {
+                ImVec2 frame, ImVec2 clear_min, ImVec2 clear_max) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
   dl->AddRectFilled(min, max, colour::kBackground);
@@ -304,7 +383,10 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
   }
   for (Eigen::Index i = 1; i < s.predicted.cols(); ++i)
     line(dl, v, s.predicted.col(i - 1), s.predicted.col(i), colour::kMpc, 2.0f);
+  const std::optional<std::size_t> why = sc.shared_authority ? shown_reason(h) : std::nullopt;
+  const std::optional<ImVec2> node = why ? draw_reason(dl, v, sc, h, *why) : std::nullopt;
   if (has_vehicle) draw_vehicle(dl, v, s);
+  if (node) draw_reason_label(dl, h[*why].reason, *node, min, max, clear_min, clear_max);
   // What stands between the camera and the vehicle: a tint and its outline, over the rest.
   for (const Ball& b : balls) {
     ImVec2 pc;

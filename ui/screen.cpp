@@ -8,6 +8,7 @@
 #include <imgui_internal.h>  // the panes' sizes of the last frame (FindWindowByName)
 
 #include "ui/panels.hpp"
+#include "ui/reason.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -190,6 +191,18 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
     draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min,
                        ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact, sc.probe);
     ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
+    // Why λ fell, while it matters and a moment after (ui/reason.hpp); the safe hold has its
+    // own line below.
+    const std::optional<std::size_t> why = shown_reason(h);
+    if (why && !(s->events & kEventSafeHold)) {
+      const Telemetry& r = h[*why];
+      ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + w);
+      ImGui::PushStyleColor(ImGuiCol_Text,
+                            r.reason.cap == LambdaCap::probe ? colour::kPilot : colour::kPlanner);
+      ImGui::TextUnformatted(reason_text(r, sc.ball_radius).c_str());
+      ImGui::PopStyleColor();
+      ImGui::PopTextWrapPos();
+    }
   }
   ImGui::PushFont(mono_font());
   const float gap = ImGui::CalcTextSize("   ").x;
@@ -610,15 +623,11 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   const ImVec2 frame = frame_min(vmin, vmax, run, hud_bottom);
   const ImVec2 centre(0.5f * (frame.x + vmax.x), 0.5f * (frame.y + vmax.y));
 
-  ImGui::SetNextWindowPos(vmin);
-  ImGui::SetNextWindowSize(ImVec2(view_w, vmax.y - vmin.y));
-  ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
-  if (sc.view == ViewKind::arm_2d) draw_pendubot(sc, h, vmin, vmax, frame);
-  else draw_arena(sc, h, ui, vmin, vmax, frame);
-  ImGui::End();
-
   // The sticks at the bottom of the frame over the camera line, below the vehicle or, where
-  // the view is short, beside it; shrunk down to a readable size.
+  // the view is short, beside it; shrunk down to a readable size. Placed before the view is
+  // drawn, so the arena's labels keep clear of them.
+  bool sticks = false;
+  ImVec2 sticks_min(0, 0), sticks_size(0, 0);
   if (sc.shared_authority && ui.show_sticks && !h.empty()) {
     const float floor = vmax.y - ImGui::GetTextLineHeightWithSpacing() - m;
     const float vehicle = kVehicleInFrame * (vmax.y - frame.y);
@@ -634,17 +643,31 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
       ht = fit(std::max(hud_bottom, frame.y) + m, vmax.x - m - beside);
       x = vmax.x - m - ht * aspect;
     }
-    const float w = ht * aspect;
     const bool clear_of_panel = !panel || x >= panel_max.x + m || floor - ht >= panel_max.y + m;
-    if (ht >= least && clear_of_panel) {
-      ImGui::SetNextWindowPos(ImVec2(x, floor - ht));
-      ImGui::SetNextWindowSize(ImVec2(w, ht));
-      ImGui::Begin("##sticks", nullptr, kOverlay);
-      const ImVec2 p = ImGui::GetCursorScreenPos();
-      draw_sticks(h.newest(), sc.hover_rotor_speed, p,
-                  ImVec2(p.x + w - 2 * st.WindowPadding.x, p.y + ht - 2 * st.WindowPadding.y));
-      ImGui::End();
-    }
+    sticks = ht >= least && clear_of_panel;
+    sticks_min = ImVec2(x, floor - ht);
+    sticks_size = ImVec2(ht * aspect, ht);
+  }
+
+  ImGui::SetNextWindowPos(vmin);
+  ImGui::SetNextWindowSize(ImVec2(view_w, vmax.y - vmin.y));
+  ImGui::Begin("##view", nullptr, kPane | ImGuiWindowFlags_NoScrollbar);
+  if (sc.view == ViewKind::arm_2d) draw_pendubot(sc, h, vmin, vmax, frame);
+  else if (sticks)
+    draw_arena(sc, h, ui, vmin, vmax, frame, sticks_min,
+               ImVec2(sticks_min.x + sticks_size.x, sticks_min.y + sticks_size.y));
+  else draw_arena(sc, h, ui, vmin, vmax, frame);
+  ImGui::End();
+
+  if (sticks) {
+    ImGui::SetNextWindowPos(sticks_min);
+    ImGui::SetNextWindowSize(sticks_size);
+    ImGui::Begin("##sticks", nullptr, kOverlay);
+    const ImVec2 p = ImGui::GetCursorScreenPos();
+    draw_sticks(h.newest(), sc.hover_rotor_speed, p,
+                ImVec2(p.x + sticks_size.x - 2 * st.WindowPadding.x,
+                       p.y + sticks_size.y - 2 * st.WindowPadding.y));
+    ImGui::End();
   }
 
   // The plots scroll when the pane is too short for them all.

@@ -89,6 +89,7 @@ SetupResult MiController::setup(const models::MikroKopter& model, const MiContro
   nearest_.resize(int(arena.obstacles.size()));
   distance_.resize(int(arena.obstacles.size()));
   out_.lambda_next = out_.lambda_used = settings.ph.initial_lambda;
+  out_.reason_next = out_.reason = ph_initial_reason(settings.ph);
   return {};
 }
 
@@ -98,6 +99,7 @@ void MiController::reset(const Eigen::VectorXd& x) {
   for (auto& ui : rti_.trajectory().u) ui = model_.hover_input();
   out_.control = model_.hover_input();
   out_.lambda_next = out_.lambda_used = settings_.ph.initial_lambda;
+  out_.reason_next = out_.reason = ph_initial_reason(settings_.ph);
 }
 
 void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eigen::VectorXd& x) {
@@ -146,7 +148,14 @@ RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotComm
   // The source's authority caps λ (input loss hands the vehicle to the planner, SPEC §6). A
   // probe pins the PH index's part to 1: the cap alone sets λ.
   const double cap = std::clamp(pilot.authority, 0.0, 1.0);
-  out_.lambda_used = settings_.assist == Assistance::on ? std::min(out_.lambda_next, cap) : cap;
+  out_.reason = out_.reason_next;
+  if (settings_.assist == Assistance::on) {
+    out_.lambda_used = std::min(out_.lambda_next, cap);
+    out_.reason.cap = cap < out_.lambda_next ? LambdaCap::input_lost : LambdaCap::none;
+  } else {
+    out_.lambda_used = cap;
+    out_.reason.cap = cap < 1.0 ? LambdaCap::input_lost : LambdaCap::probe;
+  }
   set_stage_data(t, pilot, x);
   rti_.prepare();
   const RtiStatus status = rti_.feedback(x);
@@ -154,14 +163,12 @@ RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotComm
 
   // The prediction and reference of this step, and from them λ for the next (SPEC §5.4).
   const OcpTrajectory& traj = rti_.trajectory();
-  double d_res = 0.0;
   for (int i = 0; i <= settings_.N; ++i) {
     out_.predicted.col(i) = traj.x[i].head<3>();
     out_.reference.col(i) = rti_.data().yref[i].head<3>();
-    if (i <= settings_.ph.N_b)
-      d_res = std::max(d_res, (out_.predicted.col(i) - out_.reference.col(i)).norm());
   }
-  out_.lambda_next = ph_lambda(d_res, settings_.ph);
+  out_.reason_next = ph_reason(out_.predicted, out_.reference, settings_.dt, settings_.ph);
+  out_.lambda_next = out_.reason_next.ph_index;
   out_.applied = traj.x[1];
   rti_.shift();
   return status;

@@ -20,6 +20,7 @@
 
 #include "core/numerics/integrator_erk4.hpp"
 #include "core/control/obstacle_constraint.hpp"
+#include "core/control/ph_index.hpp"
 #include "core/nlp/ocp.hpp"
 #include "core/control/pilot.hpp"
 #include "core/nlp/rti.hpp"
@@ -43,6 +44,8 @@ class MiController {
     Eigen::Matrix3Xd reference;  // 3 x (N+1)
     double lambda_next = 0.5;
     double lambda_used = 0.5;
+    LambdaReason reason_next;  // this step's prediction read by the PH index (cap none)
+    LambdaReason reason;       // what decided lambda_used
   };
 
   MiController() = default;
@@ -67,6 +70,9 @@ class MiController {
   // The PH index of the last step's prediction: λ for the next step when assisted (a probe
   // computes it and does not apply it).
   double ph_index() const { return out_.lambda_next; }
+  // What decided λ in the last step (SPEC §10 "Why λ fell"): the previous step's d_res, i* and
+  // direction, and the cap that held λ below the PH index (input lost, probe) if any.
+  const LambdaReason& reason() const { return out_.reason; }
   bool assisted() const { return settings_.assist == Assistance::on; }
   // The MPC's own (φ, θ, Ω) at stage 1: what the pilot's command became.
   PilotCommand applied_command() const;

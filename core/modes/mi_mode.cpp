@@ -22,6 +22,7 @@ enum MiChannel {
   kRotorSpeedMax,
   kRotorSpeedBound,
   kRtiTime,
+  kPredictedDeviation,
   kRttEstimate,
   kRttSample,
 };
@@ -86,6 +87,7 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   s.predicted = controller_.predicted_positions();
   s.predicted_reference = controller_.reference_positions();
   s.lambda = controller_.lambda();
+  s.reason = controller_.reason();
   s.pilot.rotor_speed.setConstant(model_.hover_speed());
   s.applied = s.pilot;
   set_channels();
@@ -158,6 +160,8 @@ void MiMode::set_channels() {
   s.set_channel(kRotorSpeedMax, "rotor speed max", "kHz", s.x.tail<4>().maxCoeff());
   s.set_channel(kRotorSpeedBound, "rotor speed bound", "kHz", model_.p.omega_max);
   s.set_channel(kRtiTime, "RTI time", "us", s.stats.total_us);
+  // d_res of SPEC §5.4, which λ came from: the previous prediction's largest deviation.
+  s.set_channel(kPredictedDeviation, "predicted deviation", "m", s.reason.d_res);
   if (remote_.attached()) {
     s.set_channel(kRttEstimate, "RTT estimate", "s", remote_.rtt().estimate());
     s.set_channel(kRttSample, "RTT sample", "s", remote_.rtt().last_sample());
@@ -196,6 +200,7 @@ bool MiMode::step() {
   controller_.step(t, s.x_measured, s.pilot);
   s.solved = true;
   s.lambda = controller_.lambda();
+  s.reason = controller_.reason();
   s.applied = controller_.applied_command();
   set_reference(t);
   s.stats = controller_.rti().stats();
@@ -208,6 +213,7 @@ bool MiMode::step() {
     if (run_.safety.switched()) run_.hold = s.x_measured.head<3>();
     hover_.control(s.x_measured, run_.hold, run_.u_safe);
     s.lambda = 0.0;
+    s.reason.cap = LambdaCap::safe_hold;
     run_.command = run_.u_safe;
   } else {
     run_.command = controller_.control();
@@ -314,7 +320,10 @@ ModeView MiMode::view() const {
   v.hover_rotor_speed = model_.hover_speed();
   using R = SeriesRole;
   v.plots = {{"authority λ", {{"lambda", R::pilot}}},
-             {"deviation |p − η_r| vs r", {{"deviation", R::pilot}, {"ball radius r", R::soft_limit}}},
+             {"deviation |p − η_r| vs r",
+              {{"deviation", R::pilot},
+               {"predicted deviation", R::other},
+               {"ball radius r", R::soft_limit}}},
              {"roll φ_h vs φ*₁", {{"roll pilot", R::pilot}, {"roll MPC", R::applied}}},
              {"pitch θ_h vs θ*₁", {{"pitch pilot", R::pilot}, {"pitch MPC", R::applied}}},
              {"rotor speed Ω vs bound",

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "core/control/ph_index.hpp"
 #include "core/control/pilot.hpp"
 #include "core/modes/mode_view.hpp"
 #include "core/modes/vehicle_link.hpp"
@@ -79,6 +80,7 @@ struct Telemetry {
   PilotCommand pilot;    // the pilot's command ν^r
   PilotCommand applied;  // the MPC's stage-1 (φ, θ, Ω): what the pilot's command became
   double lambda = 0.0;   // PH index used in this step
+  LambdaReason reason;   // what decided λ (SPEC §10 "Why λ fell")
   bool has_joy = false;  // joy holds the raw device input behind the pilot's command
   JoyInput joy;
 

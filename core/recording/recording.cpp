@@ -108,6 +108,18 @@ constexpr const char kModeChannelsSchema[] =
     "string[] units\n"
     "float64[] values\n"
     "\n" MIXPILOT_TIME_DEP;
+constexpr const char kLambdaReasonSchema[] =
+    "# What decided the authority lambda of one control step (the PH index, or a cap).\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "float64 lambda          # lambda used in the step\n"
+    "float64 ph_index        # lambda of the PH index from d_res, before any cap\n"
+    "float64 d_res           # [m] max over nodes 0..N_b of |eta - eta_r|, previous prediction\n"
+    "int32 node              # i*, the node of that maximum; -1: no prediction yet\n"
+    "float64 ahead           # [s] i* * dt\n"
+    "float64[3] direction    # unit (eta - eta_r) at node i*, world frame; 0 when d_res = 0\n"
+    "uint8 cap               # 0 none, 1 input lost, 2 probe, 3 safe hold\n"
+    "\n" MIXPILOT_TIME_DEP;
 #undef MIXPILOT_TIME_DEP
 #undef MIXPILOT_SEP
 
@@ -121,6 +133,7 @@ constexpr RecordedType kTypes[] = {
     {"/controller/solver", "mixpilot_msgs/msg/SolverStats", kSolverStatsSchema},
     {"/controller/prediction", "mixpilot_msgs/msg/Prediction", kPredictionSchema},
     {"/mode/channels", "mixpilot_msgs/msg/ModeChannels", kModeChannelsSchema},
+    {"/controller/lambda_reason", "mixpilot_msgs/msg/LambdaReason", kLambdaReasonSchema},
 };
 
 // rosbag2's serialization of one QoS profile (reliable, volatile, default durations): the ros2
@@ -157,6 +170,7 @@ void encode_body(const AppliedCommandMsg& m, const RosTime& stamp, CdrWriter& w)
 void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const ModeChannelsMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const LambdaReasonMsg& m, const RosTime& stamp, CdrWriter& w);
 
 namespace {
 void put_time(const RosTime& t, CdrWriter& w) {
@@ -311,6 +325,26 @@ bool decode(std::span<const uint8_t> d, ModeChannelsMsg& m, std::string& error) 
   return finish(r, error);
 }
 
+void encode(const LambdaReasonMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const LambdaReasonMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write(m.lambda);
+  w.write(m.ph_index);
+  w.write(m.d_res);
+  w.write(m.node);
+  w.write(m.ahead);
+  put_array(m.direction, w);
+  w.write(m.cap);
+}
+bool decode(std::span<const uint8_t> d, LambdaReasonMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.lambda) && r.read(m.ph_index) &&
+         r.read(m.d_res) && r.read(m.node) && r.read(m.ahead) && get_array(r, m.direction) &&
+         r.read(m.cap));
+  return finish(r, error);
+}
+
 void encode_float64(double v, CdrWriter& w) { w.write(v); }
 bool decode_float64(std::span<const uint8_t> d, double& v, std::string& error) {
   CdrReader r(d);
@@ -384,6 +418,7 @@ bool SessionRecorder::record_prediction(const PredictionMsg& m) {
 bool SessionRecorder::record_channels(const ModeChannelsMsg& m) {
   return put(kChannels, m.step, m);
 }
+bool SessionRecorder::record_reason(const LambdaReasonMsg& m) { return put(kReason, m.step, m); }
 bool SessionRecorder::record_lambda(uint64_t step, double lambda) {
   cdr_.reset();
   encode_float64(lambda, cdr_);
@@ -515,6 +550,7 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
       case 5: ok = decode(data, out.solver.emplace_back(), why); break;
       case 6: ok = decode(data, out.predictions.emplace_back(), why); break;
       case 7: ok = decode(data, out.channels.emplace_back(), why); break;
+      case 8: ok = decode(data, out.reasons.emplace_back(), why); break;
       default: break;
     }
     if (!ok)

@@ -112,6 +112,21 @@ struct ModeChannelsMsg {
   bool operator==(const ModeChannelsMsg&) const = default;
 };
 
+// mixpilot_msgs/msg/LambdaReason on /controller/lambda_reason: what decided the step's λ
+// (SPEC §10 "Why λ fell", from §5.4), mixed initiative only.
+struct LambdaReasonMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  double lambda = 0.0;    // λ used in the step (as /controller/lambda)
+  double ph_index = 0.0;  // λ of the PH index from d_res, before any cap
+  double d_res = 0.0;     // [m] largest deviation of the previous prediction over nodes 0..N_b
+  int32_t node = -1;      // i*, where it is reached; −1: no prediction yet (λ initial)
+  double ahead = 0.0;     // [s] i*·Δt
+  std::array<double, 3> direction{};  // unit η_{i*} − η^r_{i*}, world frame (0 when d_res = 0)
+  uint8_t cap = 0;        // LambdaCap: 0 none, 1 input lost, 2 probe, 3 safe hold
+  bool operator==(const LambdaReasonMsg&) const = default;
+};
+
 // ---- encoding ---------------------------------------------------------------------------
 
 // The ros2msg schema (top-level definition followed by its dependencies) and schema name of
@@ -133,6 +148,7 @@ void encode(const AppliedCommandMsg& m, CdrWriter& out);
 void encode(const SolverStatsMsg& m, CdrWriter& out);
 void encode(const PredictionMsg& m, CdrWriter& out);
 void encode(const ModeChannelsMsg& m, CdrWriter& out);
+void encode(const LambdaReasonMsg& m, CdrWriter& out);
 void encode_float64(double v, CdrWriter& out);
 bool decode(std::span<const uint8_t> data, JoyMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PilotCommandMsg& m, std::string& error);
@@ -141,6 +157,7 @@ bool decode(std::span<const uint8_t> data, AppliedCommandMsg& m, std::string& er
 bool decode(std::span<const uint8_t> data, SolverStatsMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PredictionMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, ModeChannelsMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, LambdaReasonMsg& m, std::string& error);
 bool decode_float64(std::span<const uint8_t> data, double& v, std::string& error);
 
 // ---- recording --------------------------------------------------------------------------
@@ -197,6 +214,7 @@ class SessionRecorder {
   bool record_solver(const SolverStatsMsg& m);
   bool record_prediction(const PredictionMsg& m);
   bool record_channels(const ModeChannelsMsg& m);
+  bool record_reason(const LambdaReasonMsg& m);
 
   bool flush() { return writer_.flush(); }
   // Writes the "mixpilot_end" Metadata record (steps = the /vehicle/state messages recorded),
@@ -208,7 +226,8 @@ class SessionRecorder {
 
  private:
   enum Topic {
-    kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kTopicCount
+    kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kReason,
+    kTopicCount
   };
   template <class Msg>
   bool put(Topic t, uint64_t step, const Msg& m);
@@ -234,6 +253,7 @@ struct RecordingContents {
   std::vector<SolverStatsMsg> solver;
   std::vector<PredictionMsg> predictions;
   std::vector<ModeChannelsMsg> channels;
+  std::vector<LambdaReasonMsg> reasons;  // empty in recordings older than the topic
   bool complete = true;  // false: read from a cut-short temporary (allow_truncated)
   // The "mixpilot_end" record: absent when the file was cut short (or is older than it).
   std::optional<RecordingEnd> end;

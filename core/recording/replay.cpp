@@ -124,6 +124,14 @@ bool same(const std::vector<double>& recorded, const Eigen::VectorXd& v) {
          std::equal(v.data(), v.data() + v.size(), recorded.begin());
 }
 
+bool same(const LambdaReasonMsg& recorded, const Telemetry& s) {
+  const LambdaReason& r = s.reason;
+  return recorded.lambda == s.lambda && recorded.ph_index == r.ph_index &&
+         recorded.d_res == r.d_res && recorded.node == r.node && recorded.ahead == r.ahead &&
+         recorded.direction[0] == r.direction(0) && recorded.direction[1] == r.direction(1) &&
+         recorded.direction[2] == r.direction(2) && recorded.cap == std::uint8_t(r.cap);
+}
+
 }  // namespace
 
 void ReplayCheck::on_sample(const Telemetry& s) {
@@ -137,6 +145,10 @@ void ReplayCheck::on_sample(const Telemetry& s) {
   } else if (s.mode == ModeKind::mixed_initiative &&
              (k >= rec_->lambda.size() || rec_->lambda[k].lambda != s.lambda)) {
     what = "lambda";
+  } else if (s.mode == ModeKind::mixed_initiative && !rec_->reasons.empty() &&
+             (k >= rec_->reasons.size() || !same(rec_->reasons[k], s))) {
+    // Recordings older than the topic have none: their λ alone is checked.
+    what = "lambda reason";
   }
   if (what) {
     first_ = s.step;

@@ -47,8 +47,9 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
                                   std::optional<double> duration, std::string& error);
 
 // Compares each replayed step with the recorded one: the state, the applied input and, in
-// mixed initiative, λ (the last pilot command shows only in the last applied input), and at
-// the end that every recorded step was replayed.
+// mixed initiative, λ and what decided it (where the recording has /controller/lambda_reason;
+// the last pilot command shows only in the last applied input), and at the end that every
+// recorded step was replayed.
 class ReplayCheck final : public TelemetrySink {
  public:
   explicit ReplayCheck(const RecordingContents& rec) : rec_(&rec) {}

@@ -96,7 +96,19 @@ void RecordingSink::write(const Telemetry& s) {
   state_.step = step;
   state_.x.assign(s.x.data(), s.x.data() + s.x.size());
   recorder_.record_state(state_);
-  if (mi) recorder_.record_lambda(step, s.lambda);
+  if (mi) {
+    recorder_.record_lambda(step, s.lambda);
+    reason_.stamp = stamp;
+    reason_.step = step;
+    reason_.lambda = s.lambda;
+    reason_.ph_index = s.reason.ph_index;
+    reason_.d_res = s.reason.d_res;
+    reason_.node = s.reason.node;
+    reason_.ahead = s.reason.ahead;
+    for (int i = 0; i < 3; ++i) reason_.direction[std::size_t(i)] = s.reason.direction(i);
+    reason_.cap = static_cast<std::uint8_t>(s.reason.cap);
+    recorder_.record_reason(reason_);
+  }
 
   applied_.stamp = stamp;
   applied_.step = step;

@@ -84,6 +84,7 @@ class RecordingSink final : public TelemetrySink {
   PredictionMsg prediction_;
   JoyMsg joy_;
   ModeChannelsMsg channels_;
+  LambdaReasonMsg reason_;
 };
 
 class ReplayPilot final : public PilotSource {
