@@ -106,6 +106,13 @@ std::vector<fs::path> files_in(const fs::path& dir) {
   return out;
 }
 
+// Saves the last frame as NAME.png in $MIXPILOT_SHOT_DIR when it is set (to look at).
+void save_shot(const cli::Offscreen& screen, const std::string& name) {
+  const char* dir = std::getenv("MIXPILOT_SHOT_DIR");
+  if (!dir || !*dir) return;
+  std::ofstream(std::string(dir) + "/" + name + ".png", std::ios::binary) << screen.png();
+}
+
 class Video : public testing::Test {
  protected:
   // One recording for every test of the process: the novice flying mi_helix for 4 s.
@@ -371,12 +378,19 @@ TEST_F(Video, ExportClipFromTheWindow) {
   EXPECT_NE(app.run_info().message.find("being exported already"), std::string::npos);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(180);
   auto slowest = std::chrono::steady_clock::duration::zero();
+  bool shot = false;
   while (app.clips().running() && std::chrono::steady_clock::now() < deadline) {
     const auto t0 = std::chrono::steady_clock::now();
     frame();
     slowest = std::max(slowest, std::chrono::steady_clock::now() - t0);
+    if (!shot && app.run_info().message.ends_with(" %")) {
+      save_shot(screen, "export_clip_progress");
+      shot = true;
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  frame();
+  save_shot(screen, "export_clip_saved");
   ASSERT_FALSE(app.clips().running());
   EXPECT_TRUE(app.clips().saved()) << app.run_info().message;
   EXPECT_EQ(app.run_info().message, "clip saved: " + (dir_ / "flight-clip-1.mp4").string());

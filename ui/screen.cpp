@@ -395,8 +395,7 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"Home / End", "replay: start / end"},
       {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
       {"[  ]", "replay: previous / next event"},
-      {kExportClipKeyName, "replay: export a clip, 5 s either side of the playhead, as a video "
-                           "(MP4) beside the recording; progress in the status line"},
+      {kExportClipKeyName, "replay: export a clip, the playhead ± 5 s, beside the recording"},
       {"Esc", "leave the replay; close this sheet or the progress"},
       {"F1  ?", "this sheet"},
   };
