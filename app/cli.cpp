@@ -96,11 +96,20 @@ void catch_interrupts() {
 
 bool interrupted() { return g_interrupted.load(std::memory_order_relaxed); }
 
-Progress::Progress(std::string label, std::int64_t total)
-    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+Progress::Progress(std::string label, std::int64_t total, Piped piped)
+    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1), piped_(piped) {}
 
 void Progress::update(std::int64_t done) {
-  if (!tty_ || total_ <= 0) return;
+  if (total_ <= 0) return;
+  if (!tty_) {
+    if (piped_ == Piped::silent) return;
+    const int tenths = int(std::clamp(done * 10 / total_, std::int64_t(0), std::int64_t(10)));
+    if (tenths <= tenths_said_) return;
+    tenths_said_ = tenths;
+    std::fprintf(stderr, "%s: %d %%\n", label_.c_str(), 10 * tenths);
+    std::fflush(stderr);
+    return;
+  }
   const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                std::chrono::steady_clock::now().time_since_epoch())
                                .count();

@@ -60,10 +60,13 @@ bool write_file(const std::string& path, const std::string& text, bool overwrite
 void catch_interrupts();
 bool interrupted();
 
-// A progress bar on stderr when it is a terminal (nothing otherwise): "label [#####   ] 42%".
+// A progress bar on stderr when it is a terminal: "label [#####   ] 42%". Otherwise nothing,
+// or with `Piped::tenths` a line "label: N %" at every tenth (for a log, or a parent process
+// that shows the progress itself).
 class Progress {
  public:
-  Progress(std::string label, std::int64_t total);
+  enum class Piped { silent, tenths };
+  Progress(std::string label, std::int64_t total, Piped piped = Piped::silent);
   ~Progress() { finish(); }
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -74,6 +77,8 @@ class Progress {
   std::string label_;
   std::int64_t total_;
   bool tty_;
+  Piped piped_;
+  int tenths_said_ = 0;  // Piped::tenths: the last tenth printed
   bool drawn_ = false;
   std::int64_t last_ns_ = 0;
 };

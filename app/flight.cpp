@@ -338,6 +338,13 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
   if (!o.report.empty()) check_not_an_input(o.command, "--report", o.report, inputs);
   for (const ScreenshotRequest& shot : o.screenshots)
     check_not_an_input(o.command, "--screenshot", shot.path, inputs);
+  if (!o.video.path.empty()) {
+    check_not_an_input(o.command, "--video", o.video.path, inputs);
+    for (const ScreenshotRequest& shot : o.screenshots)
+      if (same_output_path(shot.path, o.video.path))
+        usage_error(o.command, "--screenshot and --video name the same file '" + shot.path + "'");
+    if (!check_output_path(o.video.path, o.force, error)) return false;
+  }
   if (!o.record.empty() && !o.report.empty() && same_output_path(o.record, o.report))
     usage_error(o.command, "--record and --report name the same file '" + o.record + "'");
   for (const std::string* path : {&o.record, &o.report})

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/screenshot.hpp"
+#include "app/video.hpp"
 #include "input/device_pilot.hpp"
 #include "input/gamepad.hpp"
 #include "input/keyboard.hpp"
@@ -36,7 +37,8 @@ struct FlyOptions {
   bool allow_mismatch = false;
   bool force = false;
   std::vector<ScreenshotRequest> screenshots;
-  int width = 1280, height = 720;  // of the screenshots and the window
+  VideoOptions video;              // replay --video: a video file of the replay
+  int width = 1280, height = 720;  // of the screenshots, the video and the window
   float scale = 0.0f;              // --scale: the UI's display scale (0: the window's; headless 1)
   bool realtime = false;           // headless, paced by the wall clock
   bool exit_at_end = false;        // window: start at once, close when the run is over

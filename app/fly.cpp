@@ -16,6 +16,7 @@
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
 #include "app/trainer.hpp"
+#include "app/video_replay.hpp"
 #include "app/window.hpp"
 #include "core/history/history.hpp"
 #include "core/runtime/realtime_runner.hpp"
@@ -286,6 +287,8 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
 
 int run_fly(const FlyOptions& o) {
   std::string error;
+  // ffmpeg is looked for before the outputs: without it nothing else matters.
+  if (!o.video.path.empty()) return replay_to_video(o);
   if (!o.headless && !window_available(error)) {  // before any output is opened
     std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
     return kExitError;
@@ -478,18 +481,31 @@ constexpr const char* kReplayUsage =
     "\n"
     "  --headless         no window (with --screenshot: what the window shows at time T)\n"
     "  --screenshot T:FILE.png  as for fly; repeatable\n"
-    "  --size WxH         screenshot or window size (default 1280x720)\n"
+    "  --video OUT.mp4    a video of the replay, without a window: every frame rendered\n"
+    "                     offscreen as --screenshot renders it (frame i shows time\n"
+    "                     FROM + i/FPS) and encoded by ffmpeg (H.264, yuv420p; Debian's\n"
+    "                     package ffmpeg), with a progress bar on a terminal\n"
+    "  --from T           the video's first frame at T seconds (default 0)\n"
+    "  --to T             the video ends before T seconds (default: the recording's end)\n"
+    "  --fps F            video frames per second, 1 to 120 (default 30)\n"
+    "  --size WxH         screenshot, video or window size (default 1280x720; even for a\n"
+    "                     video)\n"
     "  --scale S          display scale of the UI, 0.5 to 4 (as for fly; headless default 1)\n"
     "  --exit-at-end      window: start at once and close the window at the end\n"
-    "  --force            overwrite existing screenshot files\n"
+    "  --force            overwrite existing screenshot and video files\n"
     "  -h, --help         show this help\n"
     "\n"
-    "exit status: 0 done, 1 unreadable recording, 2 usage, 3 the replay differs, 130 interrupted\n";
+    "A video is written to a temporary beside OUT and moved into place when complete: a\n"
+    "failure or ^C leaves no file.\n"
+    "\n"
+    "exit status: 0 done, 1 unreadable recording or a failure (no ffmpeg, ffmpeg failed),\n"
+    "2 usage, 3 the replay differs, 130 interrupted\n";
 
 int replay_command(int argc, char** argv) {
   FlyOptions o;
   o.replay = true;
   o.command = "replay";
+  bool from_given = false, to_given = false, fps_given = false;
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
     const auto value = [&] { return option_value("replay", argc, argv, i); };
@@ -498,6 +514,23 @@ int replay_command(int argc, char** argv) {
       return kExitOk;
     } else if (a == "--headless") {
       o.headless = true;
+    } else if (a == "--video") {
+      o.video.path = value();
+    } else if (a == "--from" || a == "--to") {
+      const std::string v = value();
+      const auto t = parse_time(v);
+      if (!t)
+        usage_error("replay", std::string(a) + " expects a time in seconds >= 0, got '" + v + "'");
+      (a == "--from" ? from_given : to_given) = true;
+      if (a == "--from") o.video.from = *t;
+      else o.video.to = *t;
+    } else if (a == "--fps") {
+      const std::string v = value();
+      const auto fps = parse_fps(v);
+      if (!fps)
+        usage_error("replay", "--fps expects frames per second from 1 to 120, got '" + v + "'");
+      o.video.fps = *fps;
+      fps_given = true;
     } else if (parse_view_option(a, value, o)) {
     } else if (a == "--force") {
       o.force = true;
@@ -513,6 +546,19 @@ int replay_command(int argc, char** argv) {
   if (o.pilot.empty()) usage_error("replay", "which recording? (mixpilot replay FILE.mcap)");
   if (!o.pilot.ends_with(".mcap"))
     usage_error("replay", "'" + o.pilot + "' is not a recording (FILE.mcap)");
+  if (o.video.path.empty() && (from_given || to_given || fps_given))
+    usage_error("replay", std::string(from_given ? "--from" : to_given ? "--to" : "--fps") +
+                              " goes with --video OUT.mp4");
+  if (!o.video.path.empty()) {
+    if (o.exit_at_end) usage_error("replay", "--exit-at-end is for the window; --video renders without one");
+    if (o.width % 2 != 0 || o.height % 2 != 0)
+      usage_error("replay", "--size for --video expects an even width and height (H.264 in "
+                            "4:2:0 halves both for colour), got " + std::to_string(o.width) +
+                            "x" + std::to_string(o.height));
+    if (o.video.to && *o.video.to <= o.video.from)
+      usage_error("replay", range_problem(o.video.from, *o.video.to, true, 1e300));
+    o.headless = true;  // a video renders offscreen
+  }
   if (o.exit_at_end && o.headless) usage_error("replay", "--exit-at-end is for the window");
   return run_fly(o);
 }

@@ -143,6 +143,13 @@ std::vector<std::uint8_t> Offscreen::pixels() const {
   return out;
 }
 
+void Offscreen::read_bottom_up(std::vector<std::uint8_t>& rgba) const {
+  rgba.resize(std::size_t(width_) * std::size_t(height_) * 4);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+}
+
 std::string Offscreen::png() const {
   const auto px = pixels();
   std::string out;

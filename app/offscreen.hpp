@@ -31,6 +31,9 @@ class Offscreen {
 
   // The last frame, RGBA, top row first: width × height × 4 bytes.
   std::vector<std::uint8_t> pixels() const;
+  // The last frame, RGBA, bottom row first (as OpenGL reads it), into `rgba` (resized; its
+  // capacity kept from frame to frame): no copy beyond the read, for a video.
+  void read_bottom_up(std::vector<std::uint8_t>& rgba) const;
   // The last frame as a PNG file's bytes.
   std::string png() const;
 

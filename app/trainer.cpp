@@ -31,6 +31,7 @@ void Trainer::build_frame(double wall_dt) {
   wizard_.update(input_.started(), input_.info().wizard);
   run_.input = &input_.info();
   poll_history();
+  clips_.poll();
   if (replay_.is_open()) replay_.update(wall_dt, run_);
   else if (live_.flight()) live_.update(input_.info().connected, run_);
   requests_.clear();
@@ -65,6 +66,10 @@ void Trainer::act(const ui::Request& r) {
                    std::visit(ui::overloaded{
                                   [&](const ui::OpenFile& o) { open_file(o.path); },
                                   [&](const ui::LeaveReplay&) { leave_replay(); },
+                                  [&](const ui::ExportClip& c) {
+                                    if (const ReplayTape* tape = replay_.tape())
+                                      (void)clips_.start(tape->path(), c.from, c.to);
+                                  },
                                   [&](const ui::ReplayRecording& p) {
                                     // As File → Open of that recording.
                                     std::string error;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/clip_export.hpp"
 #include "app/flight.hpp"
 #include "app/history_writer.hpp"
 #include "app/input_controller.hpp"
@@ -53,6 +54,7 @@ class Trainer {
   const LiveFlight* live() const { return live_.flight(); }
   const ReplayTape* replay() const { return replay_.tape(); }
   HistoryWriter* history() { return history_.get(); }
+  ClipExporter& clips() { return clips_; }
 
   // Stops the flight (closing its recording) and the replay; prints the summary, writes the
   // report; returns the exit status (kExitReplayMismatch for a replay that differs).
@@ -66,6 +68,8 @@ class Trainer {
   // Declared before the controllers, which say things into it and outlive none of it.
   ui::RunInfo run_;  // the frame's snapshot
   StatusLine status_{run_};
+  // "Export clip": outlives the replay it was asked from (the file is written on its own).
+  ClipExporter clips_{status_};
   InputController input_;
   WizardController wizard_;
   // Before live_: a flight closing hands its row to it (nullptr: --history off).

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # What a user does with the installed package, from a folder that holds no source: the demo, a
-# flight of an installed scenario with a report, a recording scored, a headless screenshot, the
-# man pages and the help. Runs wherever mixpilot is installed (this machine, or the throwaway
-# root of packaging/debootstrap-test.sh). Usage: installed-checks.sh WORK_DIR
+# flight of an installed scenario with a report, a recording scored, a headless screenshot, a
+# video of a replay (or, without ffmpeg, the package to install), the man pages and the help.
+# Runs wherever mixpilot is installed (this machine, or the throwaway root of
+# packaging/debootstrap-test.sh). Usage: installed-checks.sh WORK_DIR
 set -euo pipefail
 work=$1
 mkdir -p "$work/home"
@@ -32,6 +33,18 @@ mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless
   --screenshot "2:$work/shot.png"
 [ "$(head -c 8 "$work/shot.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || {
   say "the screenshot is not a PNG"; exit 1; }
+# ffmpeg is recommended, not required: without it the command names the package to install.
+if command -v ffmpeg >/dev/null; then
+  say "video of a replay"
+  mixpilot replay "$work/novice.mcap" --video "$work/novice.mp4" --to 1 --size 320x180
+  [ "$(head -c 8 "$work/novice.mp4" | tail -c 4)" = ftyp ] || { say "the video is no MP4"; exit 1; }
+else
+  say "video without ffmpeg"
+  if mixpilot replay "$work/novice.mcap" --video "$work/novice.mp4" 2>"$work/video.err"; then
+    say "a video without ffmpeg"; exit 1
+  fi
+  grep -q "apt install ffmpeg" "$work/video.err" || { say "no word of the ffmpeg package"; exit 1; }
+fi
 say "man pages"
 for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-reference; do
   [ -f /usr/share/man/man1/$page.1.gz ] || { say "no man page $page(1)"; exit 1; }

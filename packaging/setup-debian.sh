@@ -17,6 +17,8 @@ packages=(
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
   libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
   libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev xvfb xauth
+  # videos of replays (mixpilot replay --video, the window's Export clip; ffprobe in the tests)
+  ffmpeg
   # gamepads
   libsdl2-dev
   # network peers (C API + idlc)

@@ -6,8 +6,9 @@ Inputs (each through every command that reads it):
   --scenario (fly, vehicle), --input-settings (fly --pilot gamepad, gamepad-script,
   joy-publish), the config folder's input.toml and gamecontrollerdb.txt
   ($XDG_CONFIG_HOME/mixpilot/; fly --pilot gamepad, gamepad-script), --gamepad-script (fly),
-  the reference CSVs a scenario names (fly), recordings (score, replay, fly --pilot,
-  gamepad-script, joy-publish, recover) and MIXPILOT_DATA_DIR (demo).
+  the reference CSVs a scenario names (fly), recordings (score, replay, replay --video, fly
+  --pilot, gamepad-script, joy-publish, recover) and MIXPILOT_DATA_DIR (demo); replay --video's
+  --from, --to, --fps and --size values out of range or no numbers.
 File types: a regular file, an empty one, a directory, a FIFO, /dev/zero, /dev/full, a
 symbolic-link loop, a dangling link, an unreadable file (as root, which reads mode-000 files,
 the run drops to user nobody with setpriv; without setpriv that kind is left out and the count
@@ -168,6 +169,8 @@ def build_cases(base, binary, scen_dir, setpriv):
         ("recording", file_input("r.mcap", rec.read_bytes()), [
             ("score", ["score", "{X}", "--jobs", "1"], "refused"),
             ("replay", ["replay", "{X}", "--headless"], "refused"),
+            ("replay --video", ["replay", "{X}", "--video", "{D}/out.mp4", "--size", "64x64",
+                                "--fps", "5"], "refused"),
             ("fly --pilot", ["fly", "--pilot", "{X}", "--headless"], "refused"),
             ("gamepad-script", ["gamepad-script", "{X}", "-o", "{D}/out.csv"], "refused"),
             ("joy-publish", ["joy-publish", "--from", "{X}", "--wait", "0"], "refused"),
@@ -312,6 +315,11 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("replay FILE", ["replay", "", "--headless"], "empty"),
             ("replay --screenshot", ["replay", R, "--headless", "--screenshot", ""],
              "--screenshot"),
+            ("replay --video", ["replay", R, "--video", ""], "--video"),
+            ("replay --from", ["replay", R, "--video", "{D}/o.mp4", "--from", ""], "--from"),
+            ("replay --to", ["replay", R, "--video", "{D}/o.mp4", "--to", ""], "--to"),
+            ("replay --fps", ["replay", R, "--video", "{D}/o.mp4", "--fps", ""], "--fps"),
+            ("replay --size", ["replay", R, "--video", "{D}/o.mp4", "--size", ""], "--size"),
             ("score FILE", ["score", ""], "empty"),
             ("score --json", ["score", R, "--json", ""], "--json"),
             ("recover FILE", ["recover", ""], "empty"),
@@ -330,6 +338,19 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("history --history", ["history", "--history", ""], "--history"),
             ("history import DIR", ["history", "import", ""], "empty")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
+
+    # replay --video's values: out of range, not numbers, not finite; each a usage error
+    # naming its option (nothing rendered, nothing written).
+    video = ["replay", R, "--video", "{D}/v.mp4", "--size", "64x64"]
+    numbers = ["-1", "nan", "inf", "-inf", "1e999", " ", "1,5", "10abc", "\u0661", "--"]
+    for option, values in (("--from", numbers), ("--to", numbers + ["0", "99"]),
+                           ("--fps", numbers + ["0", "0.5", "121", "1e9"]),
+                           ("--size", ["0x0", "64x", "x64", "65x64", "64x-64", "99999x99999",
+                                       "64X64", "64x64x64"])):
+        for v in values:
+            argv = [a for a in video if option != "--size" or a not in ("--size", "64x64")]
+            cases.append(Case(f"value {option} {v!r} via replay --video", argv + [option, v],
+                              "usage", option))
 
     # The user's folders from the environment: never the current folder's .config.
     for label, env in (("HOME unset", {"HOME": None, "XDG_CONFIG_HOME": None}),

@@ -36,6 +36,11 @@ inline bool key_down(Key k) { return ImGui::IsKeyDown(int(k)); }
 // Holds or releases `k` for the next frames, as a backend does.
 inline void set_key(ImGuiIO& io, Key k, bool down) { io.KeysDown[int(k)] = down; }
 
+// A replay's "Export clip": the playhead ± ui::kClipHalfWidth saved as a video (the button's
+// label and the help sheet name it too).
+inline constexpr Key kExportClipKey = Key::e;
+inline constexpr const char* kExportClipKeyName = "E";
+
 // The keys that fly the keyboard pilot (input/keyboard.hpp), indexed by input::Key: W S A D
 // and the arrows.
 inline constexpr Key kFlightKeys[] = {Key::w, Key::s, Key::a, Key::d,

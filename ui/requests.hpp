@@ -88,7 +88,19 @@ struct LeaveReplay {};            // back to the live flight (Esc)
 struct ReplayRecording {          // a flight of the Progress panel: its recording, replayed
   std::string path;
 };
-using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording>;
+struct ExportClip {               // a time window of the replay shown, saved as a video file
+  double from, to;                // [s] beside its recording (the export outlives the replay)
+};
+using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording, ExportClip>;
+
+// What "Export clip" saves around a replay's time `t` [s]: `half_width` seconds either side,
+// within the recording's [0, duration].
+inline constexpr double kClipHalfWidth = 5.0;  // [s]
+inline ExportClip clip_around(double t, double duration, double half_width = kClipHalfWidth) {
+  const double from = t - half_width < 0.0 ? 0.0 : t - half_width;
+  const double to = t + half_width > duration ? duration : t + half_width;
+  return ExportClip{from, to};
+}
 
 // Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
 using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;

@@ -408,6 +408,7 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"Home / End", "replay: start / end"},
       {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
       {"[  ]", "replay: previous / next event"},
+      {kExportClipKeyName, "replay: export a clip, the playhead ± 5 s, beside the recording"},
       {"Esc", "leave the replay; close this sheet or the progress"},
       {"F1  ?", "this sheet"},
   };
@@ -456,6 +457,7 @@ void replay_keys(const RunInfo& run, Requests& out) {
   if (key_pressed(Key::down)) out.push_back(SetPlaySpeed{slower});
   if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
   if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
+  if (key_pressed(kExportClipKey)) out.push_back(clip_around(r.t, r.duration));
   if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
     out.push_back(LeaveReplay{});
 }

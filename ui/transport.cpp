@@ -120,6 +120,11 @@ void draw_transport(const RunInfo& run, Requests& out) {
   if (ImGui::Button("< previous event [")) out.push_back(JumpToEvent{-1});
   same_line_or_wrap(button_width("] next event >"));
   if (ImGui::Button("] next event >")) out.push_back(JumpToEvent{+1});
+  same_line_or_wrap(button_width("Export clip (E)"));
+  if (ImGui::Button("Export clip (E)")) out.push_back(clip_around(r.t, r.duration));
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Saves %g s either side of the playhead as a video beside the recording",
+                      kClipHalfWidth);
   ImGui::PushFont(mono_font());
   char time[48];
   std::snprintf(time, sizeof time, "%7.2f / %.2f s", r.t, r.duration);
