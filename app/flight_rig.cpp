@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/numerics/version.hpp"
 #include "input/net/dds.hpp"
 
@@ -167,12 +167,12 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
   if (r.trainee.empty()) r.trainee = "unnamed";  // an account without a name
   r.station = history::host_name();
   r.scenario = mode.scenario_name();
-  r.scenario_hash = history::sha256_hex(flight_.scenario_text);
+  r.scenario_hash = sha256_hex(flight_.scenario_text);
   r.mode = to_string(mode.kind());
   r.pilot = flight_.recording ? meta("pilot") : flight_.pilot;
   if (!flight_.recording && is_device_pilot(options_.pilot)) {
     r.input_device = options_.pilot;
-    if (flight_.devices) r.input_settings_hash = history::sha256_hex(input::to_toml(flight_.devices->settings));
+    if (flight_.devices) r.input_settings_hash = sha256_hex(input::to_toml(flight_.devices->settings));
   }
   r.started_unix_ms = started_unix_ms_;
   r.duration_s = double(mode.steps_done()) * mode.dt();
@@ -188,7 +188,7 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);
     r.recording_path = ec ? record_path_ : abs.lexically_normal().string();
     if (hash) {
-      const auto h = history::sha256_file(record_path_, error);
+      const auto h = sha256_file(record_path_, error);
       if (!h) return std::nullopt;
       r.recording_hash = *h;
     }

@@ -24,7 +24,7 @@
 #include "app/progress_html.hpp"
 #include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/postgres_history.hpp"
 #include "core/history/push.hpp"
@@ -423,7 +423,7 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
   // Known recordings are skipped before they are flown: importing again costs only the hashes.
   std::string error;
   for (ImportRow& r : rows) {
-    const auto h = history::sha256_file(r.file, r.error);
+    const auto h = sha256_file(r.file, r.error);
     if (!h) continue;
     r.hash = *h;
     bool known = false;
