@@ -289,8 +289,8 @@ TEST(HistoryStore, HostileTraineeNames) {
   EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
 }
 
-// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
-// row) is brought forward on open; its flights stay.
+// A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
+// columns, one schema_version row) is brought forward on open; its flights stay.
 TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   const fs::path p = test::fresh_path("history", "migrate.sqlite");
   auto store = open_store(p);
@@ -301,17 +301,63 @@ TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
-  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DELETE FROM schema_version "
-                             "WHERE version > 1", nullptr, nullptr, nullptr), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DROP INDEX flights_by_parent; "
+                             "ALTER TABLE flights DROP COLUMN parent_step; "
+                             "ALTER TABLE flights DROP COLUMN parent_recording_hash; "
+                             "DELETE FROM schema_version WHERE version > 1",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
   sqlite3_close(db);
   ASSERT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), 1);
   store = open_store(p);
   ASSERT_TRUE(store);
   EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
   EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'flights_by_parent'"), 1);
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
-  test::expect_same_flight(sample_flight(), rows[0]);
+  test::expect_same_flight(sample_flight(), rows[0]);  // no parent: not a branch
+}
+
+// Fly from here (SPEC §10): a branch is a row like any flight plus its parent link — the
+// parent flight's recording hash and the step it was taken over at — read back as written,
+// NULL for any other flight; the branches of a flight are found through the parent index. A
+// half link is refused.
+TEST(HistoryStore, FlyFromHereBranchRowRoundTrips) {
+  const fs::path p = test::fresh_path("history", "branch.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord parent = sample_flight("Ada", 1'700'000'000'000);
+  parent.recording_path = "/r/novice.mcap";
+  parent.recording_hash = sha256_hex("the novice's recording");
+  FlightRecord branch = sample_flight("Ada", 1'700'000'100'000);
+  branch.pilot = "experienced";
+  branch.recording_path = "/r/branch.mcap";
+  branch.recording_hash = sha256_hex("the branch's recording");
+  branch.parent_recording_hash = parent.recording_hash;
+  branch.parent_step = 666;
+  std::string error;
+  ASSERT_EQ(store->add(parent, error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(store->add(branch, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 2u);
+  test::expect_same_flight(parent, rows[0]);
+  EXPECT_FALSE(rows[0].branch());
+  test::expect_same_flight(branch, rows[1]);
+  EXPECT_TRUE(rows[1].branch());
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM flights WHERE parent_step IS NULL"), 1);
+  const std::string of_parent = "SELECT parent_step FROM flights WHERE parent_recording_hash = '" +
+                                parent.recording_hash + "'";
+  EXPECT_EQ(sql_int(p, of_parent.c_str()), 666);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'flights_by_parent'"), 1);
+  FlightRecord half = branch;
+  half.recording_hash = sha256_hex("another");
+  half.parent_recording_hash.clear();
+  EXPECT_FALSE(store->add(half, error));
+  EXPECT_NE(error.find("a branch needs both its parent recording's hash and its parent step"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(all(*store).size(), 2u);
 }
 
 // A newer mixpilot's history is refused with the reason and left as it was, byte for byte.

@@ -182,8 +182,9 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
             std::to_string(history::kSchemaVersion));
 }
 
-// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
-// row) is brought forward on open by the same migrations SQLite runs; its flights stay.
+// A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
+// columns, one schema_version row) is brought forward on open by the same migrations SQLite
+// runs; its flights stay.
 TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "migrate");
@@ -193,6 +194,11 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
   store.reset();
   ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
+  ASSERT_TRUE(server->exec("migrate",
+                           "ALTER TABLE flights DROP COLUMN parent_step, "
+                           "DROP COLUMN parent_recording_hash",
+                           error))
+      << error;
   ASSERT_TRUE(server->exec("migrate", "DELETE FROM schema_version WHERE version > 1", error))
       << error;
   ASSERT_EQ(sql(*server, "migrate", "SELECT max(version) FROM schema_version"), "1");
@@ -203,9 +209,45 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   EXPECT_EQ(sql(*server, "migrate",
                 "SELECT count(*) FROM pg_indexes WHERE indexname = 'metrics_by_name'"),
             "1");
+  EXPECT_EQ(sql(*server, "migrate",
+                "SELECT count(*) FROM pg_indexes WHERE indexname = 'flights_by_parent'"),
+            "1");
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
   expect_same_flight(sample_flight(), rows[0]);
+}
+
+// Fly from here (SPEC §10): a branch's parent link (the parent flight's recording hash and the
+// step it was taken over at) read back as written, NULL for any other flight, as in SQLite.
+TEST(Postgres, FlyFromHereBranchRowRoundTrips) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "branch");
+  auto store = open_store(url);
+  ASSERT_TRUE(store);
+  FlightRecord parent = sample_flight();
+  parent.recording_path = "/r/novice.mcap";
+  parent.recording_hash = sha256_hex("the novice's recording");
+  FlightRecord branch = sample_flight();
+  branch.started_unix_ms += 100'000;
+  branch.pilot = "experienced";
+  branch.recording_path = "/r/branch.mcap";
+  branch.recording_hash = sha256_hex("the branch's recording");
+  branch.parent_recording_hash = parent.recording_hash;
+  branch.parent_step = 666;
+  std::string error;
+  ASSERT_EQ(store->add(parent, error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(store->add(branch, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 2u);
+  expect_same_flight(parent, rows[0]);
+  EXPECT_FALSE(rows[0].branch());
+  expect_same_flight(branch, rows[1]);
+  EXPECT_TRUE(rows[1].branch());
+  EXPECT_EQ(sql(*server, "branch", "SELECT count(*) FROM flights WHERE parent_step IS NULL"), "1");
+  EXPECT_EQ(sql(*server, "branch",
+                "SELECT parent_step FROM flights WHERE parent_recording_hash = '" +
+                    parent.recording_hash + "'"),
+            "666");
 }
 
 // A recording is one flight: the same hash again is already known and adds nothing; flights
