@@ -6,6 +6,7 @@
 
 #include "core/base/content_hash.hpp"
 #include "core/numerics/version.hpp"
+#include "core/recording/branch_replay.hpp"
 #include "input/net/dds.hpp"
 
 namespace mixpilot::cli {
@@ -183,6 +184,18 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
   r.front_end = remote ? "vehicle" : front_end_;
   r.app_version = version();
   r.probe = mode.identity().probe;  // an unassisted probe (SPEC §10)
+  // A branch (fly from here): its parent flight, by that flight's recording hash, and the step
+  // it was taken over at; a branch's replay (history import) as its recording names them.
+  std::optional<ParentLink> parent;
+  std::string malformed;  // a replay of a malformed link was refused before
+  if (flight_.from)
+    parent = ParentLink{flight_.from->parent, flight_.from->parent_sha256, flight_.from->step};
+  else if (flight_.recording && !parent_link(*flight_.recording, "", parent, malformed))
+    parent.reset();
+  if (parent) {
+    r.parent_recording_hash = parent->sha256;
+    r.parent_step = parent->step;
+  }
   if (completed_recording_) {
     std::error_code ec;
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);
@@ -204,7 +217,16 @@ Metrics FlightRig::metrics() const {
 }
 
 std::string FlightRig::replay_difference() const {
-  return check_ ? check_->first_difference(flight_.mode->steps_done()) : std::string();
+  if (!check_) return {};
+  // A branch's replay: its parent's part first (core/recording/branch_replay.hpp).
+  if (std::string d = parent_difference(*flight_.mode); !d.empty()) return d;
+  return check_->first_difference(flight_.mode->steps_done());
+}
+
+std::string FlightRig::replay_difference_so_far() const {
+  if (!check_) return {};
+  if (std::string d = parent_difference(*flight_.mode); !d.empty()) return d;
+  return check_->difference_so_far();
 }
 
 }  // namespace mixpilot::cli

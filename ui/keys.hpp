@@ -36,6 +36,10 @@ inline bool key_down(Key k) { return ImGui::IsKeyDown(int(k)); }
 // Holds or releases `k` for the next frames, as a backend does.
 inline void set_key(ImGuiIO& io, Key k, bool down) { io.KeysDown[int(k)] = down; }
 
+// A replay's "fly from here" (SPEC §10): T takes the controls at the playhead ("take over"; no
+// other shortcut uses it, nor do the keyboard pilot's keys).
+inline constexpr Key kFlyFromHereKey = Key::t;
+
 // The keys that fly the keyboard pilot (input/keyboard.hpp), indexed by input::Key: W S A D
 // and the arrows.
 inline constexpr Key kFlightKeys[] = {Key::w, Key::s, Key::a, Key::d,

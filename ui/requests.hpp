@@ -40,9 +40,10 @@ struct SetTrainee {
 struct SetAssist {
   bool on;                    // false: the next flight is a probe (SPEC §10)
 };
+struct FlyFromStart {};       // a flight flown on from a recording's moment: from t = 0 instead
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
-                                 SetRecord, SetTrainee, SetAssist>;
+                                 SetRecord, SetTrainee, SetAssist, FlyFromStart>;
 
 // A replay's transport.
 struct TogglePlay {};
@@ -88,7 +89,10 @@ struct LeaveReplay {};            // back to the live flight (Esc)
 struct ReplayRecording {          // a flight of the Progress panel: its recording, replayed
   std::string path;
 };
-using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording>;
+// Fly from here (SPEC §10): the replay's moment at the playhead becomes a live flight, READY
+// there, which the trainee's pilot flies on.
+struct FlyFromHere {};
+using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording, FlyFromHere>;
 
 // Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
 using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;
