@@ -175,15 +175,6 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
     r.input_device = options_.pilot;
     if (flight_.devices) r.input_settings_hash = sha256_hex(input::to_toml(flight_.devices->settings));
   }
-  r.started_unix_ms = started_unix_ms_;
-  r.duration_s = double(mode.steps_done()) * mode.dt();
-  r.ended = mode.lost()     ? history::Ended::lost
-            : interrupted ? history::Ended::interrupted
-                          : history::Ended::completed;
-  const bool remote = flight_.recording ? meta("vehicle") == "dds" : flight_.vehicle != nullptr;
-  r.front_end = remote ? "vehicle" : front_end_;
-  r.app_version = version();
-  r.probe = mode.identity().probe;  // an unassisted probe (SPEC §10)
   // A branch (fly from here): its parent flight, by that flight's recording hash, and the step
   // it was taken over at; a branch's replay (history import) as its recording names them.
   std::optional<ParentLink> parent;
@@ -196,6 +187,16 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
     r.parent_recording_hash = parent->sha256;
     r.parent_step = parent->step;
   }
+  r.started_unix_ms = started_unix_ms_;
+  // The time flown: a branch's from its take-over on.
+  r.duration_s = double(mode.steps_done() - (parent ? parent->step : 0)) * mode.dt();
+  r.ended = mode.lost()     ? history::Ended::lost
+            : interrupted ? history::Ended::interrupted
+                          : history::Ended::completed;
+  const bool remote = flight_.recording ? meta("vehicle") == "dds" : flight_.vehicle != nullptr;
+  r.front_end = remote ? "vehicle" : front_end_;
+  r.app_version = version();
+  r.probe = mode.identity().probe;  // an unassisted probe (SPEC §10)
   if (completed_recording_) {
     std::error_code ec;
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);

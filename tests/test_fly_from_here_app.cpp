@@ -309,6 +309,7 @@ TEST_F(FlyFromHereApp, TakeOverANovicesFlightAt10sWithTheExperiencedPilot) {
   EXPECT_TRUE(rows[0].branch());
   EXPECT_EQ(rows[0].ended, history::Ended::completed);
   EXPECT_EQ(rows[0].pilot, "experienced");
+  EXPECT_NEAR(rows[0].duration_s, double(rec.states.size()) * 0.015, 1e-9) << "its own time";
   EXPECT_EQ(rows[0].recording_hash, *sha256_file(branch, error));
   EXPECT_EQ(rows[0].metrics, live);
 
@@ -537,9 +538,18 @@ TEST(FlyFromHereCli, AMissingOrChangedParentIsNamed) {
                      *sha256_file(parent, error) + " found)"),
             std::string::npos)
       << out;
-  // Put back, it replays again.
+  // Put back, it replays again: in score, and in replay, whose tape shows the parent's flight
+  // up to the take-over and the branch after it.
   fs::rename(parent + ".away", parent);
   EXPECT_EQ(test::run_mixpilot(bin, "score '" + branch + "'", home), 0)
+      << test::read_file(home / "out.txt");
+  EXPECT_EQ(test::run_mixpilot(bin, "replay '" + branch + "' --headless", home), 0)
+      << test::read_file(home / "out.txt");
+  EXPECT_NE(test::read_file(home / "out.txt").find("replay exact"), std::string::npos)
+      << test::read_file(home / "out.txt");
+  EXPECT_NE(test::read_file(home / "out.txt").find("taken over at t = 1.500 s (step 100) from " +
+                                                   abs),
+            std::string::npos)
       << test::read_file(home / "out.txt");
 }
 
