@@ -38,6 +38,14 @@ std::string rejection_counts(const net::JoyPeerStats& s) {
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
   Flight f;
+  if (o.from) {
+    // Fly from here: the recorded flight's own scenario, whatever its file says now.
+    f.scenario_text = o.from->scenario_text;
+    f.scenario_source = o.from->scenario_source;
+    f.scenario_file = o.from->scenario_file;
+    f.from = o.from;
+    return f;
+  }
   if (o.replay || o.pilot.ends_with(".mcap")) {
     f.recording = read_recording(o.pilot, error);
     if (!f.recording) return std::nullopt;
@@ -279,6 +287,10 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     ModeRequest request;
     request.duration = o.duration;
     request.assist = o.assist.value_or(Assistance::on);
+    if (o.from) {  // as long and as assisted as the flight it goes on from
+      request.duration = o.from->duration;
+      request.assist = o.from->assist;
+    }
     if (is_device_pilot(o.pilot)) {
       f->devices = open_devices(o, f->scenario_text, f->scenario_source, std::move(gamepad),
                                 request, error);
@@ -289,6 +301,14 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     f->mode = make_mode(f->scenario_text, f->scenario_source, std::move(request), error);
   }
   if (!f->mode) return std::nullopt;
+  if (o.from) {
+    const RestoreStatus r = f->mode->take_over(*o.from->snapshot);
+    if (r != RestoreStatus::ok) {
+      error = "cannot fly from t = " + seconds_text(o.from->t) + " s of " + o.from->parent +
+              ": " + to_string(r);
+      return std::nullopt;
+    }
+  }
   f->pilot = f->mode->identity().pilot;
   if (o.vehicle == "dds") {
     if (!open_vehicle_link(o, *f, error)) return std::nullopt;
@@ -315,6 +335,13 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
   if (f.mode->kind() == ModeKind::mixed_initiative)
     info.assist = f.mode->identity().probe ? "off" : "on";
   if (const auto seed = f.mode->identity().seed) info.seed = *seed;
+  // A flight flown on from a recording's moment names it (SPEC §10). A branch's replay
+  // recorded again is its whole flight from step 0, and names none.
+  if (f.from) {
+    info.parent_recording = f.from->parent;
+    info.parent_sha256 = f.from->parent_sha256;
+    info.parent_step = f.from->step;
+  }
   return info;
 }
 

@@ -27,6 +27,20 @@
 
 namespace mixpilot::cli {
 
+// Fly from here (SPEC §10): the moment of a recorded flight a new, live flight takes over from
+// (app/take_over.hpp makes it off the UI thread). The new flight flies the recording's embedded
+// scenario, as long and as assisted as it was, from the recorded flight's state at step k.
+struct FlyFrom {
+  std::string parent;         // the recording, absolute
+  std::string parent_sha256;  // its content hash (a replay of the branch checks it)
+  std::int64_t step = 0;      // k: the new flight's first step
+  double t = 0.0;             // [s] t_k = k Δt
+  std::shared_ptr<const ModeSnapshot> snapshot;  // the recorded flight before step k
+  std::string scenario_text, scenario_source, scenario_file;  // the recording's
+  double duration = 0.0;      // [s] the recorded flight's planned length
+  Assistance assist = Assistance::on;
+};
+
 struct FlyOptions {
   std::string scenario_path;
   std::string pilot;
@@ -56,6 +70,8 @@ struct FlyOptions {
   std::string trainee;             // --trainee: who flies ("" → the login name; SPEC §10)
   std::string history;             // --history: "" the default SQLite file, "off", a location
   const char* command = "fly";     // for messages
+  // Fly from here: the new flight goes on from this moment of a recording (the window's).
+  std::shared_ptr<const FlyFrom> from;
 };
 
 // A person's device flying the session (--pilot gamepad | keyboard, SPEC §6), kept alive for
@@ -87,6 +103,7 @@ struct Flight {
   std::string pilot;  // mixed initiative: the pilot source's name
   std::shared_ptr<Devices> devices;  // --pilot gamepad | keyboard
   std::unique_ptr<net::RemoteVehicle> vehicle;  // --vehicle dds
+  std::shared_ptr<const FlyFrom> from;  // a branch: flown on from this moment of its parent
 };
 
 // The haptic cue from the control thread: each step's λ to the gamepad (an atomic store).

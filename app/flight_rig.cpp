@@ -4,8 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/numerics/version.hpp"
+#include "core/recording/branch_replay.hpp"
 #include "input/net/dds.hpp"
 
 namespace mixpilot::cli {
@@ -167,15 +168,28 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
   if (r.trainee.empty()) r.trainee = "unnamed";  // an account without a name
   r.station = history::host_name();
   r.scenario = mode.scenario_name();
-  r.scenario_hash = history::sha256_hex(flight_.scenario_text);
+  r.scenario_hash = sha256_hex(flight_.scenario_text);
   r.mode = to_string(mode.kind());
   r.pilot = flight_.recording ? meta("pilot") : flight_.pilot;
   if (!flight_.recording && is_device_pilot(options_.pilot)) {
     r.input_device = options_.pilot;
-    if (flight_.devices) r.input_settings_hash = history::sha256_hex(input::to_toml(flight_.devices->settings));
+    if (flight_.devices) r.input_settings_hash = sha256_hex(input::to_toml(flight_.devices->settings));
+  }
+  // A branch (fly from here): its parent flight, by that flight's recording hash, and the step
+  // it was taken over at; a branch's replay (history import) as its recording names them.
+  std::optional<ParentLink> parent;
+  std::string malformed;  // a replay of a malformed link was refused before
+  if (flight_.from)
+    parent = ParentLink{flight_.from->parent, flight_.from->parent_sha256, flight_.from->step};
+  else if (flight_.recording && !parent_link(*flight_.recording, "", parent, malformed))
+    parent.reset();
+  if (parent) {
+    r.parent_recording_hash = parent->sha256;
+    r.parent_step = parent->step;
   }
   r.started_unix_ms = started_unix_ms_;
-  r.duration_s = double(mode.steps_done()) * mode.dt();
+  // The time flown: a branch's from its take-over on.
+  r.duration_s = double(mode.steps_done() - (parent ? parent->step : 0)) * mode.dt();
   r.ended = mode.lost()     ? history::Ended::lost
             : interrupted ? history::Ended::interrupted
                           : history::Ended::completed;
@@ -188,7 +202,7 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
     const std::filesystem::path abs = std::filesystem::absolute(record_path_, ec);
     r.recording_path = ec ? record_path_ : abs.lexically_normal().string();
     if (hash) {
-      const auto h = history::sha256_file(record_path_, error);
+      const auto h = sha256_file(record_path_, error);
       if (!h) return std::nullopt;
       r.recording_hash = *h;
     }
@@ -204,7 +218,16 @@ Metrics FlightRig::metrics() const {
 }
 
 std::string FlightRig::replay_difference() const {
-  return check_ ? check_->first_difference(flight_.mode->steps_done()) : std::string();
+  if (!check_) return {};
+  // A branch's replay: its parent's part first (core/recording/branch_replay.hpp).
+  if (std::string d = parent_difference(*flight_.mode); !d.empty()) return d;
+  return check_->first_difference(flight_.mode->steps_done());
+}
+
+std::string FlightRig::replay_difference_so_far() const {
+  if (!check_) return {};
+  if (std::string d = parent_difference(*flight_.mode); !d.empty()) return d;
+  return check_->difference_so_far();
 }
 
 }  // namespace mixpilot::cli

@@ -24,6 +24,8 @@
 //                                                                (SDL's joystick state has one
 //                                                                owner); a rig holds a share
 //   replay tape   ReplayTape's loader (app/replay_tape.hpp)      the window's replay
+//   take over     TakeOver's worker (app/take_over.hpp): flies   the window's Trainer, while
+//                 a recording to the moment flown on from        it makes that moment ready
 //   score jobs    score's worker pool (app/score.cpp)            `mixpilot score`
 //   history       HistoryWriter (app/history_writer.hpp): opens  the window's Trainer, or
 //                 the store, hashes recordings, writes rows,    `fly --headless` (which waits
@@ -123,6 +125,8 @@ class FlightRig {
   Metrics metrics() const;
   Labels labels(bool interrupted) const { return report_labels(flight_, interrupted); }
   std::string replay_difference() const;
+  // The same among the steps flown so far, however many (a replay flown to a moment).
+  std::string replay_difference_so_far() const;
   // The flight's history row as it stands: its labels, metrics, times, the scenario's and
   // input settings' hashes; the recording's path and hash once close() has completed it.
   // A replay's row describes the recorded flight (trainee and pilot from the recording).

@@ -24,7 +24,7 @@
 #include "app/progress_html.hpp"
 #include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/postgres_history.hpp"
 #include "core/history/push.hpp"
@@ -45,7 +45,10 @@ constexpr const char* kHistoryUsage =
     "\n"
     "The flights mixpilot remembers (SPEC §10): every flight of the window and of `fly`, one\n"
     "row each (a replay or `score` adds none). Oldest first, so the newest is next to the\n"
-    "prompt. A table on the terminal, or every field with --csv or --json.\n"
+    "prompt. A table on the terminal, or every field with --csv or --json. A branch (fly from\n"
+    "here: flown on from a moment of a recorded flight) names that flight by its recording's\n"
+    "hash and the step it was taken over at (parent_recording_hash, parent_step; ^ in the\n"
+    "table).\n"
     "\n"
     "  --trainee NAME     only this trainee's flights\n"
     "  --scenario NAME    only this scenario's flights (its name, as in the table)\n"
@@ -206,7 +209,7 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
   add("scenario", 18);
   add("pilot", 12);
   add("time_s", 7, true);
-  add("ended", 11);
+  add("ended", 13);  // "interrupted*^"
   add("skill", 6, true);
   add("from", 7);
   line += "recording\n";
@@ -222,9 +225,9 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
     add(f.pilot.empty() ? "-" : f.pilot, 12);
     add(number(f.duration_s, "%.1f"), 7, true);
     std::string_view ended = history::to_string(f.ended);
-    std::snprintf(number_text, sizeof number_text, "%.*s%s", int(ended.size()), ended.data(),
-                  f.probe ? "*" : "");
-    add(number_text, 11);
+    std::snprintf(number_text, sizeof number_text, "%.*s%s%s", int(ended.size()), ended.data(),
+                  f.probe ? "*" : "", f.branch() ? "^" : "");
+    add(number_text, 13);
     const auto skill = metric_of(f, "skill");
     add(skill ? number(*skill, "%.1f") : "-", 6, true);
     add(f.front_end, 7);
@@ -232,10 +235,16 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
     line += '\n';
     std::fputs(line.c_str(), stdout);
   }
+  const bool probes = std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.probe; });
+  const bool branches =
+      std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.branch(); });
+  std::string notes;
+  if (probes) notes = "* a probe flight: unassisted";
+  if (branches)
+    notes += std::string(notes.empty() ? "" : "; ") +
+             "^ a branch: flown on from a moment of another flight";
   std::printf("%zu flight%s%s\n", rows.size(), rows.size() == 1 ? "" : "s",
-              std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.probe; })
-                  ? " (* a probe flight: unassisted)"
-                  : "");
+              notes.empty() ? "" : (" (" + notes + ")").c_str());
 }
 
 // A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line break.
@@ -252,14 +261,16 @@ std::string csv(std::string_view s) {
 const char* const kFields[] = {"id", "trainee", "station", "scenario", "scenario_hash", "mode",
                                "pilot", "input_device", "input_settings_hash", "started",
                                "started_unix_ms", "duration_s", "ended", "probe",
-                               "recording_path", "recording_hash", "app_version", "front_end"};
+                               "recording_path", "recording_hash", "app_version", "front_end",
+                               "parent_recording_hash", "parent_step"};
 
 std::vector<std::string> field_values(const history::StoredFlight& f) {
   return {std::to_string(f.id),  f.trainee, f.station, f.scenario, f.scenario_hash, f.mode,
           f.pilot, f.input_device, f.input_settings_hash,
           local_time(f.started_unix_ms, "%Y-%m-%dT%H:%M:%S%z"), std::to_string(f.started_unix_ms),
           number(f.duration_s), history::to_string(f.ended), f.probe ? "1" : "0",
-          f.recording_path, f.recording_hash, f.app_version, f.front_end};
+          f.recording_path, f.recording_hash, f.app_version, f.front_end,
+          f.parent_recording_hash, f.branch() ? std::to_string(f.parent_step) : std::string()};
 }
 
 void print_csv(const std::vector<history::StoredFlight>& rows) {
@@ -322,8 +333,10 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
       out += (k ? ", " : "") + json_string(name) + ": ";
       if (name == "id" || name == "started_unix_ms")
         out += values[k];
-      else if (name == "duration_s")
+      else if (name == "duration_s" || name == "parent_step")
         out += values[k].empty() ? "null" : values[k];
+      else if (name == "parent_recording_hash" && values[k].empty())
+        out += "null";  // not a branch
       else if (name == "probe")
         out += f.probe ? "true" : "false";
       else
@@ -423,7 +436,7 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
   // Known recordings are skipped before they are flown: importing again costs only the hashes.
   std::string error;
   for (ImportRow& r : rows) {
-    const auto h = history::sha256_file(r.file, r.error);
+    const auto h = sha256_file(r.file, r.error);
     if (!h) continue;
     r.hash = *h;
     bool known = false;

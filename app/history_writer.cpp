@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "app/progress.hpp"
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 
 namespace mixpilot::cli {
 
@@ -110,7 +110,7 @@ void HistoryWriter::write(Job& job) {
   std::string error;
   bool hashed = true;
   if (!job.hash_path.empty()) {
-    const auto hash = history::sha256_file(job.hash_path, error);
+    const auto hash = sha256_file(job.hash_path, error);
     if (hash) job.record.recording_hash = *hash;
     hashed = hash.has_value();
   }

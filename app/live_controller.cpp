@@ -63,6 +63,17 @@ bool has_pilot(const std::string& path) {
   return mode && *mode == "mixed_initiative";
 }
 
+// "from REC.mcap at t = 10.00 s": where a flight flown from here goes on from.
+std::string fly_from_text(const FlyFrom& from) {
+  char at[48];
+  std::snprintf(at, sizeof at, " at t = %.2f s", from.t);
+  return "from " + fs::path(from.parent).filename().string() + at;
+}
+
+// At most this many of the recorded steps before the moment are shown with a flight flown
+// from it: a minute of the trail and the plots at Δt = 15 ms.
+constexpr std::size_t kShownBeforeTheMoment = 4096;
+
 }  // namespace
 
 // ---- The flight's assembly ---------------------------------------------------------------
@@ -72,7 +83,9 @@ bool has_pilot(const std::string& path) {
 std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& status) {
   auto f = std::make_unique<LiveFlight>();
   FlyOptions o = options_;
-  o.replay = o.pilot.ends_with(".mcap");  // a recording's pilot: any mode flies it again
+  o.from = from_;  // fly from here: fly_from() chose a live pilot
+  o.replay = !from_ && o.pilot.ends_with(".mcap");  // a recording's pilot: any mode flies it again
+  if (from_) o.duration.reset();  // as long as the flight it goes on from
   // The assistance chosen applies to new flights with a pilot: a recording's pilot flies as it
   // was recorded, and the thesis's controllers have no pilot to leave alone.
   if (o.replay || (o.assist == Assistance::off && !has_pilot(o.scenario_path))) o.assist.reset();
@@ -94,9 +107,13 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
   }
   f->rig->pace(8192);
   const Mode& mode = f->rig->mode();
-  f->scene = ui::scene_of(mode, flight.pilot.empty() ? std::string("the thesis's controller")
-                                                     : "pilot " + flight.pilot);
+  std::string source = flight.pilot.empty() ? std::string("the thesis's controller")
+                                             : "pilot " + flight.pilot;
+  if (from_) source += ", " + fly_from_text(*from_);
+  f->scene = ui::scene_of(mode, source);
   f->sample = mode.telemetry();
+  // Fly from here: READY at the moment, after the recorded steps that led there.
+  for (const Telemetry& s : from_shown_) f->history.push(s);
   return f;
 }
 
@@ -190,7 +207,9 @@ int LiveController::finish() {
   }
   std::printf("mixpilot %s: %s", options_.command, mode.summary().c_str());
   const RealtimeStats st = f.runner().stats();
-  std::printf("  %.1f s flown in the window\n", double(mode.steps_done()) * mode.dt());
+  // The runner's steps: a flight flown from a recording's moment starts there.
+  std::printf("  %.1f s flown in the window%s\n", double(st.steps) * mode.dt(),
+              f.flight().from ? (", " + fly_from_text(*f.flight().from)).c_str() : "");
   print_realtime(st, mode.dt());
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   for (const std::string& path : recorded_) std::printf("  recorded %s\n", path.c_str());
@@ -251,9 +270,44 @@ std::string LiveController::next_record_path() const {
   std::string name = live_ ? live_->mode().scenario_name() : "flight";
   if (live_ && !live_->flight().pilot.empty() && !live_->flight().recording)
     name += "-" + live_->flight().pilot;
+  if (from_) {  // a branch: the moment it was taken over at
+    char at[40];
+    std::snprintf(at, sizeof at, "-from-%.2fs", from_->t);
+    name += at;
+  }
   const fs::path folder = recordings_folder();
   if (folder.empty()) return "";
   return (folder / file_name_part(name + "-" + stamp + ".mcap")).string();
+}
+
+bool LiveController::fly_from(std::shared_ptr<const FlyFrom> from, const ui::History& so_far,
+                              bool pad_connected) {
+  const FlyOptions before = options_;
+  auto from_before = std::move(from_);
+  auto shown_before = std::move(from_shown_);
+  from_ = std::move(from);
+  from_shown_.clear();
+  const std::size_t n = std::min(so_far.size(), kShownBeforeTheMoment);
+  for (std::size_t i = so_far.size() - n; i < so_far.size(); ++i) from_shown_.push_back(so_far[i]);
+  // The pilot who takes over: the live flights' choice, else a device of the person's.
+  if (options_.pilot.empty() || options_.pilot.ends_with(".mcap"))
+    options_.pilot = pad_connected ? "gamepad" : "keyboard";
+  std::string error;
+  bool made = replace_live(error);
+  if (!made && options_.pilot != "keyboard") {  // a profile another scenario has, say
+    options_.pilot = "keyboard";
+    made = replace_live(error);
+  }
+  if (made) {
+    status_line_.say("READY " + fly_from_text(*from_) +
+                     ": the session panel picks who flies on, Space starts");
+    return true;
+  }
+  options_ = before;
+  from_ = std::move(from_before);
+  from_shown_ = std::move(shown_before);
+  status_line_.say(error, true);
+  return false;
 }
 
 bool LiveController::open(std::string& error, int& status) {
@@ -285,15 +339,28 @@ void LiveController::refresh_choices() {
     choices_.pilots = std::move(id.pilots);
     choices_.pilots.push_back("gamepad");
     choices_.pilots.push_back("keyboard");
-    if (options_.pilot.ends_with(".mcap")) choices_.pilots.push_back(options_.pilot);
+    if (options_.pilot.ends_with(".mcap") && !from_) choices_.pilots.push_back(options_.pilot);
     const auto it = std::find(choices_.pilots.begin(), choices_.pilots.end(),
                               options_.pilot.empty() ? live_->flight().pilot : options_.pilot);
     choices_.pilot = it == choices_.pilots.end() ? -1 : int(it - choices_.pilots.begin());
   }
   choices_.record_to = choices_.record ? next_record_path() : "";
   const ModeIdentity id = live_->mode().identity();
-  choices_.assist_choosable = !id.pilot.empty() && !live_->flight().recording;
+  // A flight flown from here is as assisted as the one it goes on from.
+  choices_.assist_choosable = !id.pilot.empty() && !live_->flight().recording && !from_;
   choices_.assist = !id.probe;
+  choices_.fly_from = from_ ? fly_from_text(*from_) : "";
+  if (from_ && !from_->scenario_file.empty()) {
+    // The scenario it flies: its file among the choices (joining them, as an opened file does).
+    const std::string file = absolute_path(from_->scenario_file);
+    auto it = std::find(scenario_paths_.begin(), scenario_paths_.end(), file);
+    if (it == scenario_paths_.end()) {
+      scenario_paths_.push_back(file);
+      choices_.scenarios.push_back(fs::path(file).filename().string());
+      it = scenario_paths_.end() - 1;
+    }
+    choices_.scenario = int(it - scenario_paths_.begin());
+  }
   show_progress();
 }
 
@@ -301,11 +368,18 @@ void LiveController::fly_scenario(std::size_t index) {
   const FlyOptions before = options_;
   options_.scenario_path = scenario_paths_[index];
   if (!options_.pilot.ends_with(".mcap")) options_.pilot.clear();
+  // Another scenario flies from its start.
+  auto from_before = std::move(from_);
+  auto shown_before = std::move(from_shown_);
+  from_.reset();
+  from_shown_.clear();
   std::string error;
   if (replace_live(error)) {
     choices_.scenario = int(index);
   } else {
     options_ = before;
+    from_ = std::move(from_before);
+    from_shown_ = std::move(shown_before);
     status_line_.say(error, true);
   }
 }
@@ -370,7 +444,12 @@ void LiveController::start() {
       return;
     }
   }
-  live_->history.clear();  // the initial state shown while ready
+  // The initial state shown while ready goes; a flight flown from here keeps the recorded
+  // steps that led to its moment, all but the moment itself, which its own first step is.
+  if (from_ && !live_->history.empty())
+    live_->history.pop_newest();
+  else
+    live_->history.clear();
   live_->rig->start();
   status_line_.say("");
   if (history_) live_->rig->remember(history_, choices_.trainee, "window");
@@ -432,6 +511,21 @@ void LiveController::handle(const ui::LiveRequest& r) {
           [&](const ui::SetTrainee& t) {
             choices_.trainee = t.name;
             show_progress();
+          },
+          [&](const ui::FlyFromStart&) {
+            if (!from_ || is_flying(*live_)) return;
+            const FlyOptions before = options_;
+            if (options_.scenario_path.empty()) options_.scenario_path = from_->scenario_file;
+            auto from_before = std::move(from_);
+            auto shown_before = std::move(from_shown_);
+            from_.reset();
+            from_shown_.clear();
+            if (!replace_live(error)) {
+              options_ = before;
+              from_ = std::move(from_before);
+              from_shown_ = std::move(shown_before);
+              status_line_.say(error, true);
+            }
           },
           [&](const ui::SetAssist& a) {
             // The unstarted flight is made again with the choice, as for a pilot.

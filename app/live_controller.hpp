@@ -65,6 +65,14 @@ class LiveController {
   void settings_changed();
   // Stops the flight and completes its recording (a replay takes the screen).
   void close();
+  // Fly from here (SPEC §10): the next flight goes on from `from`, a moment of a recording,
+  // READY there (its screen shows `so_far`, the recording's steps up to that moment); the pilot
+  // is the one chosen for live flights, else the gamepad when `pad_connected`, else the
+  // keyboard, and the session panel picks another. Restart flies it from that moment again;
+  // another scenario, or Fly from the start, from t = 0. False, said on the status line and
+  // changing nothing, when no flight can be made of it.
+  bool fly_from(std::shared_ptr<const FlyFrom> from, const ui::History& so_far,
+                bool pad_connected);
 
   // Start: the flight flies (or waits for its vehicle or its gamepad).
   void start();
@@ -115,6 +123,10 @@ class LiveController {
   std::string first_record_;                 // --record: the first recorded flight's path
   std::vector<std::string> recorded_;        // recordings written, for the summary
   int status_ = 0;
+  // Fly from here: the moment the next flight goes on from (null: from the start), and the
+  // recorded steps shown before it (the newest ones up to that moment).
+  std::shared_ptr<const FlyFrom> from_;
+  std::vector<Telemetry> from_shown_;
 };
 
 }  // namespace mixpilot::cli

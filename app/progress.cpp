@@ -83,6 +83,7 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
     f.duration_s = r.duration_s;
     f.when = local_minutes(r.started_unix_ms);
     f.ended = history::to_string(r.ended);
+    f.from_step = r.parent_step;
     std::error_code ec;
     if (!r.recording_path.empty() &&
         (!check_recordings || std::filesystem::is_regular_file(r.recording_path, ec)))

@@ -92,6 +92,8 @@ void ReplayController::update(double wall_dt, ui::RunInfo& run) {
   // The replay marks the recorded flight's overruns and deadline misses (Mode::replay_timing):
   // the tape counts what the flight counted.
   for (std::size_t i = 0; i < ready && i <= k; ++i) ui::count_step(r.tape()[i], run);
+  // Fly from here (SPEC §10): where a pilot shares the authority, from any loaded step.
+  info.can_fly_from_here = r.scene().shared_authority && ready > 0;
   run.recording = false;
   run.can_restart = false;
   run.metrics = r.done() && ready > 0 && k + 1 >= ready ? r.metrics() : Metrics{};
@@ -102,6 +104,12 @@ void ReplayController::update(double wall_dt, ui::RunInfo& run) {
 ui::History ReplayController::shown() const {
   const std::size_t n = tape_->ready();
   return ui::History::view(tape_->tape(), n ? tape_index(*tape_, info_.t) + 1 : 0);
+}
+
+std::int64_t ReplayController::fly_from_here() {
+  if (!tape_ || !tape_->scene().shared_authority || tape_->ready() == 0) return -1;
+  info_.playing = false;
+  return std::int64_t(tape_index(*tape_, info_.t));
 }
 
 bool ReplayController::over() const {

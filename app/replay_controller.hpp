@@ -46,6 +46,11 @@ class ReplayController {
   ui::History shown() const;
   // Played to its end, every step loaded.
   bool over() const;
+  // Fly from here: the step under the playhead, when a pilot flies this mode and the step is
+  // loaded (−1 otherwise); pauses the replay there.
+  std::int64_t fly_from_here();
+  // While the moment is made ready: the part of the way flown (−1: done, or not taking over).
+  void set_taking_over(double progress) { info_.taking_over = progress; }
   double shown_time() const;  // [s] of the step on screen (−1: none loaded yet)
   const ReplayTape* tape() const { return tape_.get(); }
 

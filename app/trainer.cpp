@@ -13,6 +13,7 @@ bool Trainer::open_live(std::string& error, int& status) { return live_.open(err
 bool Trainer::open_replay(const std::string& path, std::string& error) {
   std::unique_ptr<FlightRig> rig = replay_.prepare(path, error);
   if (!rig) return false;
+  take_over_.reset();  // of the replay this one replaces
   live_.close();  // its recording is completed before the replay loads
   replay_.open(std::move(rig), path);
   ui_.score_card_closed = false;
@@ -32,6 +33,7 @@ void Trainer::build_frame(double wall_dt) {
   run_.input = &input_.info();
   poll_history();
   clips_.poll();
+  poll_take_over();
   if (replay_.is_open()) replay_.update(wall_dt, run_);
   else if (live_.flight()) live_.update(input_.info().connected, run_);
   requests_.clear();
@@ -76,6 +78,7 @@ void Trainer::act(const ui::Request& r) {
                                     if (open_replay(p.path, error)) ui_.show_progress = false;
                                     else status_.say(error, true);
                                   },
+                                  [&](const ui::FlyFromHere&) { fly_from_here(); },
                               },
                               a);
                  },
@@ -102,8 +105,37 @@ void Trainer::poll_history() {
   run_.history = history_view_.get();
 }
 
+void Trainer::fly_from_here() {
+  if (take_over_ || !replay_.is_open()) return;
+  const std::int64_t k = replay_.fly_from_here();
+  if (k < 0) return;
+  take_over_ = std::make_unique<TakeOver>(replay_.tape()->path(), k);
+  replay_.set_taking_over(0.0);
+}
+
+void Trainer::poll_take_over() {
+  if (!take_over_) return;
+  if (!take_over_->done()) {
+    replay_.set_taking_over(take_over_->progress());
+    return;
+  }
+  replay_.set_taking_over(-1.0);
+  const std::unique_ptr<TakeOver> done = std::move(take_over_);
+  const std::shared_ptr<const FlyFrom> moment = done->moment();
+  if (!moment) {
+    status_.say(done->error(), true);
+    return;
+  }
+  // The screen shows the replay's steps up to the moment with the new flight, READY there.
+  const ui::History so_far = ui::History::view(replay_.tape()->tape(), std::size_t(done->step()) + 1);
+  if (!live_.fly_from(moment, so_far, input_.info().connected)) return;
+  replay_.close();
+  ui_.score_card_closed = false;
+}
+
 void Trainer::leave_replay() {
   if (!replay_.is_open()) return;
+  take_over_.reset();
   replay_.close();
   status_.say("");
   live_.reopen();

@@ -18,6 +18,7 @@
 #include "app/replay_controller.hpp"
 #include "app/replay_tape.hpp"
 #include "app/status_line.hpp"
+#include "app/take_over.hpp"
 #include "app/wizard_controller.hpp"
 #include "ui/requests.hpp"
 #include "ui/screen.hpp"
@@ -55,6 +56,8 @@ class Trainer {
   const ReplayTape* replay() const { return replay_.tape(); }
   HistoryWriter* history() { return history_.get(); }
   ClipExporter& clips() { return clips_; }
+  // Fly from here (SPEC §10): the moment being made ready off the UI thread (nullptr: none).
+  const TakeOver* taking_over() const { return take_over_.get(); }
 
   // Stops the flight (closing its recording) and the replay; prints the summary, writes the
   // report; returns the exit status (kExitReplayMismatch for a replay that differs).
@@ -64,6 +67,8 @@ class Trainer {
   void open_file(const std::string& path);  // File → Open: a scenario or a recording
   void poll_history();                       // the writer's outcomes and newest snapshot
   void leave_replay();
+  void fly_from_here();    // the replay's playhead: a moment made ready for a live flight
+  void poll_take_over();   // ... and once it is, the live flight READY there
 
   // Declared before the controllers, which say things into it and outlive none of it.
   ui::RunInfo run_;  // the frame's snapshot
@@ -78,6 +83,7 @@ class Trainer {
   std::shared_ptr<const ui::HistoryView> history_view_;  // the frame's (run_.history)
   LiveController live_;
   ReplayController replay_;
+  std::unique_ptr<TakeOver> take_over_;  // after replay_: it outlives no replay
   ui::UiState ui_;
   ui::Requests requests_;  // this frame's; cleared each frame, its capacity kept
 };

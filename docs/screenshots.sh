@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
-# why λ fell, and the input settings and Progress panels at 1280x720 (app tests render them). The flights
+# why λ fell, and the input settings and Progress panels and fly from here at 1280x720 (app
+# tests render them). The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
@@ -37,12 +38,16 @@ XDG_CONFIG_HOME="$tmp/config" "$m" fly --scenario scenarios/mi_helix.toml --pilo
   --gamepad-script "$tmp/unplug.csv" --headless --realtime --duration 2 \
   --screenshot 1.6:$out/input_lost.png --size 800x450 --force >/dev/null
 # The input settings and Progress panels, from the app tests that open them (MIXPILOT_SHOT_DIR;
-# the Progress panel over a trainee's history the test makes in its own data folder).
+# the Progress panel over a trainee's history the test makes in its own data folder), and fly
+# from here: a novice's replay taken over at 10 s, READY at that moment.
 tests=$(dirname "$m")/../tests
 MIXPILOT_SHOT_DIR="$tmp" XDG_CONFIG_HOME="$tmp/config" "$tests/test_app" \
   --gtest_filter='App.TheInputSettingsPanel:App.TheProgressPanel' >/dev/null
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_fly_from_here_app" \
+  --gtest_filter='FlyFromHereApp.TakeOverANovicesFlightAt10sWithTheExperiencedPilot' >/dev/null
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
+cp "$tmp/fly_from_here.png" $out/fly_from_here.png
 # The progress report to take home (history --html) of a trainee who flew the helix three times
 # as the novice, three times as the experienced pilot (each attempt with its own position noise)
 # and once unassisted, as headless Chromium prints it (Debian's chromium package).

@@ -28,6 +28,8 @@ inline void expect_same_flight(const history::FlightRecord& f, const history::St
   EXPECT_EQ(r.recording_hash, f.recording_hash);
   EXPECT_EQ(r.app_version, f.app_version);
   EXPECT_EQ(r.front_end, f.front_end);
+  EXPECT_EQ(r.parent_recording_hash, f.parent_recording_hash);
+  EXPECT_EQ(r.parent_step, f.parent_step);
   ASSERT_EQ(r.metrics.size(), f.metrics.size());
   for (std::size_t i = 0; i < f.metrics.size(); ++i) {
     EXPECT_EQ(r.metrics[i].first, f.metrics[i].first);

@@ -27,7 +27,7 @@
 #include "app/progress.hpp"
 #include "app/progress_html.hpp"
 #include "app/trainer.hpp"
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
@@ -49,7 +49,7 @@ FlightRecord sample_flight(const std::string& trainee = "Ada", std::int64_t star
   f.trainee = trainee;
   f.station = "station-1";
   f.scenario = "mi_helix";
-  f.scenario_hash = history::sha256_hex("scenario text");
+  f.scenario_hash = sha256_hex("scenario text");
   f.mode = "mixed_initiative";
   f.pilot = "novice";
   f.input_device = "";
@@ -109,11 +109,11 @@ bool running_as_root() { return ::geteuid() == 0; }
 
 // FIPS 180-4's examples (NIST's SHA256.pdf) and the empty message.
 TEST(HistoryHash, Sha256GivesTheStandardsVectors) {
-  EXPECT_EQ(history::sha256_hex("abc"),
+  EXPECT_EQ(sha256_hex("abc"),
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  EXPECT_EQ(history::sha256_hex(""),
+  EXPECT_EQ(sha256_hex(""),
             "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
-  EXPECT_EQ(history::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+  EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
   // A file across several read blocks hashes as its bytes do.
   const fs::path p = test::fresh_path("history", "big.bin");
@@ -121,10 +121,10 @@ TEST(HistoryHash, Sha256GivesTheStandardsVectors) {
   for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 131 % 251);
   std::ofstream(p, std::ios::binary) << bytes;
   std::string error;
-  const auto h = history::sha256_file(p.string(), error);
+  const auto h = sha256_file(p.string(), error);
   ASSERT_TRUE(h) << error;
-  EXPECT_EQ(*h, history::sha256_hex(bytes));
-  EXPECT_FALSE(history::sha256_file((p.parent_path() / "absent").string(), error));
+  EXPECT_EQ(*h, sha256_hex(bytes));
+  EXPECT_FALSE(sha256_file((p.parent_path() / "absent").string(), error));
   EXPECT_NE(error.find("absent"), std::string::npos) << error;
 }
 
@@ -155,11 +155,11 @@ TEST(HistoryStore, AFlightComesBackWithEveryField) {
   ASSERT_TRUE(store);
   FlightRecord f = sample_flight();
   f.input_device = "gamepad";
-  f.input_settings_hash = history::sha256_hex("mode = 2");
+  f.input_settings_hash = sha256_hex("mode = 2");
   f.ended = history::Ended::lost;
   f.probe = true;
   f.recording_path = "/tmp/a.mcap";
-  f.recording_hash = history::sha256_hex("rec");
+  f.recording_hash = sha256_hex("rec");
   std::string error;
   ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
   const auto rows = all(*store);
@@ -183,7 +183,7 @@ TEST(HistoryStore, ARecordingIsAddedOnce) {
   auto store = open_store(p);
   ASSERT_TRUE(store);
   FlightRecord f = sample_flight();
-  f.recording_hash = history::sha256_hex("recording");
+  f.recording_hash = sha256_hex("recording");
   f.recording_path = "/r.mcap";
   std::string error;
   bool known = true;
@@ -289,8 +289,8 @@ TEST(HistoryStore, HostileTraineeNames) {
   EXPECT_EQ(sql_text(p, "PRAGMA integrity_check"), "ok");
 }
 
-// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
-// row) is brought forward on open; its flights stay.
+// A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
+// columns, one schema_version row) is brought forward on open; its flights stay.
 TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   const fs::path p = test::fresh_path("history", "migrate.sqlite");
   auto store = open_store(p);
@@ -301,17 +301,63 @@ TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
-  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DELETE FROM schema_version "
-                             "WHERE version > 1", nullptr, nullptr, nullptr), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DROP INDEX flights_by_parent; "
+                             "ALTER TABLE flights DROP COLUMN parent_step; "
+                             "ALTER TABLE flights DROP COLUMN parent_recording_hash; "
+                             "DELETE FROM schema_version WHERE version > 1",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
   sqlite3_close(db);
   ASSERT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), 1);
   store = open_store(p);
   ASSERT_TRUE(store);
   EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
   EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'flights_by_parent'"), 1);
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
-  test::expect_same_flight(sample_flight(), rows[0]);
+  test::expect_same_flight(sample_flight(), rows[0]);  // no parent: not a branch
+}
+
+// Fly from here (SPEC §10): a branch is a row like any flight plus its parent link — the
+// parent flight's recording hash and the step it was taken over at — read back as written,
+// NULL for any other flight; the branches of a flight are found through the parent index. A
+// half link is refused.
+TEST(HistoryStore, FlyFromHereBranchRowRoundTrips) {
+  const fs::path p = test::fresh_path("history", "branch.sqlite");
+  auto store = open_store(p);
+  ASSERT_TRUE(store);
+  FlightRecord parent = sample_flight("Ada", 1'700'000'000'000);
+  parent.recording_path = "/r/novice.mcap";
+  parent.recording_hash = sha256_hex("the novice's recording");
+  FlightRecord branch = sample_flight("Ada", 1'700'000'100'000);
+  branch.pilot = "experienced";
+  branch.recording_path = "/r/branch.mcap";
+  branch.recording_hash = sha256_hex("the branch's recording");
+  branch.parent_recording_hash = parent.recording_hash;
+  branch.parent_step = 666;
+  std::string error;
+  ASSERT_EQ(store->add(parent, error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(store->add(branch, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 2u);
+  test::expect_same_flight(parent, rows[0]);
+  EXPECT_FALSE(rows[0].branch());
+  test::expect_same_flight(branch, rows[1]);
+  EXPECT_TRUE(rows[1].branch());
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM flights WHERE parent_step IS NULL"), 1);
+  const std::string of_parent = "SELECT parent_step FROM flights WHERE parent_recording_hash = '" +
+                                parent.recording_hash + "'";
+  EXPECT_EQ(sql_int(p, of_parent.c_str()), 666);
+  EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'flights_by_parent'"), 1);
+  FlightRecord half = branch;
+  half.recording_hash = sha256_hex("another");
+  half.parent_recording_hash.clear();
+  EXPECT_FALSE(store->add(half, error));
+  EXPECT_NE(error.find("a branch needs both its parent recording's hash and its parent step"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(all(*store).size(), 2u);
 }
 
 // A newer mixpilot's history is refused with the reason and left as it was, byte for byte.
@@ -494,7 +540,7 @@ TEST(HistoryStore, EightProcessesWriteAtOnce) {
       }
       for (int i = 0; i < kEach; ++i) {
         FlightRecord f = sample_flight("writer " + std::to_string(k), i);
-        f.recording_hash = history::sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+        f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
         if (store->add(f, error) != HistoryStore::Added::added) {
           std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
           ::_exit(3);
@@ -646,7 +692,7 @@ TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
   EXPECT_EQ(f.trainee, "Zoë O'Brien");
   EXPECT_EQ(f.station, history::host_name());
   EXPECT_EQ(f.scenario, "mi_helix");
-  EXPECT_EQ(f.scenario_hash, history::sha256_hex(test::read_file(scen)));
+  EXPECT_EQ(f.scenario_hash, sha256_hex(test::read_file(scen)));
   EXPECT_EQ(f.mode, "mixed_initiative");
   EXPECT_EQ(f.pilot, "novice");
   EXPECT_EQ(f.input_device, "");
@@ -654,7 +700,7 @@ TEST(HistoryFrontEnds, FlyHeadlessIsRememberedOnceAndReplaysAddNothing) {
   EXPECT_EQ(f.ended, history::Ended::completed);
   EXPECT_FALSE(f.probe);
   EXPECT_EQ(f.recording_path, rec.string());
-  EXPECT_EQ(f.recording_hash, *history::sha256_file(rec.string(), error));
+  EXPECT_EQ(f.recording_hash, *sha256_file(rec.string(), error));
   EXPECT_EQ(f.app_version, version());
   EXPECT_EQ(f.front_end, "fly");
   const auto now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -971,7 +1017,7 @@ TEST(HistoryFrontEnds, TheWindowsLiveFlightIsRememberedOnce) {
   EXPECT_EQ(rows[0].pilot, "novice");
   EXPECT_NEAR(rows[0].duration_s, 1.5, 0.02);
   EXPECT_EQ(rows[0].recording_path, o.record);
-  EXPECT_EQ(rows[0].recording_hash, *history::sha256_file(o.record, error));
+  EXPECT_EQ(rows[0].recording_hash, *sha256_file(o.record, error));
 }
 
 // ---- The history's thread, the window's view of it, the report --------------------------------

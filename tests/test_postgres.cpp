@@ -21,7 +21,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
 #include "core/history/postgres_history.hpp"
 #include "core/history/push.hpp"
@@ -95,7 +95,7 @@ FlightRecord sample_flight(const std::string& trainee = "Ada",
   f.trainee = trainee;
   f.station = "station-1";
   f.scenario = "mi_helix";
-  f.scenario_hash = history::sha256_hex("scenario text");
+  f.scenario_hash = sha256_hex("scenario text");
   f.mode = "mixed_initiative";
   f.pilot = "novice";
   f.started_unix_ms = started;
@@ -144,7 +144,7 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
   ASSERT_TRUE(store);
   FlightRecord f = sample_flight();
   f.input_device = "gamepad";
-  f.input_settings_hash = history::sha256_hex("mode = 2");
+  f.input_settings_hash = sha256_hex("mode = 2");
   f.ended = history::Ended::lost;
   f.probe = true;
   f.duration_s = 0.1 + 0.2;  // every bit of a double comes back
@@ -152,7 +152,7 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
   f.metrics.emplace_back("negative", -1.0 / 3.0);
   f.metrics.emplace_back("nan", NAN);
   f.recording_path = "/tmp/a.mcap";
-  f.recording_hash = history::sha256_hex("rec");
+  f.recording_hash = sha256_hex("rec");
   std::string error;
   ASSERT_EQ(store->add(f, error), HistoryStore::Added::added) << error;
   const auto rows = all(*store);
@@ -182,8 +182,9 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
             std::to_string(history::kSchemaVersion));
 }
 
-// A database an older mixpilot made (schema 1: no metrics_by_name index, one schema_version
-// row) is brought forward on open by the same migrations SQLite runs; its flights stay.
+// A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
+// columns, one schema_version row) is brought forward on open by the same migrations SQLite
+// runs; its flights stay.
 TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "migrate");
@@ -193,6 +194,11 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
   store.reset();
   ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
+  ASSERT_TRUE(server->exec("migrate",
+                           "ALTER TABLE flights DROP COLUMN parent_step, "
+                           "DROP COLUMN parent_recording_hash",
+                           error))
+      << error;
   ASSERT_TRUE(server->exec("migrate", "DELETE FROM schema_version WHERE version > 1", error))
       << error;
   ASSERT_EQ(sql(*server, "migrate", "SELECT max(version) FROM schema_version"), "1");
@@ -203,9 +209,45 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   EXPECT_EQ(sql(*server, "migrate",
                 "SELECT count(*) FROM pg_indexes WHERE indexname = 'metrics_by_name'"),
             "1");
+  EXPECT_EQ(sql(*server, "migrate",
+                "SELECT count(*) FROM pg_indexes WHERE indexname = 'flights_by_parent'"),
+            "1");
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
   expect_same_flight(sample_flight(), rows[0]);
+}
+
+// Fly from here (SPEC §10): a branch's parent link (the parent flight's recording hash and the
+// step it was taken over at) read back as written, NULL for any other flight, as in SQLite.
+TEST(Postgres, FlyFromHereBranchRowRoundTrips) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "branch");
+  auto store = open_store(url);
+  ASSERT_TRUE(store);
+  FlightRecord parent = sample_flight();
+  parent.recording_path = "/r/novice.mcap";
+  parent.recording_hash = sha256_hex("the novice's recording");
+  FlightRecord branch = sample_flight();
+  branch.started_unix_ms += 100'000;
+  branch.pilot = "experienced";
+  branch.recording_path = "/r/branch.mcap";
+  branch.recording_hash = sha256_hex("the branch's recording");
+  branch.parent_recording_hash = parent.recording_hash;
+  branch.parent_step = 666;
+  std::string error;
+  ASSERT_EQ(store->add(parent, error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(store->add(branch, error), HistoryStore::Added::added) << error;
+  const auto rows = all(*store);
+  ASSERT_EQ(rows.size(), 2u);
+  expect_same_flight(parent, rows[0]);
+  EXPECT_FALSE(rows[0].branch());
+  expect_same_flight(branch, rows[1]);
+  EXPECT_TRUE(rows[1].branch());
+  EXPECT_EQ(sql(*server, "branch", "SELECT count(*) FROM flights WHERE parent_step IS NULL"), "1");
+  EXPECT_EQ(sql(*server, "branch",
+                "SELECT parent_step FROM flights WHERE parent_recording_hash = '" +
+                    parent.recording_hash + "'"),
+            "666");
 }
 
 // A recording is one flight: the same hash again is already known and adds nothing; flights
@@ -215,7 +257,7 @@ TEST(Postgres, ARecordingIsAddedOnce) {
   auto store = open_store(fresh_database(*server, "once"));
   ASSERT_TRUE(store);
   FlightRecord f = sample_flight();
-  f.recording_hash = history::sha256_hex("recording");
+  f.recording_hash = sha256_hex("recording");
   f.recording_path = "/r.mcap";
   std::string error;
   bool known = true;
@@ -376,7 +418,7 @@ TEST(Postgres, EightProcessesWriteAtOnce) {
         // Two trainees shared by all writers: their rows are made at once too.
         FlightRecord f = sample_flight(k % 2 ? "Ben" : "Ada", i);
         f.station = "station " + std::to_string(k);
-        f.recording_hash = history::sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+        f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
         if (store->add(f, error) != HistoryStore::Added::added) {
           std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
           ::_exit(3);
@@ -480,7 +522,7 @@ TEST(Postgres, ThreadsShareOneStore) {
       for (int i = 0; i < kEach; ++i) {
         std::string error;
         FlightRecord f = sample_flight("thread " + std::to_string(t), i);
-        f.recording_hash = history::sha256_hex(std::to_string(t) + ":" + std::to_string(i));
+        f.recording_hash = sha256_hex(std::to_string(t) + ":" + std::to_string(i));
         if (store->add(f, error) != HistoryStore::Added::added) ++failures;
         std::vector<StoredFlight> rows;
         if (!store->query({}, rows, error)) ++failures;
@@ -660,7 +702,7 @@ TEST(Postgres, PushTwiceAddsNothingTheSecondTime) {
     FlightRecord f = sample_flight(i % 2 ? "O'Brien" : "Ada", 1'700'000'000'000 + 1000 * i);
     if (i < 4) {  // two without a recording
       f.recording_path = "/rec/" + std::to_string(i) + ".mcap";
-      f.recording_hash = history::sha256_hex("recording " + std::to_string(i));
+      f.recording_hash = sha256_hex("recording " + std::to_string(i));
     }
     f.metrics.emplace_back("attempt", double(i));
     ASSERT_EQ(station->add(f, error), HistoryStore::Added::added) << error;
@@ -738,7 +780,7 @@ TEST(Postgres, PushCommandTwiceAddsNothingTheSecondTime) {
     ASSERT_TRUE(station) << error;
     for (int i = 0; i < 3; ++i) {
       FlightRecord f = sample_flight("Ada", 1'700'000'000'000 + i);
-      if (i == 0) f.recording_hash = history::sha256_hex("cli recording");
+      if (i == 0) f.recording_hash = sha256_hex("cli recording");
       ASSERT_EQ(station->add(f, error), HistoryStore::Added::added) << error;
     }
   }
@@ -792,7 +834,7 @@ TEST(Postgres, APushThatFailsSaysWhere) {
   auto station = history::open_sqlite(file.string(), error);
   ASSERT_TRUE(station) << error;
   FlightRecord recorded = sample_flight();
-  recorded.recording_hash = history::sha256_hex("a recording");
+  recorded.recording_hash = sha256_hex("a recording");
   ASSERT_EQ(station->add(recorded, error), HistoryStore::Added::added) << error;
   const std::string password = doomed->password();
   doomed.reset();

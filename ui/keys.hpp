@@ -40,6 +40,9 @@ inline void set_key(ImGuiIO& io, Key k, bool down) { io.KeysDown[int(k)] = down;
 // label and the help sheet name it too).
 inline constexpr Key kExportClipKey = Key::e;
 inline constexpr const char* kExportClipKeyName = "E";
+// A replay's "fly from here" (SPEC §10): T takes the controls at the playhead ("take over"; no
+// other shortcut uses it, nor do the keyboard pilot's keys).
+inline constexpr Key kFlyFromHereKey = Key::t;
 
 // The keys that fly the keyboard pilot (input/keyboard.hpp), indexed by input::Key: W S A D
 // and the arrows.

@@ -2,6 +2,7 @@
 // The trainee's progress as the window shows it (SPEC §10): plain snapshot structs, filled by
 // the app from the history off the UI thread (app/history_writer.hpp), and the Progress panel
 // that draws one. ui/ never reads the history itself: a frame only draws what was loaded.
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -26,6 +27,8 @@ struct ProgressFlight {
   std::string when;                // local time, "YYYY-MM-DD HH:MM"
   std::string ended;               // completed | interrupted | lost
   std::string recording;           // its recording ("" none, or no longer on this disk)
+  // A branch (fly from here): flown on from this step of another flight (−1: none).
+  std::int64_t from_step = -1;
 };
 
 // A least-squares line through the last `over` skills of one kind of flight.

@@ -191,6 +191,14 @@ void flights_table(const ProgressView& v, float height, Requests& out) {
       ImGui::TextUnformatted(f.when.c_str());
       ImGui::TableNextColumn();
       coloured(f.probe ? kProbe : kAssisted, kind_of(f));
+      if (f.from_step >= 0) {  // a branch, marked as in `mixpilot history`
+        ImGui::SameLine(0.0f, 0.0f);
+        ImGui::TextUnformatted(" ^");
+        if (ImGui::IsItemHovered())
+          ImGui::SetTooltip("A branch: flown on from step %lld of another flight (fly from "
+                            "here), scored from there on",
+                            static_cast<long long>(f.from_step));
+      }
       ImGui::TableNextColumn();
       ImGui::PushFont(mono_font());
       if (std::isfinite(f.skill)) std::snprintf(text, sizeof text, "%5.1f", f.skill);

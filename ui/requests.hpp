@@ -40,9 +40,10 @@ struct SetTrainee {
 struct SetAssist {
   bool on;                    // false: the next flight is a probe (SPEC §10)
 };
+struct FlyFromStart {};       // a flight flown on from a recording's moment: from t = 0 instead
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
-                                 SetRecord, SetTrainee, SetAssist>;
+                                 SetRecord, SetTrainee, SetAssist, FlyFromStart>;
 
 // A replay's transport.
 struct TogglePlay {};
@@ -91,7 +92,6 @@ struct ReplayRecording {          // a flight of the Progress panel: its recordi
 struct ExportClip {               // a time window of the replay shown, saved as a video file
   double from, to;                // [s] beside its recording (the export outlives the replay)
 };
-using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording, ExportClip>;
 
 // What "Export clip" saves around a replay's time `t` [s]: `half_width` seconds either side,
 // within the recording's [0, duration].
@@ -101,6 +101,12 @@ inline ExportClip clip_around(double t, double duration, double half_width = kCl
   const double to = t + half_width > duration ? duration : t + half_width;
   return ExportClip{from, to};
 }
+
+// Fly from here (SPEC §10): the replay's moment at the playhead becomes a live flight, READY
+// there, which the trainee's pilot flies on.
+struct FlyFromHere {};
+using AppRequest =
+    std::variant<OpenFile, LeaveReplay, ReplayRecording, ExportClip, FlyFromHere>;
 
 // Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
 using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;

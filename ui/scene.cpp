@@ -33,6 +33,13 @@ void History::push(const Telemetry& s) {
   size_ = std::min(size_ + 1, capacity_);
 }
 
+void History::pop_newest() {
+  if (view_ || size_ == 0) return;
+  if (ring_.size() < capacity_) ring_.pop_back();  // still filling: the newest is the last
+  head_ = (head_ + capacity_ - 1) % capacity_;
+  --size_;
+}
+
 std::size_t History::first_at_or_after(double t) const {
   std::size_t lo = 0, hi = size_;
   while (lo < hi) {

@@ -46,7 +46,13 @@ class History {
     return h;
   }
   void push(const Telemetry& s);
-  void clear() { size_ = 0; head_ = 0; }
+  // Drops the newest value (a ring's; a view stays as it is).
+  void pop_newest();
+  void clear() {
+    ring_.clear();  // keeps its capacity; push() fills it from the front again
+    size_ = 0;
+    head_ = 0;
+  }
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   // i = 0 is the oldest kept, size() − 1 the newest.

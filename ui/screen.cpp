@@ -409,6 +409,8 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
       {"[  ]", "replay: previous / next event"},
       {kExportClipKeyName, "replay: export a clip, the playhead ± 5 s, beside the recording"},
+      {"T", "replay: fly from here - a new flight from the playhead's moment, with the pilot "
+            "you pick (READY there; Space starts), scored from there on"},
       {"Esc", "leave the replay; close this sheet or the progress"},
       {"F1  ?", "this sheet"},
   };
@@ -458,6 +460,8 @@ void replay_keys(const RunInfo& run, Requests& out) {
   if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
   if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
   if (key_pressed(kExportClipKey)) out.push_back(clip_around(r.t, r.duration));
+  if (key_pressed(kFlyFromHereKey) && r.can_fly_from_here && r.taking_over < 0.0)
+    out.push_back(FlyFromHere{});
   if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
     out.push_back(LeaveReplay{});
 }

@@ -46,6 +46,10 @@ struct ReplayInfo {
   double loaded = 1.0;        // fraction of the flight ready to show (it is flown again first)
   double lambda_threshold = 0.5;         // "λ below" events cross it downwards
   std::vector<TimelineEvent> events;     // by time
+  // Fly from here (SPEC §10): offered (a pilot flies this mode), and while the moment is made
+  // ready the part of the way flown (0 … 1; −1: not taking over).
+  bool can_fly_from_here = false;
+  double taking_over = -1.0;
 };
 
 // The session panel's choices (SPEC §8): what the next flight flies.
@@ -62,6 +66,9 @@ struct SessionChoices {
   // pilot flies as it was recorded).
   bool assist = true;
   bool assist_choosable = false;
+  // Fly from here: the next flight goes on from a recording's moment ("from REC at t = 10.00 s";
+  // "" for a flight from the start).
+  std::string fly_from;
 };
 
 // A joystick SDL sees.

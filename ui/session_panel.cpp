@@ -110,6 +110,13 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
       ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCaution), "off: probe flight");
     }
   }
+  // Fly from here (SPEC §10): the next flight goes on from a recording's moment.
+  if (!c.fly_from.empty()) {
+    ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kPilot), "%s", c.fly_from.c_str());
+    if (ImGui::Button("Fly from the start")) out.push_back(FlyFromStart{});
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("The scenario from t = 0 instead, as a flight of its own");
+  }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());

@@ -1,5 +1,6 @@
 // A replay's transport bar (UI.md §1, §6): the timeline with its event ticks and the playhead,
-// play / pause, previous / next event, the speeds 0.25×–8× and the "λ below" threshold.
+// play / pause, previous / next event, fly from here (SPEC §10), the speeds 0.25×–8× and the
+// "λ below" threshold.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -125,6 +126,16 @@ void draw_transport(const RunInfo& run, Requests& out) {
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Saves %g s either side of the playhead as a video beside the recording",
                       kClipHalfWidth);
+  // Fly from here (SPEC §10): a new flight from the playhead's moment, READY there.
+  if (r.can_fly_from_here) {
+    same_line_or_wrap(button_width("Fly from here (T)"));
+    ImGui::BeginDisabled(r.taking_over >= 0.0);
+    if (ImGui::Button("Fly from here (T)")) out.push_back(FlyFromHere{});
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("Take the controls at this moment: a new flight from here, with the pilot\n"
+                        "you pick, recorded as a branch of this one and scored from here on");
+  }
   ImGui::PushFont(mono_font());
   char time[48];
   std::snprintf(time, sizeof time, "%7.2f / %.2f s", r.t, r.duration);
@@ -159,6 +170,9 @@ void draw_transport(const RunInfo& run, Requests& out) {
   }
   if (r.loaded < 1.0)
     ImGui::TextDisabled("flying the recording again to show it: %.0f %%", 100.0 * r.loaded);
+  if (r.taking_over >= 0.0)
+    ImGui::TextDisabled("flying the recording to %.2f s to fly on from there: %.0f %%", r.t,
+                        100.0 * r.taking_over);
 }
 
 }  // namespace mixpilot::ui

@@ -71,6 +71,12 @@ class PilotSource {
     (void)state;
     return false;
   }
+  // Fly from here (SPEC §10, Mode::take_over): the source takes over a flight at a step it did
+  // not fly, from the present, rather than continuing another source. An emulated pilot
+  // cold-starts its NMPC from the state its next command is given, as at a flight's start; a
+  // device reads from now on and a recording gives its commands of the steps to come, so they
+  // have nothing to do (the default). Allocates nothing.
+  virtual void take_over() {}
 };
 
 }  // namespace mixpilot

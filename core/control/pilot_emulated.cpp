@@ -1,5 +1,6 @@
 #include "core/control/pilot_emulated.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -41,10 +42,11 @@ SetupResult EmulatedPilot::setup(const models::MikroKopter& model, const PilotPr
     data.yref[i].segment<4>(12).setConstant(model.hover_speed());
   }
   const int delay_steps = int(std::lround(profile.reaction_delay / dt));
-  PilotCommand hover;
-  hover.rotor_speed.setConstant(model.hover_speed());
-  delay_line_.assign(delay_steps + 1, hover);
+  hover_ = PilotCommand{};
+  hover_.rotor_speed.setConstant(model.hover_speed());
+  delay_line_.assign(delay_steps + 1, hover_);
   started_ = false;
+  initial_ = rti_.state();
   return {};
 }
 
@@ -91,6 +93,12 @@ bool EmulatedPilot::restore(const PilotState* state) {
   delay_line_ = s->delay_line;
   started_ = s->started;
   return true;
+}
+
+void EmulatedPilot::take_over() {
+  (void)rti_.restore(initial_);  // saved from this solver: it fits
+  std::fill(delay_line_.begin(), delay_line_.end(), hover_);
+  started_ = false;
 }
 
 bool RecklessPilot::command(std::int64_t, double, const Eigen::VectorXd& x, PilotCommand& out) {

@@ -36,6 +36,9 @@ class EmulatedPilot final : public PilotSource {
   void save(std::unique_ptr<PilotState>& state) const override;
   // Only a State of a pilot with the same horizon and reaction delay.
   [[nodiscard]] bool restore(const PilotState* state) override;
+  // Back to the state setup() left: the NMPC's solver as set up, to be warm-started at hover
+  // from the next command's state, and the reaction delay line full of hover commands.
+  void take_over() override;
 
  private:
   models::MikroKopter model_{};
@@ -49,6 +52,8 @@ class EmulatedPilot final : public PilotSource {
   RtiSolver rti_;
   std::vector<PilotCommand> delay_line_;  // ring buffer of delay_steps + 1 commands
   bool started_ = false;
+  RtiState initial_;   // the solver's state as setup() left it (take_over())
+  PilotCommand hover_;  // what the delay line holds before the first command arrives
 };
 
 // A pilot who ignores the reference and steers straight at the nearest obstacle at full tilt,

@@ -107,9 +107,14 @@ std::string check_record(const FlightRecord& f) {
       {"the pilot", &f.pilot},             {"the input device", &f.input_device},
       {"the input settings hash", &f.input_settings_hash},
       {"the recording's path", &f.recording_path}, {"the recording's hash", &f.recording_hash},
-      {"the app version", &f.app_version}, {"the front end", &f.front_end}};
+      {"the app version", &f.app_version}, {"the front end", &f.front_end},
+      {"the parent recording's hash", &f.parent_recording_hash}};
   for (const auto& [field, text] : texts)
     if (std::string why = check_text(field, *text); !why.empty()) return why;
+  // A branch names its parent by its recording's hash and the step it was taken over at.
+  if (f.parent_step < -1) return "the parent step is negative";
+  if (f.branch() != !f.parent_recording_hash.empty())
+    return "a branch needs both its parent recording's hash and its parent step";
   for (const auto& [name, value] : f.metrics)
     if (std::string why = check_name("a metric's name", name); !why.empty()) return why;
   return {};

@@ -27,6 +27,11 @@ struct FlightRecord {
   std::string recording_path, recording_hash;  // "" when not recorded; the hash is unique
   std::string app_version, front_end;      // front_end: window | fly | vehicle | import | ...
   std::vector<std::pair<std::string, double>> metrics;  // every score field of the report
+  // A branch (fly from here): flown on from step `parent_step` of the flight whose recording
+  // has this hash (that flight's recording_hash); "" and −1 for any other flight.
+  std::string parent_recording_hash;
+  std::int64_t parent_step = -1;
+  bool branch() const { return parent_step >= 0; }
 };
 struct StoredFlight : FlightRecord {
   std::int64_t id = 0;

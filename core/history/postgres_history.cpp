@@ -401,14 +401,21 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, s
       .text_or_null(f.recording_path)
       .text_or_null(f.recording_hash)
       .text(f.app_version)
-      .text(f.front_end);
+      .text(f.front_end)
+      .text_or_null(f.parent_recording_hash);
+  if (f.branch())
+    p.integer(f.parent_step);
+  else
+    p.null();
   // The same recording added at this moment by another station: theirs counts, ours is known.
   const auto flight =
       run("INSERT INTO flights (trainee_id, station, scenario, scenario_hash, mode, pilot, "
           "input_device, input_settings_hash, started_unix_ms, duration_s, ended, probe, "
-          "recording_path, recording_hash, app_version, front_end) "
+          "recording_path, recording_hash, app_version, front_end, parent_recording_hash, "
+          "parent_step) "
           "VALUES ($1::bigint, $2, $3, $4, $5, $6, $7, $8, $9::bigint, $10::double precision, $11, "
-          "$12::integer, $13, $14, $15, $16) ON CONFLICT (recording_hash) DO NOTHING RETURNING id",
+          "$12::integer, $13, $14, $15, $16, $17, $18::bigint) "
+          "ON CONFLICT (recording_hash) DO NOTHING RETURNING id",
           p, PGRES_TUPLES_OK, "cannot add the flight", error);
   if (!flight) return failed();
   if (flight->rows() == 0) {
@@ -458,7 +465,8 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
   const auto flights = run(
       "SELECT * FROM (SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, "
       "f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, "
-      "f.probe, f.recording_path, f.recording_hash, f.app_version, f.front_end "
+      "f.probe, f.recording_path, f.recording_hash, f.app_version, f.front_end, "
+      "f.parent_recording_hash, f.parent_step "
       "FROM flights f JOIN trainees t ON t.id = f.trainee_id "
       "WHERE ($1::text = '' OR t.name = $1::text) AND ($2::text = '' OR f.scenario = $2::text) "
       "AND f.started_unix_ms >= $3::bigint "
@@ -491,6 +499,8 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
     f.recording_hash = s.text(r, 14);
     f.app_version = s.text(r, 15);
     f.front_end = s.text(r, 16);
+    f.parent_recording_hash = s.text(r, 17);
+    f.parent_step = s.at(r, 18) ? read_int(s.at(r, 18)) : -1;
     if (r > 0) ids += ',';
     ids += std::to_string(f.id);
     at.emplace(f.id, out.size());

@@ -46,6 +46,14 @@ const std::vector<std::vector<const char*>>& migrations() {
       {
           "CREATE INDEX metrics_by_name ON metrics (name, flight_id, value)",
       },
+      // 3: fly from here (SPEC §10): a branch names its parent flight by that flight's
+      // recording hash and the step it was taken over at (NULL for any other flight); the
+      // branches of a flight are found through the index.
+      {
+          "ALTER TABLE flights ADD COLUMN parent_recording_hash TEXT",
+          "ALTER TABLE flights ADD COLUMN parent_step BIGINT CHECK (parent_step >= 0)",
+          "CREATE INDEX flights_by_parent ON flights (parent_recording_hash, parent_step)",
+      },
   };
   return m;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The history's schema, one for both backends (SPEC §10): a schema_version table (one row per
 // applied migration), trainees (unique name), flights (the FlightRecord's fields; a recording
-// hash is unique, NULL for an unrecorded flight) and metrics (flight, position, name, value).
+// hash is unique, NULL for an unrecorded flight; a branch's parent recording hash and step,
+// NULL for any other flight) and metrics (flight, position, name, value).
 // Forward migrations are an ordered list of SQL texts; the few words the dialects spell
 // differently are written as {placeholders} and filled in by dialect().
 //
@@ -20,7 +21,7 @@ namespace mixpilot::history {
 enum class Dialect { sqlite, postgresql };
 
 // The schema this build writes and reads.
-inline constexpr int kSchemaVersion = 2;
+inline constexpr int kSchemaVersion = 3;
 
 inline constexpr const char* kCreateVersionTable =
     "CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL PRIMARY KEY, "

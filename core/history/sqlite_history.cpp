@@ -219,8 +219,9 @@ std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std
     if (!prepare(s,
                  "INSERT INTO flights (trainee_id, station, scenario, scenario_hash, mode, pilot, "
                  "input_device, input_settings_hash, started_unix_ms, duration_s, ended, probe, "
-                 "recording_path, recording_hash, app_version, front_end) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
+                 "recording_path, recording_hash, app_version, front_end, parent_recording_hash, "
+                 "parent_step) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
                  error))
       return rollback(), std::nullopt;
     sqlite3_stmt* p = s.get();
@@ -240,6 +241,11 @@ std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std
     bind_text(p, 14, f.recording_hash, true);
     bind_text(p, 15, f.app_version);
     bind_text(p, 16, f.front_end);
+    bind_text(p, 17, f.parent_recording_hash, true);
+    if (f.branch())
+      sqlite3_bind_int64(p, 18, f.parent_step);
+    else
+      sqlite3_bind_null(p, 18);
     if (sqlite3_step(p) != SQLITE_ROW) return failed("cannot add the flight");
     flight_id = sqlite3_column_int64(p, 0);
   }
@@ -277,7 +283,8 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
   static constexpr const char* kColumns =
       "SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, f.pilot, "
       "f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, f.probe, "
-      "f.recording_path, f.recording_hash, f.app_version, f.front_end";
+      "f.recording_path, f.recording_hash, f.app_version, f.front_end, "
+      "f.parent_recording_hash, f.parent_step";
   // Without a limit the start-time index gives the order as it is: no sort of every row.
   const std::string flights_sql =
       q.limit > 0 ? std::string("SELECT * FROM (") + kColumns + kFilter +
@@ -316,6 +323,8 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       f.recording_hash = column_text(p, 14);
       f.app_version = column_text(p, 15);
       f.front_end = column_text(p, 16);
+      f.parent_recording_hash = column_text(p, 17);
+      f.parent_step = sqlite3_column_type(p, 18) == SQLITE_NULL ? -1 : sqlite3_column_int64(p, 18);
       out.push_back(std::move(f));
     }
     if (rc != SQLITE_DONE) {

@@ -270,6 +270,7 @@ struct MiMode::Saved final : ModeSnapshot::State {
   SimulatedVehicle<models::MikroKopter>::Data vehicle;
   std::unique_ptr<PilotState> pilot;  // null: the source keeps nothing, or cannot go back
   bool remote = false;
+  bool assisted = true;  // false: a probe (SPEC §10)
 };
 
 void MiMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
@@ -282,20 +283,43 @@ void MiMode::save_state(std::unique_ptr<ModeSnapshot::State>& state) const {
   s.vehicle = simulated_.data();
   if (pilot_) pilot_->save(s.pilot);
   s.remote = remote_.attached();
+  s.assisted = controller_.assisted();
 }
 
-RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
-  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+RestoreStatus MiMode::check_saved(const Saved& s) const {
   if (s.remote || remote_.attached()) return RestoreStatus::remote_vehicle;
   if (!controller_.rti().fits(s.rti) || !simulated_.fits(s.vehicle) ||
       s.controller.predicted.cols() != controller_.outputs().predicted.cols())
     return RestoreStatus::other_scenario;
-  if (!pilot_ || !pilot_->restore(s.pilot.get())) return RestoreStatus::pilot;
+  // λ pinned to 1 or not is the controller's setup, not its state: the steps would differ.
+  if (s.assisted != controller_.assisted()) return RestoreStatus::assistance;
+  if (!pilot_) return RestoreStatus::pilot;
+  return RestoreStatus::ok;
+}
+
+void MiMode::put_back(const Saved& s) {
   controller_.rti().restore(s.rti);
   controller_.restore(s.controller);
   scorer_.restore(s.score);
   run_ = s.run;
   simulated_.restore(s.vehicle);
+}
+
+RestoreStatus MiMode::restore_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::restore() checked the kind
+  if (const RestoreStatus r = check_saved(s); r != RestoreStatus::ok) return r;
+  if (!pilot_->restore(s.pilot.get())) return RestoreStatus::pilot;
+  put_back(s);
+  return RestoreStatus::ok;
+}
+
+RestoreStatus MiMode::take_over_state(const ModeSnapshot::State& state) {
+  const Saved& s = static_cast<const Saved&>(state);  // Mode::take_over() checked the kind
+  if (const RestoreStatus r = check_saved(s); r != RestoreStatus::ok) return r;
+  put_back(s);
+  // SPEC §10: the new flight is scored on its own steps, from the snapshot's step on.
+  scorer_.restart(run_.step);
+  pilot_->take_over();
   return RestoreStatus::ok;
 }
 
@@ -343,7 +367,9 @@ ModeIdentity MiMode::identity() const {
 
 Metrics MiMode::replayed_metrics(const std::vector<double>& recorded_solve_us) const {
   Score s = score();
-  const std::size_t n = std::min(recorded_solve_us.size(), std::size_t(steps_done()));
+  // The steps scored: all of them, or a branch's own from its take-over on (whose recording
+  // holds those steps' solver statistics alone).
+  const std::size_t n = std::min(recorded_solve_us.size(), scorer_.sums().lambda.size());
   // The deadline misses are replayed as recorded (replay_timing()).
   set_timing(s, std::vector<double>(recorded_solve_us.begin(), recorded_solve_us.begin() + std::ptrdiff_t(n)),
              s.deadline_misses);

@@ -80,9 +80,16 @@ class MiMode final : public Mode {
   // Run, the simulated vehicle and the pilot source's state. With a remote vehicle they refuse.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+  // Fly from here: the same, but the pilot source takes over from the present
+  // (PilotSource::take_over) and the score restarts at the snapshot's step.
+  [[nodiscard]] RestoreStatus take_over_state(const ModeSnapshot::State& state) override;
 
  private:
   struct Saved;
+  // Whether a saved state can be put back into this mode (ok), or why not, its pilot's state
+  // aside; put_back() then puts it back, all but the pilot's state.
+  RestoreStatus check_saved(const Saved& s) const;
+  void put_back(const Saved& s);
   bool left_the_world() const;
   void measure(double t);
   void measure_remote(double t);

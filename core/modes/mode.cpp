@@ -33,6 +33,9 @@ const char* to_string(RestoreStatus status) {
     case RestoreStatus::pilot: return "the pilot source cannot continue from the saved one";
     case RestoreStatus::remote_vehicle:
       return "a remote vehicle flies the mode or flew the snapshot: its plant cannot go back";
+    case RestoreStatus::assistance:
+      return "the snapshot was flown with the other assistance (a probe and an assisted flight)";
+    case RestoreStatus::no_pilot: return "the mode has no pilot to take the flight over";
   }
   return "unknown";
 }
@@ -51,13 +54,27 @@ void Mode::save(ModeSnapshot& snapshot) const {
 
 RestoreStatus Mode::restore(const ModeSnapshot& snapshot) {
   const ModeSnapshot& s = snapshot;
+  if (const RestoreStatus r = fits(s); r != RestoreStatus::ok) return r;
+  if (const RestoreStatus r = restore_state(*s.state_); r != RestoreStatus::ok) return r;
+  next_forced_ = s.next_forced_;
+  next_miss_ = s.next_miss_;
+  return RestoreStatus::ok;
+}
+
+RestoreStatus Mode::take_over(const ModeSnapshot& snapshot) {
+  const ModeSnapshot& s = snapshot;
+  if (const RestoreStatus r = fits(s); r != RestoreStatus::ok) return r;
+  if (const RestoreStatus r = take_over_state(*s.state_); r != RestoreStatus::ok) return r;
+  next_forced_ = s.next_forced_;
+  next_miss_ = s.next_miss_;
+  return RestoreStatus::ok;
+}
+
+RestoreStatus Mode::fits(const ModeSnapshot& s) const {
   if (!s.state_) return RestoreStatus::empty;
   if (s.kind_ != kind()) return RestoreStatus::other_kind;
   if (s.scenario_name_ != scenario_name() || s.steps_total_ != steps_total())
     return RestoreStatus::other_scenario;
-  if (const RestoreStatus r = restore_state(*s.state_); r != RestoreStatus::ok) return r;
-  next_forced_ = s.next_forced_;
-  next_miss_ = s.next_miss_;
   return RestoreStatus::ok;
 }
 

@@ -105,6 +105,8 @@ enum class RestoreStatus {
   other_scenario,  // from another scenario, or one of another shape (length, horizon, delays)
   pilot,           // this mode's pilot source cannot continue from the saved one
   remote_vehicle,  // a remote vehicle flies this mode or flew the saved one: it cannot go back
+  assistance,      // saved from a probe into an assisted flight, or the other way (SPEC §10)
+  no_pilot,        // take_over(): this mode has no pilot to take the flight over
 };
 // The reason in words ("the snapshot is of another kind of mode"; "" for ok).
 const char* to_string(RestoreStatus status);
@@ -223,6 +225,16 @@ class Mode {
   // changing nothing, a snapshot of another kind of mode or scenario (RestoreStatus).
   void save(ModeSnapshot& snapshot) const;
   [[nodiscard]] RestoreStatus restore(const ModeSnapshot& snapshot);
+  // Fly from here (SPEC §10): the flight saved in `snapshot` goes on from its step k as a new
+  // flight, with this mode's own pilot source taking over from the present
+  // (PilotSource::take_over: an emulated pilot cold-starts its NMPC from the state at k, a
+  // device reads from now) instead of continuing the saved source, and with the metrics
+  // started afresh at k: the new flight is scored on its own steps. Everything else — plant,
+  // sensor, estimators, the controller's warm start, the safety net, the telemetry, the step
+  // counter — is restore()'s, with the same checks, so step k starts from the saved state bit
+  // for bit. Allocates nothing once the snapshot is sized. A mode without a pilot has nothing to
+  // take over: RestoreStatus::no_pilot.
+  [[nodiscard]] RestoreStatus take_over(const ModeSnapshot& snapshot);
 
  protected:
   // The kind's part of save() and restore(). save_state() makes `state` when it is null (the
@@ -231,7 +243,25 @@ class Mode {
   // checks the rest of its shape and copies it back, or refuses changing nothing.
   virtual void save_state(std::unique_ptr<ModeSnapshot::State>& state) const = 0;
   [[nodiscard]] virtual RestoreStatus restore_state(const ModeSnapshot::State& state) = 0;
+  // take_over()'s part, given a state restore_state() would take. Default: no pilot.
+  [[nodiscard]] virtual RestoreStatus take_over_state(const ModeSnapshot::State& state) {
+    (void)state;
+    return RestoreStatus::no_pilot;
+  }
+  // A mode that flies other modes in turn (a branch's replay: its parent's, then its own)
+  // saves and restores the one flying as its own, and paces it as it is paced.
+  static void save_state_of(const Mode& mode, std::unique_ptr<ModeSnapshot::State>& state) {
+    mode.save_state(state);
+  }
+  [[nodiscard]] static RestoreStatus restore_state_of(Mode& mode,
+                                                      const ModeSnapshot::State& state) {
+    return mode.restore_state(state);
+  }
+  void pace_like_this(Mode& mode) const { mode.set_pacing(late_us_, period_us_); }
 
+  // Whether restore() and take_over() can take `s` at all: saved, of this kind, scenario and
+  // length (ok), or why not.
+  RestoreStatus fits(const ModeSnapshot& s) const;
   // Whether a replay stops before step k (stop_after()).
   bool stopped_at(std::int64_t k) const { return stop_after_ >= 0 && k >= stop_after_; }
   // Whether step k's solve is a recorded overrun (asked with increasing k).
@@ -247,6 +277,8 @@ class Mode {
 
  private:
   static bool take(const std::vector<std::int64_t>& steps, std::size_t& next, std::int64_t k) {
+    // Forward as the steps go; back after a snapshot of an earlier step was restored.
+    while (next > 0 && steps[next - 1] >= k) --next;
     while (next < steps.size() && steps[next] < k) ++next;
     return next < steps.size() && steps[next] == k;
   }

@@ -61,6 +61,23 @@ bool ScoreAccumulator::add(const Telemetry& s) {
   return started;
 }
 
+void ScoreAccumulator::restart(std::int64_t first_step) {
+  Sums& m = sums_;
+  // The logs moved aside and back keep their buffers; every other sum takes its initial value.
+  ReservedVector<Eigen::Vector3d> position = std::move(m.position), reference = std::move(m.reference);
+  ReservedVector<double> lambda = std::move(m.lambda), rti_us = std::move(m.rti_us);
+  m = Sums{};
+  m.position = std::move(position);
+  m.reference = std::move(reference);
+  m.lambda = std::move(lambda);
+  m.rti_us = std::move(rti_us);
+  m.position.clear();
+  m.reference.clear();
+  m.lambda.clear();
+  m.rti_us.clear();
+  m.first_step = first_step;
+}
+
 Score ScoreAccumulator::finish() const {
   const Sums& m = sums_;
   Score sc;
@@ -84,7 +101,7 @@ Score ScoreAccumulator::finish() const {
   // Waypoint k counts as flown if the vehicle came within r of it within ±1 s; the reference
   // is the whole scenario's, so a session cut short (end of a recording) makes less progress.
   const auto window = std::int64_t(std::lround(1.0 / dt_));
-  const auto total = std::int64_t(std::lround(scenario_->duration / dt_));
+  const auto total = std::int64_t(std::lround(scenario_->duration / dt_)) - m.first_step;
   std::int64_t reached = 0;
   for (std::int64_t k = 0; k < std::int64_t(K); ++k) {
     const std::int64_t lo = std::max<std::int64_t>(0, k - window);

@@ -3,7 +3,9 @@
 // position, η^r_k the planner reference, r the ball radius, r_v the vehicle radius:
 //   duration_s        K Δt
 //   progress          fraction of the reference waypoints η^r_k that the vehicle came within r
-//                     of at some step j with |j − k| Δt ≤ 1 s (how much of the path was flown)
+//                     of at some step j with |j − k| Δt ≤ 1 s (how much of the path was flown),
+//                     out of the waypoints of the flight's planned steps from its first scored
+//                     step on (a branch flown from step k: those from k on)
 //   time_in_ball      fraction of steps with ‖p_k − η^r_k‖ ≤ r
 //   max_deviation_m   max_k ‖p_k − η^r_k‖;   rms_deviation_m  √(mean_k ‖p_k − η^r_k‖²)
 //   mean_lambda, min_lambda   of the PH index λ_k
@@ -28,7 +30,8 @@
 //                     + 0.2 exp(−override_rms / 0.1 rad)) / (1 + collisions) ∈ [0, 100]
 // The three timing fields measure this run on this machine (a replay takes them from the
 // recording); every other field is a pure function of the telemetry, so a replay of a
-// recording reproduces it bit for bit.
+// recording reproduces it bit for bit. A flight taken over from another one's step k (SPEC
+// §10, fly from here) is scored on its own steps k, k + 1, ... only (restart()).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -90,6 +93,7 @@ class ScoreAccumulator {
     int deadline_misses = 0;
     std::int64_t input_lost_steps = 0;
     std::int64_t safe_hold_steps = 0;
+    std::int64_t first_step = 0;  // the step scoring started at (restart())
   };
 
   ScoreAccumulator() = default;
@@ -99,6 +103,10 @@ class ScoreAccumulator {
   // Adds one step; true when the vehicle sphere started touching something in it.
   bool add(const Telemetry& step);
   Score finish() const;
+  // Starts the score afresh at step `first_step` of the same flight (fly from here): nothing
+  // added so far counts, and progress is out of the waypoints from that step on. Keeps the
+  // logs' capacity: allocates nothing.
+  void restart(std::int64_t first_step);
 
   // The sums so far, and back: restore() takes those of an accumulator set up for the same
   // flight (they then fit its reserved logs: no allocation).

@@ -382,6 +382,11 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                              {"planned_steps", std::to_string(info.planned_steps)},
                              {"control_period_ns", std::to_string(period_ns_)}};
   if (!info.assist.empty()) metadata.emplace("assist", info.assist);
+  if (info.parent_step >= 0) {
+    metadata.emplace("parent_recording", info.parent_recording);
+    metadata.emplace("parent_sha256", info.parent_sha256);
+    metadata.emplace("parent_step", std::to_string(info.parent_step));
+  }
   writer_.write_metadata("mixpilot", metadata);
   if (!writer_.error().empty()) {
     error = writer_.error() + "; no file is kept (no step had been recorded)";

@@ -176,6 +176,11 @@ struct SessionInfo {
   // a replay flies again as one; "" (other modes): no key is written. A recording without the
   // key was assisted.
   std::string assist = {};
+  // Fly from here (SPEC §10): a branch names its parent recording (its absolute path and
+  // SHA-256) and the parent's step k it was taken over at, its own first step. "" / −1: none.
+  std::string parent_recording = {};
+  std::string parent_sha256 = {};
+  std::int64_t parent_step = -1;
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by

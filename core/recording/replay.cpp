@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "core/modes/make_mode.hpp"
+#include "core/recording/branch_replay.hpp"
 #include "core/modes/report.hpp"
 #include "core/base/input_file.hpp"
 #include "core/recording/session_recording.hpp"
@@ -55,8 +56,8 @@ namespace {
 // The steps of the recorded (real-time) flight marked with `event`.
 std::vector<std::int64_t> recorded_steps(const RecordingContents& rec, std::uint32_t event) {
   std::vector<std::int64_t> steps;
-  for (std::size_t j = 0; j < rec.channels.size(); ++j)
-    if (rec.channels[j].events & event) steps.push_back(std::int64_t(j));
+  for (const ModeChannelsMsg& c : rec.channels)
+    if (c.events & event) steps.push_back(std::int64_t(c.step));
   return steps;
 }
 
@@ -70,16 +71,20 @@ std::int64_t planned_steps(const RecordingContents& rec) {
   return end != it->second.c_str() && *end == '\0' && n > 0 && n <= (1ll << 40) ? n : 0;
 }
 
-std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::string& path,
-                                  const std::string& text, const std::string& source,
-                                  std::optional<double> duration, Assistance assist,
-                                  std::string& error) {
+}  // namespace
+
+std::unique_ptr<Mode> replay_own_steps(const RecordingContents& rec, const std::string& path,
+                                     const std::string& text, const std::string& source,
+                                     std::optional<double> duration, Assistance assist,
+                                     std::string& error) {
   const auto kind = scenario_mode(text, source, error);
   if (!kind) return nullptr;
   const bool mi = *kind == "mixed_initiative";
   // As many steps as were recorded (an interrupted run, or one flown with --duration), in a
-  // flight of the planned length: the metrics are those the flight had.
-  const auto recorded = std::int64_t(mi ? rec.pilot.size() : rec.states.size());
+  // flight of the planned length: the metrics are those the flight had. A branch's recorded
+  // steps come after its parent's, from its first step on.
+  const std::int64_t first = first_recorded_step(rec);
+  const auto recorded = first + std::int64_t(mi ? rec.pilot.size() : rec.states.size());
   const double dt = rec.control_period_ns > 0 ? 1e-9 * double(rec.control_period_ns) : 0.0;
   ModeRequest request;
   request.duration = duration;
@@ -87,18 +92,20 @@ std::unique_ptr<Mode> replay_mode_of(const RecordingContents& rec, const std::st
     request.duration = double(std::max(planned_steps(rec), recorded)) * dt;
   if (mi) {
     request.assist = assist;
-    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path);
+    request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path, first);
   }
   auto mode = make_mode(text, source, std::move(request), error);
   if (mode && !duration) mode->stop_after(recorded);
+  // What depended on the wall clock is replayed as recorded: the overruns' fallbacks and the
+  // deadline misses.
+  if (mode)
+    mode->replay_timing(recorded_steps(rec, kEventOverrun), recorded_steps(rec, kEventDeadlineMiss));
   return mode;
 }
 
-}  // namespace
-
 std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
                                   const std::string& text, const std::string& source,
-                                  std::optional<double> duration, std::string& error) {
+                                  std::optional<double> duration, std::string& error, int depth) {
   if (const auto v = rec.metadata.find("vehicle"); v != rec.metadata.end() && !v->second.empty()) {
     error = path + " was flown with a remote vehicle (--vehicle " + printable(v->second) +
             "): its plant ran in another process, so the flight cannot be flown again here";
@@ -106,15 +113,20 @@ std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::strin
   }
   const std::optional<Assistance> assist = recorded_assistance(rec, path, error);
   if (!assist) return nullptr;
-  auto mode = replay_mode_of(rec, path, text, source, duration, *assist, error);
-  // What depended on the wall clock is replayed as recorded: the overruns' fallbacks and the
-  // deadline misses.
-  if (mode)
-    mode->replay_timing(recorded_steps(rec, kEventOverrun), recorded_steps(rec, kEventDeadlineMiss));
+  std::optional<ParentLink> parent;
+  if (!parent_link(rec, path, parent, error)) return nullptr;
+  if (parent) return branch_replay_mode(rec, path, *parent, text, source, duration, depth, error);
+  auto mode = replay_own_steps(rec, path, text, source, duration, *assist, error);
   const auto embedded = rec.metadata.find("scenario");
   if (!mode && embedded != rec.metadata.end() && embedded->second == text)
     error = in_embedded_scenario(path, error);
   return mode;
+}
+
+std::int64_t first_recorded_step(const RecordingContents& rec) {
+  std::optional<ParentLink> parent;
+  std::string ignored;  // a malformed link: replay_mode() refuses the recording
+  return parent_link(rec, "", parent, ignored) && parent ? parent->step : 0;
 }
 
 namespace {
@@ -135,8 +147,8 @@ bool same(const LambdaReasonMsg& recorded, const Telemetry& s) {
 }  // namespace
 
 void ReplayCheck::on_sample(const Telemetry& s) {
-  if (first_ >= 0) return;
-  const auto k = std::size_t(s.step);
+  if (first_ >= 0 || s.step < first_step_) return;
+  const auto k = std::size_t(s.step - first_step_);
   const char* what = nullptr;
   if (k >= rec_->states.size() || !same(rec_->states[k].x, s.x)) {
     what = "state";
@@ -160,16 +172,24 @@ bool ReplayCheck::matches(std::int64_t steps) const {
   return first_difference(steps).empty();
 }
 
+std::string ReplayCheck::difference_so_far() const {
+  if (first_ < 0) return "";
+  return std::string("the ") + what_ + " of step " + std::to_string(first_) +
+         " differs from the recorded one";
+}
+
 std::string ReplayCheck::first_difference(std::int64_t steps) const {
-  if (first_ >= 0)
-    return std::string("the ") + what_ + " of step " + std::to_string(first_) +
-           " differs from the recorded one";
-  if (std::size_t(steps) != rec_->states.size())
-    return std::to_string(steps) + " steps replayed, " + std::to_string(rec_->states.size()) +
-           " recorded";
-  if (!rec_->pilot.empty() && std::size_t(steps) != rec_->pilot.size())
-    return std::to_string(steps) + " steps replayed, " + std::to_string(rec_->pilot.size()) +
-           " pilot commands recorded";
+  if (first_ >= 0) return difference_so_far();
+  // A branch's steps are counted from its first (the take-over's), as are its parent's.
+  const std::int64_t own = steps - first_step_;
+  const std::string from =
+      first_step_ > 0 ? " from the take-over at step " + std::to_string(first_step_) : "";
+  if (own != std::int64_t(rec_->states.size()))
+    return std::to_string(std::max<std::int64_t>(own, 0)) + " steps replayed" + from + ", " +
+           std::to_string(rec_->states.size()) + " recorded";
+  if (!rec_->pilot.empty() && own != std::int64_t(rec_->pilot.size()))
+    return std::to_string(own) + " steps replayed" + from + ", " +
+           std::to_string(rec_->pilot.size()) + " pilot commands recorded";
   return "";
 }
 

@@ -42,26 +42,47 @@ std::optional<Assistance> recorded_assistance(const RecordingContents& rec,
 // A fresh flight of `scenario_text` for the recording: mixed initiative replays the recorded
 // pilot commands and is as long as they are, assisted or as a probe as it was recorded; other
 // modes fly on their own for as many steps as were recorded. `duration` overrides the length.
+// A branch (SPEC §10, fly from here: the recording names a parent) replays its parent up to its
+// take-over first (core/recording/branch_replay.hpp); `depth` counts the branches whose parent
+// this recording is (a parent's replay is asked for with depth + 1).
 std::unique_ptr<Mode> replay_mode(const RecordingContents& rec, const std::string& path,
                                   const std::string& scenario_text, const std::string& source,
-                                  std::optional<double> duration, std::string& error);
+                                  std::optional<double> duration, std::string& error,
+                                  int depth = 0);
+
+// replay_mode()'s flight of the steps `rec` holds, flown by its own recorded commands (a
+// branch's from its take-over on, without its parent), assisted or not by `assist`.
+std::unique_ptr<Mode> replay_own_steps(const RecordingContents& rec, const std::string& path,
+                                       const std::string& scenario_text, const std::string& source,
+                                       std::optional<double> duration, Assistance assist,
+                                       std::string& error);
+
+// The first step a recording holds: a branch's take-over step (its parent_step metadata), 0 for
+// any other recording.
+std::int64_t first_recorded_step(const RecordingContents& rec);
 
 // Compares each replayed step with the recorded one: the state, the applied input and, in
 // mixed initiative, λ and what decided it (where the recording has /controller/lambda_reason;
 // the last pilot command shows only in the last applied input), and at the end that every
-// recorded step was replayed.
+// recorded step was replayed. A branch's steps before its first recorded one are its parent's:
+// its replay checks those against the parent.
 class ReplayCheck final : public TelemetrySink {
  public:
-  explicit ReplayCheck(const RecordingContents& rec) : rec_(&rec) {}
+  explicit ReplayCheck(const RecordingContents& rec)
+      : rec_(&rec), first_step_(first_recorded_step(rec)) {}
   void on_sample(const Telemetry& s) override;
   // True when every recorded step was replayed bit for bit (call after the run).
   bool matches(std::int64_t steps_replayed) const;
   // What differed first, for messages ("" when nothing did).
   std::string first_difference(std::int64_t steps_replayed) const;
+  // What differed first among the steps replayed so far, however many those are ("" when
+  // nothing did): a parent replayed up to a branch's take-over.
+  std::string difference_so_far() const;
 
  private:
   const RecordingContents* rec_;
-  std::int64_t first_ = -1;  // first differing step
+  std::int64_t first_step_ = 0;  // of the recording
+  std::int64_t first_ = -1;      // first differing step
   const char* what_ = "";
 };
 

@@ -166,8 +166,9 @@ bool RecordingSink::close(std::string& error, bool interrupted) {
 }
 
 bool ReplayPilot::command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) {
-  if (step < 0 || step >= std::int64_t(commands_.size())) return false;
-  const PilotCommandMsg& m = commands_[std::size_t(step)];
+  const std::int64_t i = step - first_;
+  if (i < 0 || i >= std::int64_t(commands_.size())) return false;
+  const PilotCommandMsg& m = commands_[std::size_t(i)];
   if (m.step != std::uint64_t(step)) return false;  // a gap: the recording is not contiguous
   out.roll = m.roll;
   out.pitch = m.pitch;

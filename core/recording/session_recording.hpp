@@ -89,10 +89,12 @@ class RecordingSink final : public TelemetrySink {
 
 class ReplayPilot final : public PilotSource {
  public:
-  ReplayPilot(std::vector<PilotCommandMsg> commands, std::string name)
-      : commands_(std::move(commands)), name_(std::move(name)) {}
+  // `commands` of the steps first_step, first_step + 1, ... (a branch's recording starts at its
+  // take-over step, SPEC §10; any other at 0).
+  ReplayPilot(std::vector<PilotCommandMsg> commands, std::string name, std::int64_t first_step = 0)
+      : commands_(std::move(commands)), name_(std::move(name)), first_(first_step) {}
   std::string name() const override { return name_; }
-  // The recorded command of this step; false past the end of the recording.
+  // The recorded command of this step; false outside the recorded steps.
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
   // Keeps nothing (save() leaves the state null): its position in the recording is the step.
   // Restored with a snapshot of any flight of the recorded scenario, it flies the recorded
@@ -102,6 +104,7 @@ class ReplayPilot final : public PilotSource {
  private:
   std::vector<PilotCommandMsg> commands_;
   std::string name_;
+  std::int64_t first_ = 0;
 };
 
 }  // namespace mixpilot

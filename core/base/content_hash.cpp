@@ -1,4 +1,4 @@
-#include "core/history/content_hash.hpp"
+#include "core/base/content_hash.hpp"
 
 #include <openssl/evp.h>
 
@@ -7,7 +7,7 @@
 #include <cstring>
 #include <memory>
 
-namespace mixpilot::history {
+namespace mixpilot {
 
 namespace {
 
@@ -70,4 +70,4 @@ std::optional<std::string> sha256_file(const std::string& path, std::string& err
   return hex(d, n);
 }
 
-}  // namespace mixpilot::history
+}  // namespace mixpilot
