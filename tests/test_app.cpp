@@ -35,6 +35,7 @@
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
 
+#include "app_window_test.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -78,7 +79,7 @@ struct Rgb {
 };
 Rgb rgb_of(ImU32 c) { return {int(c & 0xFF), int((c >> 8) & 0xFF), int((c >> 16) & 0xFF)}; }
 
-class App : public testing::Test {
+class App : public test::AppWindowTest {
  protected:
   void SetUp() override {
     // The flights' history and recordings go to this process's folder, never the user's.
@@ -87,47 +88,6 @@ class App : public testing::Test {
     if (!screen_.open(kW, kH, error)) GTEST_SKIP() << "no EGL device: " << error;
   }
 
-  void frame(cli::Trainer& app, double dt = 1.0 / 60.0) {
-    // ImGui needs a positive frame time; the app's playhead moves by `dt` alone.
-    screen_.frame([&] { app.build_frame(dt); }, std::max(float(dt), 1e-4f));
-  }
-  // A key held for one frame, then released (by the UI's key names, as the window passes them).
-  void key(cli::Trainer& app, ui::Key k, bool ctrl = false) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.KeyCtrl = ctrl;
-    ui::set_key(io, k, true);
-    frame(app, 0.0);
-    ui::set_key(io, k, false);
-    io.KeyCtrl = false;
-    frame(app, 0.0);
-  }
-  // Where the item `label` of `window` lies: the mouse moves over the window until ImGui says
-  // it hovers that item (layout-only frames, nothing rendered).
-  std::optional<ImVec2> locate(cli::Trainer& app, const char* window, const char* label) {
-    frame(app, 0.0);
-    ImGuiWindow* w = ImGui::FindWindowByName(window);
-    if (!w) return std::nullopt;
-    const ImGuiID id = w->GetID(label);
-    const ImRect r = w->Rect();
-    for (float y = r.Min.y + 2; y < r.Max.y; y += 5) {
-      for (float x = r.Min.x + 2; x < r.Max.x; x += 10) {
-        ImGui::GetIO().MousePos = ImVec2(x, y);
-        screen_.layout([&] { app.build_frame(0.0); }, 1e-4f);
-        if (GImGui->HoveredId == id) return ImVec2(x, y);
-      }
-    }
-    return std::nullopt;
-  }
-  void click(cli::Trainer& app, ImVec2 at) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.MousePos = at;
-    frame(app, 0.0);
-    io.MouseDown[0] = true;
-    frame(app, 0.0);
-    io.MouseDown[0] = false;
-    frame(app, 0.0);
-    io.MousePos = ImVec2(-1, -1);
-  }
   const std::uint8_t* px(const std::vector<std::uint8_t>& p, int x, int y) {
     return &p[(std::size_t(y) * kW + std::size_t(x)) * 4];
   }
@@ -143,16 +103,6 @@ class App : public testing::Test {
       }
     return false;
   }
-  // Frames until the live flight's run is over (real time: a few seconds at most).
-  void until_over(cli::Trainer& app) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (!app.over() && std::chrono::steady_clock::now() < deadline) {
-      frame(app);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-
-  cli::Offscreen screen_;
 };
 
 // Saves the last frame as NAME.png in $MIXPILOT_SHOT_DIR when it is set (to look at the app's

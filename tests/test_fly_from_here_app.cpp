@@ -30,6 +30,7 @@
 #include "core/recording/replay.hpp"
 
 #include "run_mixpilot.hpp"
+#include "app_window_test.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -116,7 +117,7 @@ void save_shot(const cli::Offscreen& screen, const std::string& name) {
   std::ofstream(std::string(dir) + "/" + name + ".png", std::ios::binary) << screen.png();
 }
 
-class FlyFromHereApp : public testing::Test {
+class FlyFromHereApp : public test::AppWindowTest {
  protected:
   void SetUp() override {
     fresh_user_dirs("default");
@@ -125,46 +126,6 @@ class FlyFromHereApp : public testing::Test {
   }
   virtual float scale() const { return 1.0f; }
 
-  // One frame; its build time [s] (what the UI thread spent on it).
-  double frame(cli::Trainer& app, double dt = 1.0 / 60.0) {
-    const auto t0 = std::chrono::steady_clock::now();
-    screen_.frame([&] { app.build_frame(dt); }, std::max(float(dt), 1e-4f));
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
-  void key(cli::Trainer& app, ui::Key k, bool ctrl = false) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.KeyCtrl = ctrl;
-    ui::set_key(io, k, true);
-    frame(app, 0.0);
-    ui::set_key(io, k, false);
-    io.KeyCtrl = false;
-    frame(app, 0.0);
-  }
-  std::optional<ImVec2> locate(cli::Trainer& app, const char* window, const char* label) {
-    frame(app, 0.0);
-    ImGuiWindow* w = ImGui::FindWindowByName(window);
-    if (!w) return std::nullopt;
-    const ImGuiID id = w->GetID(label);
-    const ImRect r = w->Rect();
-    for (float y = r.Min.y + 2; y < r.Max.y; y += 5) {
-      for (float x = r.Min.x + 2; x < r.Max.x; x += 10) {
-        ImGui::GetIO().MousePos = ImVec2(x, y);
-        screen_.layout([&] { app.build_frame(0.0); }, 1e-4f);
-        if (GImGui->HoveredId == id) return ImVec2(x, y);
-      }
-    }
-    return std::nullopt;
-  }
-  void click(cli::Trainer& app, ImVec2 at) {
-    ImGuiIO& io = ImGui::GetIO();
-    io.MousePos = at;
-    frame(app, 0.0);
-    io.MouseDown[0] = true;
-    frame(app, 0.0);
-    io.MouseDown[0] = false;
-    frame(app, 0.0);
-    io.MousePos = ImVec2(-1, -1);
-  }
   // Frames while the moment is made ready: how many, the longest, and the wall time.
   struct Waited {
     int frames = 0;
@@ -183,13 +144,7 @@ class FlyFromHereApp : public testing::Test {
     frame(app);
     return w;
   }
-  void until_over(cli::Trainer& app) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
-    while (!app.over() && std::chrono::steady_clock::now() < deadline) {
-      frame(app);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
+  void until_over(cli::Trainer& app) { AppWindowTest::until_over(app, std::chrono::seconds(90)); }
   // A replay of `parent` in the window, its playhead at `t`, taken over with the button in the
   // transport; READY at that moment once the app has made it ready.
   void take_over(cli::Trainer& app, const std::string& parent, double t, Waited* waited = nullptr) {
@@ -222,7 +177,6 @@ class FlyFromHereApp : public testing::Test {
     EXPECT_EQ(app.run_info().state, ui::RunState::ready);
   }
 
-  cli::Offscreen screen_;
 };
 
 // The case: a novice's recording of mi_helix replayed in the window, taken over at
