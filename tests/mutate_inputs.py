@@ -32,8 +32,9 @@ Each run is classified:
                the output, or the current folder's .config read as the user's
 
 Prints `tried / clean error / accepted / crash / hang / nonsense`; exits 1 if any run crashed,
-hung or gave nonsense. --sample K runs a seeded random sample of K cases (the CTest); the full
-run is the script without --sample (tests/mutate_inputs.py --mixpilot build/release/app/mixpilot).
+hung or gave nonsense. --sample K runs a seeded random sample of K cases (the CTest); --only TEXT
+the cases whose label holds TEXT (--only ghost); the full run is the script without either
+(tests/mutate_inputs.py --mixpilot build/release/app/mixpilot).
 """
 import argparse
 import os
@@ -482,6 +483,7 @@ def main():
     ap.add_argument("--memory-gb", type=float, default=4,
                     help="address-space limit per run; 0: none (ASan builds reserve terabytes)")
     ap.add_argument("--sample", type=int, default=0, help="run only K random cases")
+    ap.add_argument("--only", default="", help="run only the cases whose label holds this text")
     ap.add_argument("--seed", type=int, default=12)
     ap.add_argument("--verbose", action="store_true", help="print every run's class")
     args = ap.parse_args()
@@ -514,7 +516,7 @@ def main():
         return 1
     for f in base.iterdir():
         f.chmod(0o644)
-    cases = build_cases(base, binary, scen_dir, setpriv)
+    cases = [c for c in build_cases(base, binary, scen_dir, setpriv) if args.only in c.label]
     total = len(cases)
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
