@@ -358,7 +358,8 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
       {"--scenario", o.scenario_path},
       {o.replay ? "the recording" : "--pilot", o.pilot.ends_with(".mcap") ? o.pilot : ""},
       {"--gamepad-script", o.gamepad_script},
-      {"--input-settings", o.input_settings}};
+      {"--input-settings", o.input_settings},
+      {"--ghost", o.ghost == "best" || o.ghost == "off" ? "" : o.ghost}};
   for (const std::string& file : history::sqlite_files(o.history))
     inputs.emplace_back("the history", file);
   if (!o.record.empty()) check_not_an_input(o.command, "--record", o.record, inputs);

@@ -69,6 +69,10 @@ struct FlyOptions {
   double vehicle_wait_s = 30.0;    // --vehicle-wait: how long to wait for the vehicle
   std::string trainee;             // --trainee: who flies ("" → the login name; SPEC §10)
   std::string history;             // --history: "" the default SQLite file, "off", a location
+  // --ghost: a recorded flight of the scenario flying along (SPEC §10, app/ghost.hpp): a
+  // recording's path, "best" (the trainee's best recorded flight of it in the history) or
+  // "off"; "" the front end's default (the window: best; headless: off).
+  std::string ghost;
   const char* command = "fly";     // for messages
   // Fly from here: the new flight goes on from this moment of a recording (the window's).
   std::shared_ptr<const FlyFrom> from;

@@ -1,6 +1,7 @@
 // mixpilot fly / demo: one session of any mode, as fast as possible.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/flight.hpp"
 #include "app/flight_rig.hpp"
+#include "app/ghost.hpp"
 #include "core/recording/replay.hpp"
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
@@ -94,6 +96,16 @@ constexpr const char* kFlyUsage =
     "                     sizes the window has on such a display. Default: the window follows\n"
     "                     the desktop (GLFW's content scale, Xft.dpi / 96 on X11); --headless\n"
     "                     renders at 1 (100 %)\n"
+    "  --ghost REC.mcap|best|off  a recorded flight of the same scenario flies along as a\n"
+    "                     translucent vehicle with its trail, in step by time (at t it is where\n"
+    "                     the recording was at t), and the HUD says how far ahead or behind\n"
+    "                     along the reference you are. best: the trainee's best recorded flight\n"
+    "                     of this scenario in the history whose recording is still on this\n"
+    "                     disk (none yet: said, and flown without a ghost). Default: best in\n"
+    "                     the window (the session panel picks another), off headless, where a\n"
+    "                     ghost shows in --screenshot and the summary gives its figure. A\n"
+    "                     recording of another scenario, or of another version of its file, is\n"
+    "                     refused (mixed_initiative only)\n"
     "  --trainee NAME     who flies (default: the login name): the history's row and the\n"
     "                     recording's metadata. 1-200 characters of UTF-8, no control characters\n"
     "  --history LOCATION where the flight is remembered (SPEC §10; `mixpilot history` lists\n"
@@ -113,6 +125,18 @@ constexpr const char* kFlyUsage =
 int run_in_window(const FlyOptions& o) {
   std::string error;
   int status = kExitOk;
+  // The window reads --ghost's recording off its UI thread once it runs; a file that is not
+  // there at all is said now, before the window opens.
+  if (const GhostChoice g = GhostChoice::of(o.ghost); g.kind == GhostChoice::Kind::file) {
+    std::error_code ec;
+    const auto st = std::filesystem::status(g.path, ec);
+    if (ec || !std::filesystem::is_regular_file(st)) {
+      std::fprintf(stderr, "mixpilot %s: --ghost %s: %s\n", o.command, g.path.c_str(),
+                   ec || !std::filesystem::exists(st) ? "no such file"
+                                                      : "not a recording file (a folder or a device)");
+      return kExitError;
+    }
+  }
   catch_interrupts();
   Trainer app(o);
   const bool opened = o.replay ? app.open_replay(o.pilot, error) : app.open_live(error, status);
@@ -159,6 +183,11 @@ int run_replay_headless(const FlyOptions& o) {
   }
   app.load_replay();
   if (interrupted()) return kExitInterrupted;
+  if (!app.replay_ghost_error().empty()) {
+    std::fprintf(stderr, "mixpilot %s: --ghost %s\n", o.command, app.replay_ghost_error().c_str());
+    (void)app.finish();
+    return kExitError;
+  }
   const double end = double(app.replay()->steps()) * app.replay()->dt();
   for (const ScreenshotRequest& r : o.screenshots)  // all checked before the first is written
     if (r.t >= end)
@@ -214,11 +243,52 @@ double fly_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// --ghost for a headless flight (its default: off): the ghost it names, or the trainee's best
+// recorded flight of the scenario, read now (nothing here is a UI thread). False with the
+// reason: a recording that cannot be a ghost of this flight. --ghost best without such a
+// flight is no error: it is said, and the flight flies without one.
+bool headless_ghost(const FlightRig& rig, const FlyOptions& o,
+                    std::shared_ptr<const ui::Ghost>& ghost, std::string& error) {
+  const GhostChoice choice = GhostChoice::of(o.ghost.empty() ? "off" : o.ghost);
+  if (choice.kind == GhostChoice::Kind::off) return true;
+  const std::optional<GhostTarget> target = ghost_target(rig.flight(), error);
+  if (!target) {
+    error = (choice.kind == GhostChoice::Kind::best ? "best: " : choice.path + ": ") + error;
+    return false;
+  }
+  std::string path = choice.path, label;
+  if (choice.kind == GhostChoice::Kind::best) {
+    std::string why;
+    const std::optional<ui::ProgressFlight> best = best_ghost_flight(o.history, o.trainee, *target, why);
+    if (!best) {
+      std::fprintf(stderr, "mixpilot %s: --ghost best: %s; flying without a ghost\n", o.command,
+                   why.c_str());
+      return true;
+    }
+    path = best->recording;
+    label = ghost_label(*best, true);
+  }
+  ghost = load_ghost(path, *target, label, error);
+  return ghost != nullptr;
+}
+
+// The ghost's line of the summary: where the flight ended against it.
+void print_ghost(const ui::Ghost& ghost, const Mode& mode) {
+  std::printf("  ghost %s (%s)", ghost.label.c_str(), ghost.path.c_str());
+  const std::optional<ui::GhostGap> gap =
+      ui::ghost_gap(ghost, mode.view().reference_at, mode.telemetry());
+  if (gap)
+    std::printf(": at t = %.3f s you were %s by %.3f s along the reference\n", gap->t,
+                gap->ahead >= 0 ? "ahead" : "behind", std::abs(gap->ahead));
+  else
+    std::printf(": it flew %.3f s to %.3f s\n", double(ghost.first_step) * ghost.dt, ghost.last_t());
+}
+
 // The summary on stdout after the flight, the report and the screenshots written; the exit
 // status.
 int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screenshots,
                     double wall, const std::optional<RealtimeStats>& realtime,
-                    HistoryWriter* history) {
+                    HistoryWriter* history, const ui::Ghost* ghost) {
   const Mode& mode = rig.mode();
   const bool stopped = interrupted() && !mode.finished();
   int status = kExitOk;
@@ -241,6 +311,7 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
                 (unsigned long long)closed.published_steps, unsigned(o.domain),
                 (unsigned long long)closed.publish_dropped);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
+  if (ghost) print_ghost(*ghost, mode);
   if (!o.report.empty()) {
     const std::string json = to_json(rig.labels(stopped), rig.metrics()) + "\n";
     if (!write_file(o.report, json, o.force, error)) {
@@ -253,7 +324,9 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
       std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
       status = kExitError;
     }
-    for (const std::string& path : screenshots->written()) std::printf("  screenshot %s\n", path.c_str());
+    for (std::size_t i = 0; i < screenshots->written().size(); ++i)
+      std::printf("  screenshot %s%s\n", screenshots->written()[i].c_str(),
+                  screenshots->notes()[i].c_str());
   }
   if (!closed.recorded.empty() && status == kExitOk) std::printf("  recorded %s\n", o.record.c_str());
   // The history never changes the exit status: the flight is fine without it. Its row is
@@ -319,12 +392,18 @@ int run_fly(const FlyOptions& o) {
     if (r.t >= end)
       usage_error(o.command, "--screenshot at t = " + seconds_text(r.t) +
                                  " s is beyond the flight's end (" + seconds_text(end) + " s)");
+  std::shared_ptr<const ui::Ghost> ghost;
+  if (!headless_ghost(*rig, o, ghost, error)) {
+    std::fprintf(stderr, "mixpilot %s: --ghost %s\n", o.command, error.c_str());
+    return kExitError;
+  }
   const std::string& pilot = rig->flight().pilot;
   std::optional<ScreenshotSink> screenshots;
   if (!o.screenshots.empty()) {
-    screenshots.emplace(
-        ui::scene_of(mode, pilot.empty() ? std::string("the thesis's controller") : "pilot " + pilot),
-        o.screenshots, o.force);
+    ui::Scene scene =
+        ui::scene_of(mode, pilot.empty() ? std::string("the thesis's controller") : "pilot " + pilot);
+    scene.ghost = ghost;
+    screenshots.emplace(std::move(scene), o.screenshots, o.force);
     if (!screenshots->open(o.width, o.height, error, o.scale > 0 ? o.scale : 1.0f)) {
       std::fprintf(stderr, "mixpilot %s: --screenshot: %s\n", o.command, error.c_str());
       return kExitError;
@@ -352,7 +431,8 @@ int run_fly(const FlyOptions& o) {
   ScreenshotSink* shots = screenshots ? &*screenshots : nullptr;
   std::optional<RealtimeStats> realtime;
   const double wall = fly_headless(*rig, o, shots, realtime);
-  return finish_headless(*rig, o, shots, wall, realtime, history ? &*history : nullptr);
+  return finish_headless(*rig, o, shots, wall, realtime, history ? &*history : nullptr,
+                         ghost.get());
 }
 
 // --screenshot, --size, --scale and --exit-at-end, shared by fly and replay: true when `a` is one of them
@@ -445,12 +525,17 @@ int fly_command(int argc, char** argv) {
         usage_error(o.command, "--trainee: " + why);
     } else if (a == "--history") {
       o.history = value();
+    } else if (a == "--ghost") {
+      o.ghost = value();
     } else if (a == "--force") {
       o.force = true;
     } else {
       usage_error(o.command, "unknown option '" + std::string(a) + "'");
     }
   }
+  if (o.ghost == "best" && o.history == "off")
+    usage_error(o.command, "--ghost best is read from the history: not with --history off "
+                           "(name a recording: --ghost REC.mcap)");
   // The window without a scenario (the desktop entry): the shipped mi_helix, changeable there.
   if (o.scenario_path.empty() && !o.headless && !o.pilot.ends_with(".mcap"))
     o.scenario_path = data_file("scenarios/mi_helix.toml");
@@ -492,6 +577,11 @@ constexpr const char* kReplayUsage =
     "                     video)\n"
     "  --scale S          display scale of the UI, 0.5 to 4 (as for fly; headless default 1)\n"
     "  --exit-at-end      window: start at once and close the window at the end\n"
+    "  --ghost REC.mcap   another recording of the same scenario flies along the replay as a\n"
+    "                     translucent vehicle with its trail, in step by time, with how far\n"
+    "                     ahead or behind along the reference the replayed flight is (window,\n"
+    "                     --screenshot and --video; a recording of another scenario is\n"
+    "                     refused)\n"
     "  --force            overwrite existing screenshot and video files\n"
     "  -h, --help         show this help\n"
     "\n"
@@ -532,6 +622,12 @@ int replay_command(int argc, char** argv) {
       o.video.fps = *fps;
       fps_given = true;
     } else if (parse_view_option(a, value, o)) {
+    } else if (a == "--ghost") {
+      o.ghost = value();
+      if (o.ghost == "best")
+        usage_error("replay", "--ghost best is for a flight of your own (fly): a replay races "
+                              "a recording, --ghost REC.mcap");
+      if (o.ghost == "off") o.ghost.clear();
     } else if (a == "--force") {
       o.force = true;
     } else if (!a.empty() && a[0] == '-') {

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "app/cli.hpp"
+#include "app/progress.hpp"
 #include "core/modes/report.hpp"
 #include "core/scenario/data_files.hpp"
 #include "core/scenario/scenario_toml.hpp"
@@ -111,6 +112,9 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
                                              : "pilot " + flight.pilot;
   if (from_) source += ", " + fly_from_text(*from_);
   f->scene = ui::scene_of(mode, source);
+  std::string no_ghost;  // a mode without one: the session panel offers none
+  f->ghost_target = ghost_target(flight, no_ghost);
+  ++flights_made_;
   f->sample = mode.telemetry();
   // Fly from here: READY at the moment, after the recorded steps that led there.
   for (const Telemetry& s : from_shown_) f->history.push(s);
@@ -243,6 +247,7 @@ int LiveController::finish() {
 LiveController::LiveController(FlyOptions o, InputController& input, StatusLine& status,
                                HistoryWriter* history)
     : options_(std::move(o)), history_(history), input_(input), status_line_(status) {
+  ghost_choice_ = GhostChoice::of(options_.ghost);
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
   scenario_paths_ = shipped_scenarios();
@@ -261,6 +266,116 @@ LiveController::LiveController(FlyOptions o, InputController& input, StatusLine&
 }
 
 LiveController::~LiveController() { close(); }
+
+// ---- The ghost (SPEC §10) ------------------------------------------------------------------
+
+void LiveController::ghost_options(const LiveFlight& f, const ui::HistoryView* h) {
+  ghost_options_of_ = h;
+  ghost_options_for_ = flights_made_;
+  choices_.ghosts.clear();
+  ghost_options_.clear();
+  if (!f.ghost_target) return;
+  const auto add = [&](std::string label, GhostChoice c) {
+    choices_.ghosts.push_back(std::move(label));
+    ghost_options_.push_back(std::move(c));
+  };
+  add("none", {GhostChoice::Kind::off, ""});
+  // The trainee's recorded flights of this scenario (this very text), best first.
+  const ui::ProgressView* v = h && h->loaded && h->progress.scenario == f.ghost_target->scenario_name
+                                  ? &h->progress
+                                  : nullptr;
+  std::vector<const ui::ProgressFlight*> recorded;
+  if (v)
+    for (const ui::ProgressFlight& pf : v->flights)
+      if (!pf.recording.empty() && pf.scenario_hash == f.ghost_target->scenario_hash &&
+          std::isfinite(pf.skill))
+        recorded.push_back(&pf);
+  std::stable_sort(recorded.begin(), recorded.end(),
+                   [](const auto* a, const auto* b) { return a->skill > b->skill; });
+  if (!history_)
+    add("your best (no history: --history off)", {GhostChoice::Kind::best, ""});
+  else if (!v)
+    add("your best (reading the history...)", {GhostChoice::Kind::best, ""});
+  else if (recorded.empty())
+    add("your best (none recorded yet)", {GhostChoice::Kind::best, ""});
+  else
+    add(ghost_label(*recorded.front(), true), {GhostChoice::Kind::best, ""});
+  // A few more to race, the next best.
+  constexpr std::size_t kOthers = 8;
+  for (std::size_t i = 1; i < recorded.size() && i <= kOthers; ++i)
+    add(ghost_label(*recorded[i], false) + ", " + recorded[i]->when,
+        {GhostChoice::Kind::file, recorded[i]->recording});
+  // --ghost's recording, and a recording chosen before that is not among them.
+  if (ghost_choice_.kind == GhostChoice::Kind::file &&
+      std::none_of(ghost_options_.begin(), ghost_options_.end(),
+                   [&](const GhostChoice& c) { return c.path == ghost_choice_.path; }))
+    add(fs::path(ghost_choice_.path).filename().string(), ghost_choice_);
+  choices_.ghost = -1;
+  for (std::size_t i = 0; i < ghost_options_.size(); ++i)
+    if (ghost_options_[i].kind == ghost_choice_.kind && ghost_options_[i].path == ghost_choice_.path)
+      choices_.ghost = int(i);
+}
+
+void LiveController::update_ghost(LiveFlight& f, const ui::HistoryView* h) {
+  // Loaders no longer wanted go once they are done (their threads joined without waiting).
+  std::erase_if(ghost_retired_, [](const auto& l) { return l->done(); });
+  if (h != ghost_options_of_ || ghost_options_for_ != flights_made_) ghost_options(f, h);
+  if (!f.ghost_target) {
+    f.scene.ghost.reset();
+    choices_.ghost_note.clear();
+    return;
+  }
+  const GhostTarget& target = *f.ghost_target;
+  // The recording the choice names now: a file, or the best of the snapshot.
+  std::string wanted, label;
+  if (ghost_choice_.kind == GhostChoice::Kind::file) {
+    wanted = ghost_choice_.path;
+    if (choices_.ghost >= 0 && std::size_t(choices_.ghost) < choices_.ghosts.size())
+      label = choices_.ghosts[std::size_t(choices_.ghost)];  // as the session panel names it
+  } else if (ghost_choice_.kind == GhostChoice::Kind::best && h && h->loaded &&
+             h->progress.scenario == target.scenario_name) {
+    if (const int best = best_recorded(h->progress, target.scenario_hash); best >= 0) {
+      const ui::ProgressFlight& b = h->progress.flights[std::size_t(best)];
+      wanted = b.recording;
+      label = ghost_label(b, true);
+    }
+  }
+  if (ghost_loader_ && ghost_loader_->done()) {
+    const std::unique_ptr<GhostLoader> done = std::move(ghost_loader_);
+    if (std::shared_ptr<const ui::Ghost> g = done->ghost()) {
+      ghost_ = std::move(g);
+      ghost_refused_.clear();
+      status_line_.add("ghost: " + ghost_->label + " flies along");
+    } else {
+      ghost_.reset();
+      ghost_refused_ = done->path();
+      choices_.ghost_note = "ghost refused: " + done->error();
+      choices_.ghost_note_is_error = true;
+      status_line_.say("ghost " + done->error(), true);
+    }
+  }
+  // A flight that flies keeps its ghost; one started before its ghost was ready (Restart
+  // starts at once) gets it when it is, while it flies (after the flight the best may be
+  // itself).
+  if (f.started() && (f.scene.ghost || !is_flying(f))) return;
+  const bool fits = ghost_ && ghost_->path == wanted && ghost_->scenario_hash == target.scenario_hash;
+  f.scene.ghost = fits ? ghost_ : nullptr;
+  const bool loading = ghost_loader_ && ghost_loader_->path() == wanted &&
+                       ghost_loader_->target().scenario_hash == target.scenario_hash;
+  if (!fits && !loading && !wanted.empty() && wanted != ghost_refused_) {
+    if (ghost_loader_) ghost_retired_.push_back(std::move(ghost_loader_));
+    ghost_loader_ = std::make_unique<GhostLoader>(wanted, target, label);
+  }
+  if (wanted != ghost_refused_ || wanted.empty()) {
+    choices_.ghost_note_is_error = false;
+    choices_.ghost_note = ghost_loader_ && ghost_loader_->path() == wanted && !wanted.empty()
+                              ? "loading the ghost..."
+                          : ghost_choice_.kind == GhostChoice::Kind::best && wanted.empty() &&
+                                  history_
+                              ? "your best recorded flight of this scenario will fly along"
+                              : "";
+  }
+}
 
 std::string LiveController::next_record_path() const {
   if (!first_record_.empty()) return first_record_;
@@ -527,6 +642,12 @@ void LiveController::handle(const ui::LiveRequest& r) {
               status_line_.say(error, true);
             }
           },
+          [&](const ui::PickGhost& g) {
+            if (g.index < 0 || g.index >= int(ghost_options_.size()) || is_flying(*live_)) return;
+            ghost_choice_ = ghost_options_[std::size_t(g.index)];
+            choices_.ghost = g.index;
+            ghost_refused_.clear();  // chosen again: read again
+          },
           [&](const ui::SetAssist& a) {
             // The unstarted flight is made again with the choice, as for a pilot.
             if (is_flying(*live_) || !choices_.assist_choosable) return;
@@ -551,6 +672,7 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
       ui::count_step(f.sample, f.counts);
     }
   }
+  update_ghost(f, run.history);
   const Mode& mode = f.mode();
   // Before the start the screen shows the initial state: the arena, the vehicle, the reference.
   if (!f.started() && f.history.empty()) f.history.push(mode.telemetry());

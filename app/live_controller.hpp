@@ -11,6 +11,7 @@
 
 #include "app/flight.hpp"
 #include "app/flight_rig.hpp"
+#include "app/ghost.hpp"
 #include "app/input_controller.hpp"
 #include "app/status_line.hpp"
 #include "core/runtime/realtime_runner.hpp"
@@ -34,6 +35,8 @@ struct LiveFlight {
   bool awaiting_vehicle = false, no_vehicle = false;
   FlightRig::Closed closing;  // what closing the flight did (its recording, the publisher)
   Metrics metrics;   // once the run is over
+  // What a ghost of this flight must be a flight of (app/ghost.hpp); nullopt: it has none.
+  std::optional<GhostTarget> ghost_target;
 
   const Flight& flight() const { return rig->flight(); }
   const Mode& mode() const { return rig->mode(); }
@@ -110,6 +113,12 @@ class LiveController {
   void history_problem(const std::string& why);
   // The history's snapshot follows the session: the trainee and the scenario flown next.
   void show_progress();
+  // The ghost (SPEC §10) of the flight not yet started, once a frame: the session panel's ghost
+  // choices from the history's snapshot `h` (nullptr: none), the recording the choice names
+  // loaded off the UI thread, then shown with the flight; a loaded or refused recording is said
+  // on the status line.
+  void update_ghost(LiveFlight& f, const ui::HistoryView* h);
+  void ghost_options(const LiveFlight& f, const ui::HistoryView* h);
 
   FlyOptions options_;
   HistoryWriter* history_;  // outlives live_: its rig hands its row over at close
@@ -127,6 +136,18 @@ class LiveController {
   // recorded steps shown before it (the newest ones up to that moment).
   std::shared_ptr<const FlyFrom> from_;
   std::vector<Telemetry> from_shown_;
+  // The ghost: what the session panel chose, the options it offers (parallel to
+  // choices_.ghosts, made again when the history's snapshot or the flight changes), the
+  // recording loaded for it, the loader reading one, and loaders whose result is no longer
+  // wanted (kept until they finish: the UI never waits for a join).
+  GhostChoice ghost_choice_;
+  std::vector<GhostChoice> ghost_options_;
+  const ui::HistoryView* ghost_options_of_ = nullptr;
+  std::uint64_t flights_made_ = 0, ghost_options_for_ = 0;  // make_live()'s count
+  std::shared_ptr<const ui::Ghost> ghost_;
+  std::unique_ptr<GhostLoader> ghost_loader_;
+  std::vector<std::unique_ptr<GhostLoader>> ghost_retired_;
+  std::string ghost_refused_;  // the recording refused for the choice (not read again for it)
 };
 
 }  // namespace mixpilot::cli

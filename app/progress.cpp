@@ -84,6 +84,7 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
     f.when = local_minutes(r.started_unix_ms);
     f.ended = history::to_string(r.ended);
     f.from_step = r.parent_step;
+    f.scenario_hash = r.scenario_hash;
     std::error_code ec;
     if (!r.recording_path.empty() &&
         (!check_recordings || std::filesystem::is_regular_file(r.recording_path, ec)))
@@ -99,6 +100,17 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
   v.assisted_trend = skill_trend(assisted, "assisted");
   v.probe_trend = skill_trend(probes, "probe");
   return v;
+}
+
+int best_recorded(const ui::ProgressView& v, const std::string& scenario_hash) {
+  int best = -1;
+  for (std::size_t i = 0; i < v.flights.size(); ++i) {
+    const ui::ProgressFlight& f = v.flights[i];
+    if (f.recording.empty() || f.scenario_hash != scenario_hash || !std::isfinite(f.skill))
+      continue;
+    if (best < 0 || f.skill > v.flights[std::size_t(best)].skill) best = int(i);
+  }
+  return best;
 }
 
 }  // namespace mixpilot::cli

@@ -29,6 +29,12 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
                                std::string trainee, std::string scenario,
                                bool check_recordings = true);
 
+// The ghost a trainee races by default (SPEC §10): the index in `view` of the flight with the
+// highest skill among those whose recording is on this disk and whose scenario's content hash is
+// `scenario_hash` (the one flown now); −1 when none. ProgressView::best is the best of all, the
+// ones without a recording too.
+int best_recorded(const ui::ProgressView& view, const std::string& scenario_hash);
+
 // "YYYY-MM-DD HH:MM" in local time.
 std::string local_minutes(std::int64_t unix_ms);
 

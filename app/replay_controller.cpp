@@ -7,8 +7,10 @@
 
 namespace mixpilot::cli {
 
-ReplayController::ReplayController(const char* command, bool allow_mismatch, StatusLine& status)
-    : command_(command), allow_mismatch_(allow_mismatch), status_(status) {}
+ReplayController::ReplayController(const char* command, bool allow_mismatch, StatusLine& status,
+                                   std::string ghost)
+    : command_(command), allow_mismatch_(allow_mismatch), status_(status),
+      ghost_path_(std::move(ghost)) {}
 
 ReplayController::~ReplayController() {
   if (tape_) tape_->stop();
@@ -25,6 +27,15 @@ std::unique_ptr<FlightRig> ReplayController::prepare(const std::string& path,
 }
 
 void ReplayController::open(std::unique_ptr<FlightRig> rig, const std::string& path) {
+  if (ghost_loader_) ghost_retired_.push_back(std::move(ghost_loader_));  // the last replay's
+  ghost_error_.clear();
+  if (!ghost_path_.empty()) {
+    // The target before the tape's loader steps the mode.
+    if (std::optional<GhostTarget> target = ghost_target(rig->flight(), ghost_error_))
+      ghost_loader_ = std::make_unique<GhostLoader>(ghost_path_, std::move(*target), "");
+    else
+      status_.say("ghost " + ghost_path_ + ": " + ghost_error_, true);
+  }
   tape_ = std::make_unique<ReplayTape>(std::move(rig), path);
   tape_->start();
   info_ = ui::ReplayInfo{};
@@ -36,6 +47,20 @@ void ReplayController::close() { tape_.reset(); }
 
 void ReplayController::load() {
   if (tape_) tape_->fly();
+  if (ghost_loader_) ghost_loader_->wait();
+  poll_ghost();
+}
+
+void ReplayController::poll_ghost() {
+  std::erase_if(ghost_retired_, [](const auto& l) { return l->done(); });
+  if (!ghost_loader_ || !ghost_loader_->done() || !tape_) return;
+  const std::unique_ptr<GhostLoader> done = std::move(ghost_loader_);
+  if (std::shared_ptr<const ui::Ghost> g = done->ghost()) {
+    tape_->set_ghost(std::move(g));
+  } else {
+    ghost_error_ = done->error();
+    status_.say("ghost " + ghost_error_, true);
+  }
 }
 
 void ReplayController::handle(const ui::ReplayRequest& r) {
@@ -64,6 +89,7 @@ void ReplayController::handle(const ui::ReplayRequest& r) {
 }
 
 void ReplayController::update(double wall_dt, ui::RunInfo& run) {
+  poll_ghost();
   ReplayTape& r = *tape_;
   ui::ReplayInfo& info = info_;
   const std::size_t ready = r.ready();

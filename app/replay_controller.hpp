@@ -5,8 +5,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/flight_rig.hpp"
+#include "app/ghost.hpp"
 #include "app/replay_tape.hpp"
 #include "app/status_line.hpp"
 #include "ui/requests.hpp"
@@ -18,7 +20,10 @@ class ReplayController {
  public:
   // `command` names the command in messages; `allow_mismatch`: a replay that differs from its
   // recording is no failure (--allow-mismatch).
-  ReplayController(const char* command, bool allow_mismatch, StatusLine& status);
+  // `ghost`: a recording that flies along every replay of its scenario (replay --ghost; ""
+  // none).
+  ReplayController(const char* command, bool allow_mismatch, StatusLine& status,
+                   std::string ghost = "");
   ~ReplayController();
   ReplayController(const ReplayController&) = delete;
   ReplayController& operator=(const ReplayController&) = delete;
@@ -34,7 +39,9 @@ class ReplayController {
 
   void play() { info_.playing = true; }
   void seek(double t) { info_.t = std::max(0.0, t); }  // [s] the playhead
-  void load();  // flies the whole replay now (headless), with a progress bar
+  void load();  // flies the whole replay now (headless), with a progress bar, and reads its ghost
+  // Why the ghost was refused ("" when it flies along, or there is none).
+  const std::string& ghost_error() const { return ghost_error_; }
 
   // The transport's requests (ignored while no replay is open).
   void handle(const ui::ReplayRequest& r);
@@ -67,6 +74,11 @@ class ReplayController {
   ui::ReplayInfo info_;
   bool events_final_ = false;  // the timeline's events are those of the whole tape
   double speed_ = 1.0;
+  // The ghost (app/ghost.hpp): its recording, read off the UI thread for each replay opened.
+  void poll_ghost();
+  std::string ghost_path_, ghost_error_;
+  std::unique_ptr<GhostLoader> ghost_loader_;
+  std::vector<std::unique_ptr<GhostLoader>> ghost_retired_;  // of replays closed: joined once done
 };
 
 }  // namespace mixpilot::cli

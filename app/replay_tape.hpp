@@ -39,6 +39,8 @@ class ReplayTape {
   std::size_t steps() const { return done() ? ready() : tape_.size(); }
   double dt() const { return dt_; }
   const ui::Scene& scene() const { return scene_; }
+  // The UI's: a ghost flying along the replay (ui/ghost.hpp; the loader never reads the scene).
+  void set_ghost(std::shared_ptr<const ui::Ghost> ghost) { scene_.ghost = std::move(ghost); }
   const std::string& path() const { return path_; }
   const Mode& mode() const { return rig_->mode(); }  // read it only once done()
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "app/cli.hpp"
@@ -67,6 +68,14 @@ void ScreenshotSink::on_sample(const Telemetry& s) {
       continue;
     }
     written_.push_back(requests_[i].path);
+    std::string note;
+    if (const std::optional<ui::GhostGap> gap = ui::ghost_gap(scene_, s)) {
+      char text[64];
+      std::snprintf(text, sizeof text, " (ghost: you are %s by %.3f s)",
+                    gap->ahead >= 0 ? "ahead" : "behind", std::abs(gap->ahead));
+      note = text;
+    }
+    notes_.push_back(std::move(note));
   }
 }
 

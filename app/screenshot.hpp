@@ -39,6 +39,9 @@ class ScreenshotSink : public TelemetrySink {
   // After the flight: false with the first failure (a write error, a time never reached).
   [[nodiscard]] bool finish(std::string& error) const;
   const std::vector<std::string>& written() const { return written_; }
+  // What the summary adds to each written screenshot's line: with a ghost, the HUD's figure to
+  // the millisecond (" (ghost: you are ahead by 0.843 s)"); "" without one.
+  const std::vector<std::string>& notes() const { return notes_; }
   // Fallbacks and deadline misses of the steps so far: what the screenshots' HUD shows.
   const ui::RunInfo& counts() const { return counts_; }
 
@@ -51,7 +54,7 @@ class ScreenshotSink : public TelemetrySink {
   ui::History history_;
   ui::RunInfo counts_;  // fallbacks and deadline misses so far, as the window counts them
   ui::UiState ui_;
-  std::vector<std::string> written_;
+  std::vector<std::string> written_, notes_;
   std::string error_;
 };
 

@@ -6,7 +6,7 @@ Trainer::Trainer(FlyOptions o)
     : input_(o.input_settings, status_),
       history_(o.history == "off" ? nullptr : std::make_unique<HistoryWriter>(o.history)),
       live_(o, input_, status_, history_.get()),
-      replay_(o.command, o.allow_mismatch, status_) {}
+      replay_(o.command, o.allow_mismatch, status_, o.replay ? o.ghost : std::string()) {}
 
 bool Trainer::open_live(std::string& error, int& status) { return live_.open(error, status); }
 

@@ -54,6 +54,8 @@ class Trainer {
   const ui::RunInfo& run_info() const { return run_; }
   const LiveFlight* live() const { return live_.flight(); }
   const ReplayTape* replay() const { return replay_.tape(); }
+  // replay --ghost: why its recording was refused ("" none, or it flies along).
+  const std::string& replay_ghost_error() const { return replay_.ghost_error(); }
   HistoryWriter* history() { return history_.get(); }
   ClipExporter& clips() { return clips_; }
   // Fly from here (SPEC §10): the moment being made ready off the UI thread (nullptr: none).

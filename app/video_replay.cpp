@@ -64,6 +64,7 @@ int replay_to_video(const FlyOptions& o) {
     std::fprintf(stderr, "mixpilot %s: interrupted; no video written\n", o.command);
     return kExitInterrupted;
   }
+  if (!app.replay_ghost_error().empty()) return fail(o, "--ghost " + app.replay_ghost_error());
   const double to = checked_end(o, replay_end(*app.replay()));
 
   // What --screenshot writes, as `replay --headless` writes it.

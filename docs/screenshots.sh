@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
-# why λ fell, and the input settings and Progress panels and fly from here at 1280x720 (app
-# tests render them). The flights
+# why λ fell, a ghost run, and the input settings and Progress panels and fly from here at
+# 1280x720 (app tests render them). The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
@@ -32,6 +32,13 @@ export XDG_DATA_HOME="$tmp/data"
 # arena draws the prediction λ came from, its node i*, the ball B there and the gap.
 "$m" fly --scenario scenarios/mi_helix.toml --pilot reckless --headless --duration 2 \
   --screenshot 1.2:$out/reason.png --size 1280x720 --force >/dev/null
+# A ghost run: the novice flying with the experienced pilot's recording as the ghost (lavender,
+# translucent, a dashed trail, tagged "ghost"), at 12 s; the HUD says how far behind it the
+# novice is along the reference.
+"$m" fly --scenario scenarios/mi_helix.toml --pilot experienced --headless --duration 14 \
+  --record "$tmp/experienced.mcap" >/dev/null
+"$m" fly --scenario scenarios/mi_helix.toml --pilot novice --headless --duration 14 \
+  --ghost "$tmp/experienced.mcap" --screenshot 12:$out/ghost.png --size 1280x720 --force >/dev/null
 # A person's gamepad (a scripted SDL virtual pad) unplugged at 1 s: the planner flies.
 printf 't,left_x,left_y,right_x,right_y\n0,0,0,0.3,0\n1.0,unplug\n' >"$tmp/unplug.csv"
 XDG_CONFIG_HOME="$tmp/config" "$m" fly --scenario scenarios/mi_helix.toml --pilot gamepad \

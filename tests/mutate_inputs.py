@@ -7,7 +7,8 @@ Inputs (each through every command that reads it):
   joy-publish), the config folder's input.toml and gamecontrollerdb.txt
   ($XDG_CONFIG_HOME/mixpilot/; fly --pilot gamepad, gamepad-script), --gamepad-script (fly),
   the reference CSVs a scenario names (fly), recordings (score, replay, replay --video, fly
-  --pilot, gamepad-script, joy-publish, recover) and MIXPILOT_DATA_DIR (demo); replay --video's
+  --pilot, gamepad-script, joy-publish, recover), a ghost's recording (fly --ghost, replay
+  --ghost) and MIXPILOT_DATA_DIR (demo); replay --video's
   --from, --to, --fps and --size values out of range or no numbers.
 File types: a regular file, an empty one, a directory, a FIFO, /dev/zero, /dev/full, a
 symbolic-link loop, a dangling link, an unreadable file (as root, which reads mode-000 files,
@@ -31,8 +32,9 @@ Each run is classified:
                the output, or the current folder's .config read as the user's
 
 Prints `tried / clean error / accepted / crash / hang / nonsense`; exits 1 if any run crashed,
-hung or gave nonsense. --sample K runs a seeded random sample of K cases (the CTest); the full
-run is the script without --sample (tests/mutate_inputs.py --mixpilot build/release/app/mixpilot).
+hung or gave nonsense. --sample K runs a seeded random sample of K cases (the CTest); --only TEXT
+the cases whose label holds TEXT (--only ghost); the full run is the script without either
+(tests/mutate_inputs.py --mixpilot build/release/app/mixpilot).
 """
 import argparse
 import os
@@ -176,6 +178,12 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("joy-publish", ["joy-publish", "--from", "{X}", "--wait", "0"], "refused"),
             ("recover", ["recover", "{X}", "-o", "{D}/out.mcap"], "refused"),
         ], {}),
+        # A ghost (SPEC §10): a recording of the scenario flown, read beside the flight.
+        ("--ghost", file_input("g.mcap", rec.read_bytes()), [
+            ("fly", ["fly", "--scenario", str(scen_dir / "mi_helix.toml"), "--pilot", "novice",
+                     "--headless", "--history", "off", "--ghost", "{X}"] + short, "refused"),
+            ("replay", ["replay", str(rec), "--headless", "--ghost", "{X}"], "refused"),
+        ], {}),
     ]
     # The config folder's files: their problems never stop a flight.
     for name, content in (("input.toml", settings_text), ("gamecontrollerdb.txt", db_text)):
@@ -289,6 +297,13 @@ def build_cases(base, binary, scen_dir, setpriv):
                               ["gamepad-script", str(rec), "-o", "{D}/out.csv"], "config_toml",
                               None, {"XDG_CONFIG_HOME": "{D}/cfg"}, "regular", cfg))
             deep_rec = with_embedded_scenario(rec.read_bytes(), text.decode())
+            # As a ghost the embedded scenario is only parsed for its name when its text is not
+            # the one flown: refused as another scenario, naming the file.
+            cases.append(Case(f"nesting {label} in an embedded scenario via fly --ghost",
+                              ["fly", "--scenario", str(scen_dir / "mi_helix.toml"), "--pilot",
+                               "novice", "--headless", "--history", "off", "--ghost", "{X}"]
+                              + short, "refused", "{X}", {}, "regular",
+                              file_input("deep_ghost.mcap", deep_rec)))
             for cmd_label, argv in (
                     ("score", ["score", "{X}", "--jobs", "1"]),
                     ("replay", ["replay", "{X}", "--headless"]),
@@ -335,6 +350,8 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("fly --history", fly + ["--history", ""], "--history"),
             ("fly --trainee", fly + ["--trainee", ""], "--trainee"),
             ("fly --assist", fly + ["--assist", ""], "--assist"),
+            ("fly --ghost", fly + ["--ghost", ""], "--ghost"),
+            ("replay --ghost", ["replay", R, "--headless", "--ghost", ""], "--ghost"),
             ("history --history", ["history", "--history", ""], "--history"),
             ("history import DIR", ["history", "import", ""], "empty")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
@@ -466,6 +483,7 @@ def main():
     ap.add_argument("--memory-gb", type=float, default=4,
                     help="address-space limit per run; 0: none (ASan builds reserve terabytes)")
     ap.add_argument("--sample", type=int, default=0, help="run only K random cases")
+    ap.add_argument("--only", default="", help="run only the cases whose label holds this text")
     ap.add_argument("--seed", type=int, default=12)
     ap.add_argument("--verbose", action="store_true", help="print every run's class")
     args = ap.parse_args()
@@ -498,7 +516,7 @@ def main():
         return 1
     for f in base.iterdir():
         f.chmod(0o644)
-    cases = build_cases(base, binary, scen_dir, setpriv)
+    cases = [c for c in build_cases(base, binary, scen_dir, setpriv) if args.only in c.label]
     total = len(cases)
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)

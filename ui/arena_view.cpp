@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,8 @@
 
 namespace mixpilot::ui {
 namespace {
+
+constexpr double kTrailS = 6.0;  // [s] the trails of the vehicle and the ghost
 
 // A pinhole camera: world point → pixel in the view rectangle, or nothing behind the eye.
 struct View {
@@ -184,6 +187,101 @@ void draw_vehicle(ImDrawList* dl, const View& v, const Telemetry& s) {
   if (v.project(p, pp)) dl->AddCircleFilled(pp, scaled(4.0f), colour::kText, 12);
 }
 
+// The ghost (ui/ghost.hpp) at the flight's time t: its trail of the last `trail_s` seconds
+// dashed, then the vehicle translucent — arms, filled rotors, a hub — in the ghost's colour,
+// drawn before the flight's vehicle so that one stays on top. Returns where its hub is on
+// screen, for its label.
+std::optional<ImVec2> draw_ghost(ImDrawList* dl, const View& v, const Ghost& g, double t,
+                                 double trail_s) {
+  const std::optional<std::size_t> at = ghost_column(g, t);
+  if (!at) return std::nullopt;
+  const auto j = Eigen::Index(*at);
+  // Dashes of 8 steps (0.12 s at Δt = 15 ms) with gaps of 4.
+  const Eigen::Index from = std::max<Eigen::Index>(1, j - Eigen::Index(trail_s / g.dt));
+  for (Eigen::Index i = from; i <= j; ++i) {
+    if ((i % 12) >= 8) continue;
+    const Eigen::Vector3d a = g.states.col(i - 1).head<3>(), b = g.states.col(i).head<3>();
+    if (a.allFinite() && b.allFinite()) line(dl, v, a, b, with_alpha(colour::kGhost, 0.8f), 2.5f);
+  }
+  const Eigen::VectorXd x = g.states.col(j);
+  if (!x.head<3>().allFinite()) return std::nullopt;
+  const Eigen::Vector3d p = x.head<3>();
+  const Eigen::Matrix3d R = attitude(x);
+  const double arm = 0.23;
+  const Eigen::Vector3d arms[4] = {{arm, 0, 0}, {0, arm, 0}, {-arm, 0, 0}, {0, -arm, 0}};
+  // Each part drawn once, none over another (the arms start clear of the hub, the nose beyond
+  // the front rotor), so the whole vehicle is equally see-through.
+  for (const Eigen::Vector3d& a : arms) {
+    const Eigen::Vector3d tip = p + R * a;
+    line(dl, v, p + 0.25 * R * a, tip, with_alpha(colour::kGhost, 0.6f), 3.0f);
+    ImVec2 pt;
+    if (v.project(tip, pt)) {
+      const float r = std::clamp(float(v.pixels(0.05, tip)), scaled(3.0f), scaled(12.0f));
+      dl->AddCircleFilled(pt, r, with_alpha(colour::kGhost, 0.35f), 16);
+      dl->AddCircle(pt, r, with_alpha(colour::kGhost, 0.7f), 16, scaled(1.5f));
+    }
+  }
+  line(dl, v, p + R * Eigen::Vector3d(1.25 * arm, 0, 0), p + R * Eigen::Vector3d(1.6 * arm, 0, 0),
+       with_alpha(colour::kGhost, 0.6f), 2.0f);
+  ImVec2 pp;
+  if (!v.project(p, pp)) return std::nullopt;
+  dl->AddCircleFilled(pp, scaled(4.0f), with_alpha(colour::kGhost, 0.6f), 12);
+  return pp;
+}
+
+// A screen rectangle [min, max).
+struct Box {
+  ImVec2 min, max;
+};
+bool overlap(const Box& a, const Box& b) {
+  return a.min.x < b.max.x && b.min.x < a.max.x && a.min.y < b.max.y && b.min.y < a.max.y;
+}
+
+// The ghost's name tag: "ghost" in its colour on a dark backing, diagonally off its hub with a
+// leader, on the side away from the vehicle at `away` (so it never seems to name the vehicle):
+// the first corner of that side, up then down, then of the other side, near then farther out,
+// clear of `keep_clear` (the reason's label, an overlay) and, where it can be, of `rather_not`
+// (the vehicle); inside the pane [min, max).
+void draw_ghost_label(ImDrawList* dl, ImVec2 hub, ImVec2 away, ImVec2 min, ImVec2 max,
+                      std::initializer_list<Box> keep_clear, Box rather_not) {
+  const char* label = "ghost";
+  const ImVec2 size = ImGui::CalcTextSize(label);
+  const float pad = scaled(3.0f), near = scaled(22.0f);
+  if (size.x + 4.0f * pad > max.x - min.x || size.y + 4.0f * pad > max.y - min.y) return;
+  const auto place = [&](ImVec2 corner, float off) {
+    const float x = corner.x < 0 ? hub.x - off - size.x : hub.x + off;
+    const float y = corner.y < 0 ? hub.y - off - size.y : hub.y + off;
+    return ImVec2(std::clamp(x, min.x + 2.0f * pad, max.x - 2.0f * pad - size.x),
+                  std::clamp(y, min.y + 2.0f * pad, max.y - 2.0f * pad - size.y));
+  };
+  const auto clear = [&](ImVec2 at, bool of_vehicle) {
+    const Box b{ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad)};
+    return (!of_vehicle || !overlap(rather_not, b)) &&
+           std::none_of(keep_clear.begin(), keep_clear.end(),
+                        [&](const Box& a) { return overlap(a, b); });
+  };
+  const float side = hub.x >= away.x ? 1.0f : -1.0f;
+  const ImVec2 corners[] = {ImVec2(side, -1), ImVec2(side, +1), ImVec2(-side, -1), ImVec2(-side, +1)};
+  std::optional<ImVec2> found;
+  for (const bool of_vehicle : {true, false})
+    for (const float off : {near, 2.5f * near})
+      for (const ImVec2 corner : corners)
+        if (!found && clear(place(corner, off), of_vehicle)) found = place(corner, off);
+  const ImVec2 at = found.value_or(place(corners[0], near));
+  // The leader from just off the hub (which stays as see-through as the rest) to the tag's
+  // nearest corner.
+  const ImVec2 end(hub.x < at.x ? at.x - pad : at.x + size.x + pad,
+                   hub.y < at.y ? at.y - pad : at.y + size.y + pad);
+  const float dx = end.x - hub.x, dy = end.y - hub.y, len = std::sqrt(dx * dx + dy * dy);
+  const float gap = scaled(6.0f);
+  if (len > gap)
+    dl->AddLine(ImVec2(hub.x + gap * dx / len, hub.y + gap * dy / len), end,
+                with_alpha(colour::kGhost, 0.7f), scaled(1.0f));
+  dl->AddRectFilled(ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad),
+                    colour::rgb(0x10, 0x10, 0x14, 190), pad);
+  dl->AddText(at, colour::kGhost, label);
+}
+
 // The vehicle's height made visible: a line down to the floor and a ring where it lands.
 void draw_drop_line(ImDrawList* dl, const View& v, const Scene& sc, const Eigen::Vector3d& p) {
   const Eigen::Vector3d foot(p.x(), p.y(), sc.arena_min.z());
@@ -261,9 +359,9 @@ std::optional<ImVec2> draw_reason(ImDrawList* dl, const View& v, const Scene& sc
 // Node i*'s label, over the vehicle: the gap and how far ahead, diagonally off the node (clear
 // of the rotors) with a leader to it: up and right, else the first other corner clear of
 // [clear_min, clear_max) (an overlay); inside the pane [min, max) (its text is never cut),
-// where it fits at all.
-void draw_reason_label(ImDrawList* dl, const LambdaReason& r, ImVec2 node, ImVec2 min,
-                       ImVec2 max, ImVec2 clear_min, ImVec2 clear_max) {
+// where it fits at all. Returns where it was drawn.
+std::optional<Box> draw_reason_label(ImDrawList* dl, const LambdaReason& r, ImVec2 node,
+                                     ImVec2 min, ImVec2 max, ImVec2 clear_min, ImVec2 clear_max) {
   char label[64];
   if (r.node > 0)
     std::snprintf(label, sizeof label, "%.2f m off the reference in %.3g s", r.d_res, r.ahead);
@@ -271,7 +369,8 @@ void draw_reason_label(ImDrawList* dl, const LambdaReason& r, ImVec2 node, ImVec
     std::snprintf(label, sizeof label, "%.2f m off the reference now", r.d_res);
   const ImVec2 size = ImGui::CalcTextSize(label);
   const float pad = scaled(3.0f), m = scaled(7.0f);
-  if (size.x + 4.0f * pad > max.x - min.x || size.y + 4.0f * pad > max.y - min.y) return;
+  if (size.x + 4.0f * pad > max.x - min.x || size.y + 4.0f * pad > max.y - min.y)
+    return std::nullopt;
   const auto place = [&](float sx, float sy) {
     const float x = sx > 0 ? node.x + 4.0f * m : node.x - 4.0f * m - size.x;
     const float y = sy < 0 ? node.y - 5.0f * m - size.y : node.y + 5.0f * m;
@@ -295,6 +394,7 @@ void draw_reason_label(ImDrawList* dl, const LambdaReason& r, ImVec2 node, ImVec
   dl->AddRect(ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad),
               colour::kCritical, pad, 0, scaled(1.0f));
   dl->AddText(at, colour::kText, label);
+  return Box{ImVec2(at.x - pad, at.y - pad), ImVec2(at.x + size.x + pad, at.y + size.y + pad)};
 }
 
 }  // namespace
@@ -373,7 +473,7 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     }
   }
   // The trail of the last seconds, coloured by λ in mixed initiative.
-  const double t0 = s.t - 6.0;
+  const double t0 = s.t - kTrailS;
   for (std::size_t i = std::max<std::size_t>(1, h.first_at_or_after(t0) + 1); i < h.size(); ++i) {
     const Telemetry& a = h[i - 1];
     const Telemetry& b = h[i];
@@ -385,8 +485,19 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     line(dl, v, s.predicted.col(i - 1), s.predicted.col(i), colour::kMpc, 2.0f);
   const std::optional<std::size_t> why = sc.shared_authority ? shown_reason(h) : std::nullopt;
   const std::optional<ImVec2> node = why ? draw_reason(dl, v, sc, h, *why) : std::nullopt;
+  const std::optional<ImVec2> ghost = sc.ghost ? draw_ghost(dl, v, *sc.ghost, s.t, kTrailS)
+                                                : std::nullopt;
   if (has_vehicle) draw_vehicle(dl, v, s);
-  if (node) draw_reason_label(dl, h[*why].reason, *node, min, max, clear_min, clear_max);
+  const std::optional<Box> said =
+      node ? draw_reason_label(dl, h[*why].reason, *node, min, max, clear_min, clear_max)
+           : std::nullopt;
+  if (ghost) {
+    // Its tag clear of the vehicle (arms and rotors), the reason's label and the overlay.
+    ImVec2 pv(-1e9f, -1e9f);
+    const float reach = has_vehicle && v.project(p, pv) ? float(v.pixels(0.3, p)) : 0.0f;
+    draw_ghost_label(dl, *ghost, pv, min, max, {said.value_or(Box{}), Box{clear_min, clear_max}},
+                     Box{ImVec2(pv.x - reach, pv.y - reach), ImVec2(pv.x + reach, pv.y + reach)});
+  }
   // What stands between the camera and the vehicle: a tint and its outline, over the rest.
   for (const Ball& b : balls) {
     ImVec2 pc;

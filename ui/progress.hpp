@@ -27,6 +27,8 @@ struct ProgressFlight {
   std::string when;                // local time, "YYYY-MM-DD HH:MM"
   std::string ended;               // completed | interrupted | lost
   std::string recording;           // its recording ("" none, or no longer on this disk)
+  std::string scenario_hash;       // SHA-256 of the scenario's text it flew (a file edited since
+                                   // is another scenario to a ghost)
   // A branch (fly from here): flown on from this step of another flight (−1: none).
   std::int64_t from_step = -1;
 };

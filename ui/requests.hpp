@@ -41,9 +41,12 @@ struct SetAssist {
   bool on;                    // false: the next flight is a probe (SPEC §10)
 };
 struct FlyFromStart {};       // a flight flown on from a recording's moment: from t = 0 instead
+struct PickGhost {
+  int index;                  // into SessionChoices::ghosts
+};
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
-                                 SetRecord, SetTrainee, SetAssist, FlyFromStart>;
+                                 SetRecord, SetTrainee, SetAssist, FlyFromStart, PickGhost>;
 
 // A replay's transport.
 struct TogglePlay {};

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "core/modes/mode.hpp"
+#include "ui/ghost.hpp"
 
 namespace mixpilot::ui {
 
@@ -25,6 +27,9 @@ struct Scene : ModeView {
   double dt = 0.01;          // [s] control period
   double duration = 0.0;     // [s] of the whole run
   bool probe = false;        // a probe flight: the planner does not assist (SPEC §10)
+  // A recorded flight of the scenario flying along (ui/ghost.hpp); null: none. Immutable, so a
+  // frame, a replay and a screenshot share it as loaded.
+  std::shared_ptr<const Ghost> ghost;
 };
 
 // The value of the channel called `name` in `s`, or `fallback` when it has none.

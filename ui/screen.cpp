@@ -7,6 +7,7 @@
 
 #include <imgui_internal.h>  // the panes' sizes of the last frame (FindWindowByName)
 
+#include "ui/ghost.hpp"
 #include "ui/panels.hpp"
 #include "ui/reason.hpp"
 #include "ui/theme.hpp"
@@ -203,6 +204,24 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
       ImGui::PopStyleColor();
       ImGui::PopTextWrapPos();
     }
+  }
+  // The ghost (ui/ghost.hpp): a dashed swatch in its colour, as its trail is drawn, and how far
+  // ahead or behind along the reference the flight is; what it is, on hover.
+  if (sc.ghost && s) {
+    const std::string line = ghost_hud_text(sc, *s);
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    const float dash = 0.5f * ImGui::GetFontSize(), y = at.y + 0.5f * ImGui::GetTextLineHeight();
+    for (int i = 0; i < 3; ++i)
+      ImGui::GetWindowDrawList()->AddLine(ImVec2(at.x + float(i) * 1.5f * dash, y),
+                                          ImVec2(at.x + (float(i) * 1.5f + 1.0f) * dash, y),
+                                          colour::kGhost, scaled(2.5f));
+    ImGui::Dummy(ImVec2(4.5f * dash, 0.0f));
+    ImGui::SameLine();
+    ImGui::PushTextWrapPos(ImGui::GetWindowContentRegionMax().x);
+    ImGui::PushStyleColor(ImGuiCol_Text, colour::kGhost);
+    ImGui::TextUnformatted(line.c_str());
+    ImGui::PopStyleColor();
+    ImGui::PopTextWrapPos();
   }
   ImGui::PushFont(mono_font());
   const float gap = ImGui::CalcTextSize("   ").x;

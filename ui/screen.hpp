@@ -69,6 +69,14 @@ struct SessionChoices {
   // Fly from here: the next flight goes on from a recording's moment ("from REC at t = 10.00 s";
   // "" for a flight from the start).
   std::string fly_from;
+  // The ghost (SPEC §10): a recorded flight of the scenario flying along. The choices ("none",
+  // "your best ...", the trainee's other recorded flights of it, --ghost's file; empty: this
+  // flight can have none), the one chosen, and what became of it ("loading ...", why it was
+  // refused; "" nothing to say).
+  std::vector<std::string> ghosts;
+  int ghost = -1;
+  std::string ghost_note;
+  bool ghost_note_is_error = false;
 };
 
 // A joystick SDL sees.

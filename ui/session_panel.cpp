@@ -117,6 +117,22 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
     if (ImGui::IsItemHovered())
       ImGui::SetTooltip("The scenario from t = 0 instead, as a flight of its own");
   }
+  // The ghost (SPEC §10): a recorded flight of this scenario flying along.
+  if (!c.ghosts.empty()) {
+    ImGui::SetNextItemWidth(fields);
+    if (combo("ghost", c.ghosts, c.ghost, chosen)) out.push_back(PickGhost{chosen});
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("A recorded flight of this scenario flies along as a translucent\n"
+                        "lavender vehicle with a dashed trail, in step by time. The HUD says\n"
+                        "how far ahead or behind it you are along the reference.");
+    if (!c.ghost_note.empty()) {
+      if (c.ghost_note_is_error)
+        ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s",
+                           c.ghost_note.c_str());
+      else
+        ImGui::TextDisabled("%s", c.ghost_note.c_str());
+    }
+  }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());

@@ -20,6 +20,10 @@ inline constexpr ImU32 kReference = rgb(0xEE, 0xEE, 0xEE, 200);
 inline constexpr ImU32 kGrid = rgb(0x60, 0x66, 0x70, 160);
 inline constexpr ImU32 kWall = rgb(0x90, 0x98, 0xA8, 200);
 inline constexpr ImU32 kObstacle = rgb(0xCC, 0x79, 0xA7);  // reddish purple
+// A ghost (ui/ghost.hpp): lavender, a hue no other thing on the arena has, lighter than the
+// obstacles' purple; drawn translucent, with a dashed trail and filled rotors (the vehicle's
+// are rings), so it reads apart from the vehicle in greyscale too.
+inline constexpr ImU32 kGhost = rgb(0xB4, 0xA0, 0xFF);
 inline constexpr ImU32 kBackground = rgb(0x16, 0x19, 0x1E);  // the arena and plot areas
 // The panes (top bar, plots, transport): the frame is cleared to it and the panes draw no
 // background of their own, which spares a software rasterizer a screenful of blending.

@@ -340,6 +340,7 @@ ModeView MiMode::view() const {
   for (const Obstacle& o : scenario_.arena.obstacles) v.spheres.push_back({o.center, o.radius});
   const Scenario& sc = scenario_;
   v.reference = sample_path(sc.duration, [&sc](double t) { return sc.reference.position(t); });
+  v.reference_at = [helix = sc.reference](double tau) { return helix.position(tau); };
   v.ball_radius = sc.controller.ph.r;
   v.hover_rotor_speed = model_.hover_speed();
   using R = SeriesRole;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "core/modes/reference_progress.hpp"
 #include "core/nlp/ocp.hpp"
 
 namespace mixpilot {
@@ -55,6 +56,9 @@ struct ModeView {
   std::function<void(double t, std::vector<Eigen::Vector3d>& centers)> moving;
   double moving_radius = 0.1;      // [m]
   Eigen::Matrix3Xd reference;      // 3 x M: the whole reference path, for drawing
+  // η^r(τ) at any reference time, for progress along it (core/modes/reference_progress.hpp:
+  // a ghost's ahead / behind). It holds a copy of what it needs. Empty: the mode has none.
+  ReferencePath reference_at;
   double ball_radius = 0.0;        // [m] r of the ball B (shared authority), 0: none
   double hover_rotor_speed = 1.0;  // Ω at hover (shared authority: the thrust stick's centre)
   double link1 = 0.0, link2 = 0.0;  // [m] arm view: the two links
