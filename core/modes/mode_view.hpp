@@ -56,6 +56,8 @@ struct ModeView {
   double moving_radius = 0.1;      // [m]
   Eigen::Matrix3Xd reference;      // 3 x M: the whole reference path, for drawing
   double ball_radius = 0.0;        // [m] r of the ball B (shared authority), 0: none
+  // [m] the vehicle's sphere, which Telemetry::clearance is measured from (0: none measured)
+  double vehicle_radius = 0.0;
   double hover_rotor_speed = 1.0;  // Ω at hover (shared authority: the thrust stick's centre)
   double link1 = 0.0, link2 = 0.0;  // [m] arm view: the two links
   // The plots, in order; empty: one plot per telemetry channel.
