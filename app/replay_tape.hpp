@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/flight_rig.hpp"
+#include "core/modes/debrief.hpp"
 #include "core/recording/replay.hpp"
 #include "ui/scene.hpp"
 
@@ -39,6 +40,9 @@ class ReplayTape {
   std::size_t steps() const { return done() ? ready() : tape_.size(); }
   double dt() const { return dt_; }
   const ui::Scene& scene() const { return scene_; }
+  // How the debrief reads this flight (SPEC §10, core/modes/debrief.hpp): its Δt, ball and
+  // vehicle radius, the default thresholds.
+  const DebriefSettings& debrief() const { return debrief_; }
   const std::string& path() const { return path_; }
   const Mode& mode() const { return rig_->mode(); }  // read it only once done()
 
@@ -54,6 +58,7 @@ class ReplayTape {
   std::string path_;
   double dt_ = 0.01;
   ui::Scene scene_;
+  DebriefSettings debrief_;
   std::vector<Telemetry> tape_;  // sized once, filled in order
   std::atomic<std::size_t> ready_{0};
   std::atomic<bool> done_{false}, stop_{false};
