@@ -72,6 +72,23 @@ const std::string& reckless_recording() {
   return path;
 }
 
+// The novice's whole flight of mi_helix, recorded the same way: many events, more than the
+// panel shows at once.
+const std::string& novice_recording() {
+  static const std::string path = [] {
+    const fs::path home = test::fresh_path("debrief", "novice");
+    fs::create_directories(home);
+    const std::string rec = (home / "N.mcap").string();
+    const int status = test::run_mixpilot(
+        MIXPILOT_BINARY, "fly --scenario '" + kHelix + "' --pilot novice --headless --record '" +
+                             rec + "'",
+        home);
+    EXPECT_EQ(status, 0) << test::read_file(home / "out.txt");
+    return rec;
+  }();
+  return path;
+}
+
 RecordingContents read(const std::string& path) {
   std::string error;
   auto rec = read_recording(path, error);
@@ -717,9 +734,6 @@ TEST_P(DebriefScreen, ThePanelListsTheEventsAndTheBracketsStepThroughThem) {
     EXPECT_GT(bar, int(ImGui::GetTextLineHeight())) << "no highlight bar by the selected row";
   }
   EXPECT_TRUE(test::layout_problems().empty()) << test::layout_problems().front();
-  if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"))
-    (void)cli::write_file(std::string(dir) + "/debrief_" + std::to_string(int(scale * 100)) + ".png",
-                          screen.png(), true, error);
 
   // A click on the last row selects it and moves the playhead there.
   const ImGuiWindow* panel = ImGui::FindWindowByName("Debrief");
@@ -741,6 +755,12 @@ TEST_P(DebriefScreen, ThePanelListsTheEventsAndTheBracketsStepThroughThem) {
   io.MousePos = ImVec2(-1, -1);
   EXPECT_EQ(r.selected, int(r.events.size()) - 1);
   EXPECT_DOUBLE_EQ(r.t, r.events.back().t);
+  frame();  // the HUD fits what it says at the new time (ImGui sizes a window a frame late)
+  frame();
+  for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+  if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"))
+    (void)cli::write_file(std::string(dir) + "/debrief_" + std::to_string(int(scale * 100)) + ".png",
+                          screen.png(), true, error);
 
   // L hides the panel and shows it again.
   key(ui::kDebriefKey);
@@ -749,6 +769,47 @@ TEST_P(DebriefScreen, ThePanelListsTheEventsAndTheBracketsStepThroughThem) {
   EXPECT_TRUE(!hidden || !hidden->Active);
   key(ui::kDebriefKey);
   EXPECT_TRUE(app.ui_state().show_debrief);
+}
+
+// The novice's replay lists more events than the panel holds: the list scrolls (nothing cut), and
+// ] keeps the selected row in sight.
+TEST_P(DebriefScreen, ALongListScrollsToTheSelectedEvent) {
+  const float scale = GetParam();
+  cli::Offscreen screen;
+  std::string error;
+  if (!screen.open(1280, 720, error, scale)) GTEST_SKIP() << "no EGL device: " << error;
+  cli::FlyOptions o;
+  o.replay = true;
+  o.pilot = novice_recording();
+  o.history = "off";
+  cli::Trainer app(o);
+  ASSERT_TRUE(app.open_replay(novice_recording(), error)) << error;
+  app.load_replay();
+  const auto frame = [&] { screen.frame([&] { app.build_frame(0.0); }, 1e-4f); };
+  frame();
+  frame();
+  const ui::ReplayInfo& r = *app.run_info().replay;
+  ASSERT_GE(r.events.size(), 10u) << "the novice's flight has many events";
+  const auto list = [] {
+    const ImGuiWindow* panel = ImGui::FindWindowByName("Debrief");
+    for (const ImGuiWindow* w : GImGui->Windows)
+      if (panel && w->ParentWindow == panel && w->Active) return w;
+    return static_cast<const ImGuiWindow*>(nullptr);
+  };
+  ASSERT_TRUE(list());
+  EXPECT_TRUE(list()->ScrollbarY) << "the list holds more than it shows";
+  EXPECT_TRUE(test::layout_problems().empty()) << test::layout_problems().front();
+  for (std::size_t i = 0; i < r.events.size(); ++i) {
+    ui::set_key(ImGui::GetIO(), ui::Key::right_bracket, true);
+    frame();
+    ui::set_key(ImGui::GetIO(), ui::Key::right_bracket, false);
+    frame();
+  }
+  EXPECT_EQ(r.selected, int(r.events.size()) - 1);
+  frame();
+  EXPECT_GT(list()->Scroll.y, 0.0f) << "the list scrolled to the last event";
+  EXPECT_EQ(list()->Scroll.y, list()->ScrollMax.y);
+  EXPECT_TRUE(test::layout_problems().empty()) << test::layout_problems().front();
 }
 
 INSTANTIATE_TEST_SUITE_P(Scales, DebriefScreen, testing::Values(1.0f, 1.5f));

@@ -45,7 +45,10 @@ void draw_debrief_panel(const RunInfo& run, UiState& ui, float max_height, Reque
   const float room = std::max(ImGui::GetFrameHeight(), max_height - ImGui::GetCursorPosY() -
                                                            st.WindowPadding.y);
   const bool scroll_to = r.selected != ui.debrief_shown_selected;
-  ImGui::BeginChild("##events", ImVec2(0.0f, std::min(content, room)), false);
+  // A list taller than the room scrolls, its scrollbar there from the first frame (ImGui would
+  // add it a frame later, after measuring what the list holds).
+  ImGui::BeginChild("##events", ImVec2(0.0f, std::min(content, room)), false,
+                    content > room ? ImGuiWindowFlags_AlwaysVerticalScrollbar : 0);
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const float row_w = ImGui::GetContentRegionAvail().x;
   for (std::size_t i = 0; i < r.events.size(); ++i) {

@@ -123,8 +123,9 @@ void DebriefBuilder::add(const Telemetry& s) {
   last_step_ = k;
   const bool mi = s.mode == ModeKind::mixed_initiative;
 
-  // A run that has been off for hold_steps (or `hold` steps) by now closes: its condition last
-  // held at o.last_on, and steps last_on + 1 .. k are clear of it.
+  // A run closes once its condition has been off for `hold` steps: it last held at o.last_on,
+  // and steps last_on + 1 .. k are clear of it (so an on step at most `hold` steps after the
+  // last one continues the run).
   const auto run = [&](Open& o, DebriefKind kind, bool on, std::int64_t hold) {
     if (on) {
       if (!o.open) start(o, kind, s);
