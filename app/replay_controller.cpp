@@ -76,13 +76,23 @@ void ReplayController::handle(const ui::ReplayRequest& r) {
                  },
                  [&](const ui::SetPlaySpeed& s) { speed_ = std::clamp(s.speed, 0.25, 8.0); },
                  [&](const ui::Seek& s) { info.t = std::clamp(s.t, 0.0, last()); },
+                 // The debrief's events: [ / ] select the previous / next one from the
+                 // playhead, a click in the list that one; the playhead goes to its start.
                  [&](const ui::JumpToEvent& j) {
-                   const double t = ui::event_after(info.events, info.t, j.direction);
-                   if (t >= 0) info.t = t;
+                   const int i = ui::event_after(info.events, info.t, j.direction);
+                   if (i >= 0) {
+                     info.selected = i;
+                     info.t = std::min(info.events[std::size_t(i)].t, last());
+                   }
+                 },
+                 [&](const ui::SelectEvent& e) {
+                   if (e.index < 0 || std::size_t(e.index) >= info.events.size()) return;
+                   info.selected = e.index;
+                   info.t = std::min(info.events[std::size_t(e.index)].t, last());
                  },
                  [&](const ui::SetLambdaThreshold& l) {
                    info.lambda_threshold = l.lambda;
-                   events_final_ = false;  // found again on the next frame
+                   events_final_ = false;  // the takeovers found again on the next frame
                  },
              },
              r);
@@ -105,7 +115,13 @@ void ReplayController::update(double wall_dt, ui::RunInfo& run) {
     }
   }
   if (r.done() && !events_final_) {
-    info.events = ui::timeline_events(ui::History::view(r.tape(), ready), info.lambda_threshold);
+    // The debrief of the replayed flight (SPEC §10): the builder the recorder ran, over the
+    // tape, with the transport's λ_T for the takeovers.
+    DebriefSettings settings = r.debrief();
+    settings.takeover_lambda = info.lambda_threshold;
+    info.events = ui::debrief_rows(debrief_of(r.tape(), ready, settings), settings.ball_radius);
+    info.events_ready = true;
+    info.selected = -1;
     events_final_ = true;
     if (!r.mismatch().empty() && r.mismatch() != "interrupted")
       status_.say("the replay differs from the recording: " + r.mismatch(), true);

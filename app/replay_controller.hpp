@@ -1,7 +1,9 @@
 #pragma once
 // A recording's replay in the app (SPEC §8 "Replay"): the tape flown again on its loader thread,
-// the playhead, the speed and the timeline's events; its transport's requests move them. Open
-// from File → Open or `mixpilot replay`; closed by leaving it (Esc) or opening another file.
+// the playhead, the speed and the debrief's events (SPEC §10: the Debrief panel's list and the
+// timeline's ticks, rebuilt from the replayed telemetry), the one selected; its transport's and
+// the panel's requests move them. Open from File → Open or `mixpilot replay`; closed by leaving
+// it (Esc) or opening another file.
 #include <memory>
 #include <optional>
 #include <string>
@@ -72,7 +74,7 @@ class ReplayController {
   std::unique_ptr<ReplayTape> tape_;
   // Outlives the tape: the screen keeps showing it until another flight is shown.
   ui::ReplayInfo info_;
-  bool events_final_ = false;  // the timeline's events are those of the whole tape
+  bool events_final_ = false;  // the debrief's events are those of the whole tape
   double speed_ = 1.0;
   // The ghost (app/ghost.hpp): its recording, read off the UI thread for each replay opened.
   void poll_ghost();

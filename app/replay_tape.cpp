@@ -46,6 +46,7 @@ ReplayTape::ReplayTape(std::unique_ptr<FlightRig> rig, std::string path)
   dt_ = mode.dt();
   scene_ = ui::scene_of(mode, pilot.empty() ? std::string("replay of ") + path_
                                             : "replay of " + path_ + " (" + pilot + ")");
+  debrief_ = debrief_settings(mode);
   tape_.assign(std::size_t(std::max<std::int64_t>(mode.steps_total(), 0)), mode.telemetry());
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/flight_rig.hpp"
+#include "core/modes/debrief.hpp"
 #include "core/recording/replay.hpp"
 #include "ui/scene.hpp"
 
@@ -41,6 +42,9 @@ class ReplayTape {
   const ui::Scene& scene() const { return scene_; }
   // The UI's: a ghost flying along the replay (ui/ghost.hpp; the loader never reads the scene).
   void set_ghost(std::shared_ptr<const ui::Ghost> ghost) { scene_.ghost = std::move(ghost); }
+  // How the debrief reads this flight (SPEC §10, core/modes/debrief.hpp): its Δt, ball and
+  // vehicle radius, the default thresholds.
+  const DebriefSettings& debrief() const { return debrief_; }
   const std::string& path() const { return path_; }
   const Mode& mode() const { return rig_->mode(); }  // read it only once done()
 
@@ -56,6 +60,7 @@ class ReplayTape {
   std::string path_;
   double dt_ = 0.01;
   ui::Scene scene_;
+  DebriefSettings debrief_;
   std::vector<Telemetry> tape_;  // sized once, filled in order
   std::atomic<std::size_t> ready_{0};
   std::atomic<bool> done_{false}, stop_{false};

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
-# why λ fell, a ghost run, and the input settings and Progress panels and fly from here at
+# why λ fell, a ghost run, and the input settings and Progress panels, fly from here and the
+# debrief at
 # 1280x720 (app tests render them). The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
@@ -55,6 +56,11 @@ MIXPILOT_SHOT_DIR="$tmp" "$tests/test_fly_from_here_app" \
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
 cp "$tmp/fly_from_here.png" $out/fly_from_here.png
+# The debrief: a replay of the reckless pilot's whole flight (`fly --pilot reckless --record`),
+# its Debrief panel listing the events, the last one clicked (selected, the playhead there).
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_debrief" \
+  --gtest_filter='Scales/DebriefScreen.ThePanelListsTheEventsAndTheBracketsStepThroughThem/0' >/dev/null
+cp "$tmp/debrief_100.png" $out/debrief.png
 # The progress report to take home (history --html) of a trainee who flew the helix three times
 # as the novice, three times as the experienced pilot (each attempt with its own position noise)
 # and once unassisted, as headless Chromium prints it (Debian's chromium package).

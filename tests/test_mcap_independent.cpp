@@ -144,6 +144,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   PredictionMsg pred;
   ModeChannelsMsg channels;
   LambdaReasonMsg reason;
+  LogMsg log;
   double lambda = 0;
   for (uint64_t k = 0; k < kSteps; ++k) {
     const double s = static_cast<double>(k);
@@ -171,6 +172,11 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
     reason = {{}, k, lambda, 0.75 - 0.001 * s, 0.0625 * s, static_cast<int32_t>(k % 11) - 1,
               0.015 * static_cast<double>(k % 11), {0.6, -0.8, 0.0}, static_cast<uint8_t>(k % 4)};
     ASSERT_TRUE(rec.record_reason(reason));
+    // Its stamp is its own (a debrief event's start), before the log time.
+    log = {ros_time_from_ns(k / 2 * kPeriodNs), static_cast<uint8_t>(10 * (1 + k % 5)),
+           kDebriefLogger, "planner took over for 1.8 s (lowest λ 0.21) at step " + std::to_string(k),
+           "", k % 2 ? "takeover" : "near miss", static_cast<uint32_t>(k)};
+    ASSERT_TRUE(rec.record_log(k, log));
   }
   ASSERT_TRUE(rec.close(err)) << err;
 
@@ -237,6 +243,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.key("roll").num(pilot.roll).key("pitch").num(pilot.pitch);
   j.key("rotor_speed").nums(pilot.rotor_speed).key("source").str(pilot.source);
   j.key("authority").num(pilot.authority).key("input_state").num(pilot.input_state).end('}');
+  j.key("/rosout").begin('{').stamp(log.stamp).key("level").num(log.level);
+  j.key("name").str(log.name).key("msg").str(log.msg).key("file").str(log.file);
+  j.key("function").str(log.function).key("line").num(log.line).end('}');
   j.key("/vehicle/state").begin('{').stamp(t).key("step").num(state.step);
   j.key("x").nums(state.x).end('}');
   j.end('}');

@@ -2,9 +2,14 @@
 // allocation check armed (EIGEN_RUNTIME_NO_MALLOC), which aborts on any Eigen heap allocation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "core/control/crazyflie_tracking.hpp"
 #include "core/control/pendubot_reference.hpp"
 #include "core/control/tracking.hpp"
+#include "core/modes/debrief.hpp"
 #include "core/modes/make_mode.hpp"
 #include "core/modes/mi_mode.hpp"
 #include "core/modes/pendubot_mode.hpp"
@@ -230,6 +235,39 @@ TEST(NoMalloc, PendubotModeStep) {
       EXPECT_GE(switches, 2) << c.what;  // the exit path ran
     }
   }
+}
+
+// The debrief's builder (SPEC §10, core/modes/debrief.hpp), as the recorder's writer thread runs
+// it: after setup, adding the steps of the reckless pilot's flight of mi_helix (a takeover and
+// near misses), finishing, a marker and the words of every event allocate nothing.
+TEST(Debrief, TheBuilderAllocatesNothingAfterSetup) {
+  ModeRequest request;
+  request.pilot_name = "reckless";
+  std::string error;
+  auto mode = load_mode(std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml",
+                        std::move(request), error);
+  ASSERT_TRUE(mode) << error;
+  std::vector<Telemetry> steps;
+  steps.reserve(std::size_t(mode->steps_total()));
+  while (mode->step()) steps.push_back(mode->telemetry());
+  DebriefBuilder builder(debrief_settings(*mode));
+  long allocations = 0;
+  char words[320];
+  std::size_t said = 0;
+  {
+    NoMalloc guard;
+    for (const Telemetry& s : steps) builder.add(s);
+    builder.mark("an instructor's note");
+    builder.finish();
+    for (const DebriefEvent& e : builder.events())
+      said += describe(e, builder.settings().ball_radius, words, sizeof words);
+    allocations = NoMalloc::count();
+  }
+  EXPECT_EQ(allocations, 0) << "allocations in the builder or its words";
+  EXPECT_GE(builder.events().size(), 3u);
+  EXPECT_GT(said, 0u);
+  EXPECT_TRUE(std::any_of(builder.events().begin(), builder.events().end(),
+                          [](const DebriefEvent& e) { return e.kind == DebriefKind::takeover; }));
 }
 
 }  // namespace

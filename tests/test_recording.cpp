@@ -113,6 +113,12 @@ TEST(RecordingMessages, EveryTypeRoundTripsBitExactly) {
                            {kDoubles[0], kDoubles[5], kDoubles[6]}};
   expect_bit_exact_round_trip(channels);
   expect_bit_exact_round_trip(ModeChannelsMsg{});
+  // rcl_interfaces/msg/Log: the debrief's events on /rosout.
+  LogMsg log{{13, 14}, 30, "mixpilot.debrief",
+             "planner took over for 1.8 s (lowest λ 0.21): you would leave the ball by 0.08 m",
+             "", "takeover", 7};
+  expect_bit_exact_round_trip(log);
+  expect_bit_exact_round_trip(LogMsg{});
 
   // And == where NaN is absent.
   CdrWriter w;
@@ -149,7 +155,7 @@ TEST(RecordingMessages, DecodeRejectsTrailingBytes) {
 
 TEST(RecordingMessages, SchemasAreRos2msgWithDependencies) {
   const auto types = recorded_types();
-  ASSERT_EQ(types.size(), 9u);
+  ASSERT_EQ(types.size(), 10u);
   const std::string sep(80, '=');
   for (const auto& t : types) {
     const std::string text = t.schema_text;
@@ -195,6 +201,10 @@ void record_session(SessionRecorder& rec, uint64_t steps) {
     ASSERT_TRUE(rec.record_reason({{}, k, 1.0 / (1.0 + s), 1.0 / (1.0 + s), 0.01 * s,
                                    int32_t(k % 11) - 1, 0.015 * double(k % 11), {0.0, 0.6, -0.8},
                                    uint8_t(k % 4)}));
+    // A debrief event's message: stamped at its start, logged when it closed (now).
+    ASSERT_TRUE(rec.record_log(k, {ros_time_from_ns(k / 2 * kPeriodNs), 30, "mixpilot.debrief",
+                                   "near miss for " + std::to_string(k) + " s", "", "near miss",
+                                   0}));
   }
 }
 
@@ -248,6 +258,12 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
     EXPECT_EQ(why.ahead, 0.015 * double(k % 11));
     EXPECT_EQ(why.direction, (std::array<double, 3>{0.0, 0.6, -0.8}));
     EXPECT_EQ(why.cap, k % 4);
+    const LogMsg& log = r->log[k];
+    EXPECT_EQ(ros_time_to_ns(log.stamp), k / 2 * kPeriodNs);  // its own stamp, not the log time
+    EXPECT_EQ(log.level, 30u);
+    EXPECT_EQ(log.name, "mixpilot.debrief");
+    EXPECT_EQ(log.msg, "near miss for " + std::to_string(k) + " s");
+    EXPECT_EQ(log.function, "near miss");
   }
   // Log times in the container are k·Δt too.
   std::string e2;

@@ -1,6 +1,7 @@
 #pragma once
 // A layout as a person would judge it, read from ImGui's own state after a frame was rendered:
-// no pane overlaps another, the overlays on the view (HUD, sticks, session panel) stay inside it
+// no pane overlaps another, the overlays on the view (HUD, sticks, session panel, a replay's
+// Debrief panel) stay inside it
 // and apart, every window stays inside the display, no window holds more than it shows without
 // a scrollbar to reach it (a label cut, a row of buttons under the next pane), and no text is
 // drawn across its clip rectangle (a legend running out of its pane).
@@ -59,7 +60,7 @@ inline std::vector<std::string> layout_problems() {
 
   // The fixed panes tile the display; the overlays lie inside the view, apart.
   const char* panes[] = {"##top", "##view", "##plots", "##transport"};
-  const char* overlays[] = {"##hud", "##sticks", "Session"};
+  const char* overlays[] = {"##hud", "##sticks", "Session", "Debrief"};
   for (std::size_t i = 0; i < std::size(panes); ++i)
     for (std::size_t j = i + 1; j < std::size(panes); ++j)
       if (ImGuiWindow *a = shown(panes[i]), *b = shown(panes[j]); a && b && overlap(a->Rect(), b->Rect()))

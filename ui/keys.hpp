@@ -44,6 +44,11 @@ inline constexpr const char* kExportClipKeyName = "E";
 // other shortcut uses it, nor do the keyboard pilot's keys).
 inline constexpr Key kFlyFromHereKey = Key::t;
 
+// A replay's Debrief panel, the list of what happened (SPEC §10), shown or hidden ("list"; no
+// other shortcut uses it, nor do the keyboard pilot's keys).
+inline constexpr Key kDebriefKey = Key::l;
+inline constexpr const char* kDebriefKeyName = "L";
+
 // The keys that fly the keyboard pilot (input/keyboard.hpp), indexed by input::Key: W S A D
 // and the arrows.
 inline constexpr Key kFlightKeys[] = {Key::w, Key::s, Key::a, Key::d,

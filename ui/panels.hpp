@@ -36,6 +36,14 @@ void draw_plots(const Scene& scene, const History& history, UiState& ui);
 void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out);
 // A replay's transport bar: timeline with event ticks, play / pause, events, speeds (run.replay).
 void draw_transport(const RunInfo& run, Requests& out);
+// The colour of a debrief event's kind, and its mark (shape and colour, `size` its half width)
+// centred at `centre`: the timeline's ticks and the Debrief panel's rows share them.
+ImU32 event_colour(DebriefKind kind);
+void draw_event_mark(ImDrawList* dl, ImVec2 centre, float size, DebriefKind kind);
+// A replay's Debrief panel (SPEC §10): its events (run.replay->events) with time and words, the
+// selected one highlighted; a click selects one and moves the playhead to it. At most
+// `max_height` tall: the list scrolls (to the selected event when the selection changes).
+void draw_debrief_panel(const RunInfo& run, UiState& ui, float max_height, Requests& out);
 // File → Open: a modal browser of scenarios and recordings while ui.open_dialog.open.
 void draw_open_dialog(UiState& ui, Requests& out);
 // Fills the dialog's entries from its folder.

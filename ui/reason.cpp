@@ -1,7 +1,8 @@
 #include "ui/reason.hpp"
 
-#include <cmath>
 #include <cstdio>
+
+#include "core/control/reason_words.hpp"
 
 namespace mixpilot::ui {
 
@@ -27,18 +28,6 @@ const Telemetry* reason_prediction(const History& h, std::size_t i) {
   return previous.step == h[i].step - 1 && previous.predicted.cols() > 0 ? &previous : nullptr;
 }
 
-namespace {
-
-// "too low" or "too high" when the gap points mostly down or up; "" otherwise (a direction
-// across the arena means little to a pilot looking from the chase camera).
-const char* vertical(const LambdaReason& r) {
-  if (r.direction.z() < -0.7) return "too low";
-  if (r.direction.z() > 0.7) return "too high";
-  return "";
-}
-
-}  // namespace
-
 std::string reason_text(const Telemetry& s, double ball_radius) {
   const LambdaReason& r = s.reason;
   const double planner = 100.0 * (1.0 - s.lambda);
@@ -57,23 +46,8 @@ std::string reason_text(const Telemetry& s, double ball_radius) {
     std::snprintf(buf, sizeof buf, "planner %.0f %% until the first prediction", planner);
     return buf;
   }
-  // Node 0 is where the vehicle was at the previous step: "now" to the pilot.
-  char when[32] = "";
-  if (r.node > 0) std::snprintf(when, sizeof when, " in %.3g s", r.ahead);
-  const char* v = vertical(r);
-  const double out = r.d_res - ball_radius;
-  if (std::abs(out) < 0.005) {  // on the edge, to the centimetre shown
-    std::snprintf(buf, sizeof buf, "planner %.0f %%: you %s the ball's edge%s%s%s%s", planner,
-                  r.node > 0 ? "would reach" : "are on", when, *v ? " (" : "", v, *v ? ")" : "");
-  } else if (out > 0.0) {
-    std::snprintf(buf, sizeof buf, "planner %.0f %%: you %s the ball by %.2f m%s%s%s%s", planner,
-                  r.node > 0 ? "would leave" : "are out of", out, when, *v ? " (" : "", v,
-                  *v ? ")" : "");
-  } else {
-    std::snprintf(buf, sizeof buf, "planner %.0f %%: you %s %.2f m off the reference%s%s%s%s",
-                  planner, r.node > 0 ? "would be" : "are", r.d_res, when, *v ? " (" : "", v,
-                  *v ? ")" : "");
-  }
+  const int n = std::snprintf(buf, sizeof buf, "planner %.0f %%: ", planner);
+  prediction_words(r, ball_radius, buf + n, sizeof buf - std::size_t(n));
   return buf;
 }
 

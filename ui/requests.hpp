@@ -60,9 +60,13 @@ struct JumpToEvent {
   int direction;              // −1 previous, +1 next
 };
 struct SetLambdaThreshold {
-  double lambda;              // "λ below" events cross it downwards
+  double lambda;              // λ_T of the debrief's takeovers
 };
-using ReplayRequest = std::variant<TogglePlay, SetPlaySpeed, Seek, JumpToEvent, SetLambdaThreshold>;
+struct SelectEvent {
+  int index;                  // into ReplayInfo::events: selected, the playhead at its start
+};
+using ReplayRequest =
+    std::variant<TogglePlay, SetPlaySpeed, Seek, JumpToEvent, SetLambdaThreshold, SelectEvent>;
 
 // The input settings panel.
 struct ApplySettings {

@@ -426,8 +426,11 @@ void help_sheet(UiState& ui, ImVec2 display) {
       {"Left / Right", "replay: step 100 ms (Shift 10 ms, Alt 500 ms)"},
       {"Home / End", "replay: start / end"},
       {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
-      {"[  ]", "replay: previous / next event"},
-      {kExportClipKeyName, "replay: export a clip, the playhead ± 5 s, beside the recording"},
+      {"[  ]", "replay: previous / next event of the debrief (selects it, the playhead at its "
+               "start)"},
+      {kDebriefKeyName, "replay: show / hide the Debrief panel, the list of what happened"},
+      {kExportClipKeyName, "replay: export a clip beside the recording: the selected event ± 5 s, "
+                           "else the playhead ± 5 s"},
       {"T", "replay: fly from here - a new flight from the playhead's moment, with the pilot "
             "you pick (READY there; Space starts), scored from there on"},
       {"Esc", "leave the replay; close this sheet or the progress"},
@@ -462,7 +465,7 @@ void help_sheet(UiState& ui, ImVec2 display) {
 // The replay speeds, slowest first (↑ / ↓ move along them).
 constexpr double kReplaySpeeds[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
 
-void replay_keys(const RunInfo& run, Requests& out) {
+void replay_keys(const RunInfo& run, UiState& ui, Requests& out) {
   const ReplayInfo& r = *run.replay;
   const ImGuiIO& io = ImGui::GetIO();
   const double step = io.KeyShift ? 0.01 : io.KeyAlt ? 0.5 : 0.1;
@@ -478,9 +481,10 @@ void replay_keys(const RunInfo& run, Requests& out) {
   if (key_pressed(Key::down)) out.push_back(SetPlaySpeed{slower});
   if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
   if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
-  if (key_pressed(kExportClipKey)) out.push_back(clip_around(r.t, r.duration));
+  if (key_pressed(kExportClipKey)) out.push_back(clip_of(r));
   if (key_pressed(kFlyFromHereKey) && r.can_fly_from_here && r.taking_over < 0.0)
     out.push_back(FlyFromHere{});
+  if (key_pressed(kDebriefKey)) ui.show_debrief = !ui.show_debrief;
   if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
     out.push_back(LeaveReplay{});
 }
@@ -498,7 +502,7 @@ void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
   }
   if (key_pressed(Key::escape) && ui.show_help) ui.show_help = false;
   else if (key_pressed(Key::escape) && ui.show_progress) ui.show_progress = false;
-  else if (run.replay) replay_keys(run, out);
+  else if (run.replay) replay_keys(run, ui, out);
   else if (key_pressed(Key::escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
   // Space is the transport's: a replay plays or pauses, a live flight starts, pauses or resumes.
   if (key_pressed(Key::space) && run.state != RunState::waiting) {
@@ -563,21 +567,23 @@ float session_panel_width(float view_w) {
                   view_w - 2.0f * ImGui::GetStyle().WindowPadding.x);
 }
 
+// A replay's Debrief panel (its window's name: the layout reads its last frame by it).
+constexpr const char* kDebriefWindow = "Debrief";
+
 // The vehicle's half size on screen as a part of the frame's height (the chase camera's
 // distance and field of view), with a margin.
 constexpr float kVehicleInFrame = 0.13f;
 
 // Where the view frames its scene (the chase camera keeps the vehicle at its centre): the pane,
-// less the session panel at its left and the HUD above where they would cover that centre (a
-// small window, a large scale), so the vehicle stays in sight. `hud_bottom`: the HUD's bottom
-// edge (the pane's top without one).
-ImVec2 frame_min(ImVec2 min, ImVec2 max, const RunInfo& run, float hud_bottom) {
+// less the panel at its left (the session panel, a replay's Debrief panel) and the HUD above
+// where they would cover that centre (a small window, a large scale), so the vehicle stays in
+// sight. `panel_right`: the left panel's right edge (the pane's left without one);
+// `hud_bottom`: the HUD's bottom edge (the pane's top without one).
+ImVec2 frame_min(ImVec2 min, ImVec2 max, float panel_right, float hud_bottom) {
   const float m = ImGui::GetStyle().WindowPadding.x, em = ImGui::GetFontSize();
   ImVec2 f = min;
-  if (session_panel_shown(run)) {
-    const float panel_right = min.x + m + session_panel_width(max.x - min.x);
-    if (panel_right + 3.0f * em > 0.5f * (min.x + max.x)) f.x = std::min(panel_right + m, max.x - 1.0f);
-  }
+  if (panel_right > min.x && panel_right + 3.0f * em > 0.5f * (min.x + max.x))
+    f.x = std::min(panel_right + m, max.x - 1.0f);
   if (hud_bottom + m > 0.5f * (min.y + max.y) - kVehicleInFrame * (max.y - min.y))
     f.y = std::min(hud_bottom + m, max.y - 1.0f);
   return f;
@@ -591,7 +597,14 @@ void view_rect(ImVec2 display, const RunInfo& run, ImVec2& min, ImVec2& max) {
   view_pane(display, top, bottom, min, max);
   const ImGuiWindow* hud = ImGui::FindWindowByName("##hud");
   const float hud_bottom = hud && hud->Active ? hud->Pos.y + hud->Size.y : min.y;
-  min = frame_min(min, max, run, hud_bottom);
+  float panel_right = min.x;
+  if (session_panel_shown(run)) {
+    panel_right = min.x + ImGui::GetStyle().WindowPadding.x + session_panel_width(max.x - min.x);
+  } else if (const ImGuiWindow* d = ImGui::FindWindowByName(kDebriefWindow);
+             run.replay && d && d->Active) {
+    panel_right = d->Pos.x + d->Size.x;
+  }
+  min = frame_min(min, max, panel_right, hud_bottom);
 }
 
 void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState& ui,
@@ -633,19 +646,47 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
     ImGui::End();
   }
 
-  // The HUD at the top centre of the view, beside the session panel; where the view is too
+  const float hud_least =
+      mono_font()->CalcTextSizeA(em, FLT_MAX, 0.0f, kWidestHudItem).x + 2 * st.WindowPadding.x;
+  // A replay's Debrief panel (L) at the view's left like the session panel, the HUD beside it
+  // where both fit; else under the HUD (which the authority bar keeps first), where there is
+  // room for a few rows of it.
+  const bool debrief = run.replay && ui.show_debrief;
+  const float debrief_w = std::min(20.0f * em, view_w - 3 * m - hud_least);
+  const bool debrief_beside = debrief && debrief_w >= 13.0f * em;
+  bool left = panel;  // a panel at the view's left, its bottom right corner panel_max
+  const auto debrief_panel = [&](ImVec2 pos, float w, float max_h) {
+    ImGui::SetNextWindowPos(pos);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(w, 0), ImVec2(w, max_h));
+    ImGui::Begin(kDebriefWindow, nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                     ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoFocusOnAppearing);
+    draw_debrief_panel(run, ui, max_h, out);
+    panel_max = ImVec2(ImGui::GetWindowPos().x + ImGui::GetWindowWidth(),
+                       ImGui::GetWindowPos().y + ImGui::GetWindowHeight());
+    ImGui::End();
+    left = true;
+  };
+  if (debrief_beside) debrief_panel(ImVec2(vmin.x + m, top + m), debrief_w, vmax.y - top - 2 * m);
+
+  // The HUD at the top centre of the view, beside the left panel; where the view is too
   // narrow for both (a small window, a large scale) it waits for the flight to start.
   float hud_bottom = top;
   {
-    const float lo = panel ? panel_max.x + m : vmin.x + m, room = vmax.x - m - lo;
-    const float widest = mono_font()->CalcTextSizeA(em, FLT_MAX, 0.0f, kWidestHudItem).x;
+    const float lo = left ? panel_max.x + m : vmin.x + m, room = vmax.x - m - lo;
     const float w = std::min(std::clamp(0.6f * view_w, 28.0f * em, 43.0f * em), room);
-    if (w >= widest + 2 * st.WindowPadding.x) {
+    if (w >= hud_least) {
       const float x = std::max(lo, std::min(vmin.x + 0.5f * (view_w - w), vmax.x - m - w));
       hud_bottom = hud(sc, h, run, ImVec2(x, top + m), w, vmax.y - vmin.y < 24.0f * em);
     }
   }
-  const ImVec2 frame = frame_min(vmin, vmax, run, hud_bottom);
+  if (debrief && !debrief_beside) {
+    const float y = hud_bottom + m, max_h = vmax.y - m - y;
+    if (max_h >= 6.0f * ImGui::GetFrameHeightWithSpacing())
+      debrief_panel(ImVec2(vmin.x + m, y), std::min(20.0f * em, view_w - 2 * m), max_h);
+  }
+  const ImVec2 frame = frame_min(vmin, vmax, left ? panel_max.x : vmin.x, hud_bottom);
   const ImVec2 centre(0.5f * (frame.x + vmax.x), 0.5f * (frame.y + vmax.y));
 
   // The sticks at the bottom of the frame over the camera line, below the vehicle or, where
@@ -668,7 +709,11 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
       ht = fit(std::max(hud_bottom, frame.y) + m, vmax.x - m - beside);
       x = vmax.x - m - ht * aspect;
     }
-    const bool clear_of_panel = !panel || x >= panel_max.x + m || floor - ht >= panel_max.y + m;
+    // Beside a panel at the view's left rather than under it, where they fit there.
+    if (left && x < panel_max.x + m && floor - ht < panel_max.y + m &&
+        panel_max.x + m + ht * aspect <= vmax.x - m)
+      x = panel_max.x + m;
+    const bool clear_of_panel = !left || x >= panel_max.x + m || floor - ht >= panel_max.y + m;
     sticks = ht >= least && clear_of_panel;
     sticks_min = ImVec2(x, floor - ht);
     sticks_size = ImVec2(ht * aspect, ht);

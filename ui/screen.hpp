@@ -1,7 +1,8 @@
 #pragma once
 // The whole window, one frame at a time (SPEC §8, UI.md §1): a top bar with the status pill,
-// the session buttons and the authority bar; the session panel; the arena (3D) or Pendubot (2D)
-// view in the centre; plots on the right; the sticks at the bottom, or a replay's timeline. A
+// the session buttons and the authority bar; the session panel, or a replay's Debrief panel; the
+// arena (3D) or Pendubot (2D) view in the centre; plots on the right; the sticks at the bottom,
+// or a replay's timeline. A
 // function of the scene, the telemetry history and the UI's own state; what the user asked for
 // comes back as requests (ui/requests.hpp). Keys by the UI's own names (ui/keys.hpp).
 #include <cstdint>
@@ -13,6 +14,7 @@
 
 #include "input/mapping.hpp"
 #include "input/mapping_wizard.hpp"
+#include "core/modes/debrief.hpp"
 #include "input/settings.hpp"
 #include "ui/keys.hpp"
 #include "ui/progress.hpp"
@@ -29,14 +31,18 @@ const char* to_string(Camera c);
 enum class RunState { ready, waiting, flying, paused, finished, replay, loading, lost };
 const char* to_string(RunState s);
 
-// Events a replay's timeline marks and jumps to (UI.md §6).
-enum class EventKind { collision, fallback, low_lambda, lost, input_lost };
-const char* to_string(EventKind k);
-
-struct TimelineEvent {
-  double t = 0.0;  // [s]
-  EventKind kind = EventKind::collision;
+// An event of a replay's debrief (SPEC §10, core/modes/debrief.hpp) as the screen shows it:
+// a row of the Debrief panel and a tick on the timeline (UI.md §6), which jump to it.
+struct DebriefRow {
+  double t = 0.0;    // [s] its start: where a jump puts the playhead
+  double end = 0.0;  // [s] its end (t for a moment: a lost vehicle, a marker)
+  DebriefKind kind = DebriefKind::takeover;
+  std::string text;  // what happened, in words (describe())
 };
+
+// The rows of a flight's debrief events (as the builder lists them: in the order they closed),
+// by start time, in words for a ball of radius `ball_radius`.
+std::vector<DebriefRow> debrief_rows(const std::vector<DebriefEvent>& events, double ball_radius);
 
 // A replay's transport: a playhead over a recorded flight.
 struct ReplayInfo {
@@ -44,8 +50,12 @@ struct ReplayInfo {
   double t = 0.0;             // [s] the playhead
   double duration = 0.0;      // [s] of the recording
   double loaded = 1.0;        // fraction of the flight ready to show (it is flown again first)
-  double lambda_threshold = 0.5;         // "λ below" events cross it downwards
-  std::vector<TimelineEvent> events;     // by time
+  double lambda_threshold = 0.5;  // λ_T: λ below it is a takeover (the debrief's)
+  // The debrief: the Debrief panel lists these and the timeline marks them; [ and ] step
+  // through them. By start time; once the whole flight is loaded (events_ready).
+  std::vector<DebriefRow> events;
+  bool events_ready = false;
+  int selected = -1;  // the event selected (highlighted; what Export clip saves), −1: none
   // Fly from here (SPEC §10): offered (a pilot flies this mode), and while the moment is made
   // ready the part of the way flown (0 … 1; −1: not taking over).
   bool can_fly_from_here = false;
@@ -162,6 +172,8 @@ struct UiState {
   double plot_window = 10.0;  // [s]
   bool show_sticks = true;
   bool show_help = false;      // the shortcut sheet (F1, ?)
+  bool show_debrief = true;    // a replay's Debrief panel (L)
+  int debrief_shown_selected = -1;  // the selection the list last scrolled to
   bool show_progress = false;  // the Progress panel (H)
   bool score_card_closed = false;
   OpenDialog open_dialog;
@@ -171,12 +183,13 @@ struct UiState {
   bool draft_loaded = false;
 };
 
-// The events of a flight for a replay's timeline: collisions, fallbacks (overruns included),
-// the vehicle lost, and λ crossing `lambda_threshold` downwards (mixed initiative).
-std::vector<TimelineEvent> timeline_events(const History& flight, double lambda_threshold);
+// The index of the next (direction +1) or previous (−1) event starting after / before `t`,
+// or −1.
+int event_after(const std::vector<DebriefRow>& events, double t, int direction);
 
-// The time of the next (direction +1) or previous (−1) event after / before `t`, or −1.
-double event_after(const std::vector<TimelineEvent>& events, double t, int direction);
+// What "Export clip" saves of a replay: the selected event from kClipHalfWidth before its start
+// to kClipHalfWidth after its end, else the playhead ± kClipHalfWidth.
+ExportClip clip_of(const ReplayInfo& replay);
 
 // Builds one frame's ImGui windows over the whole display (between ImGui::NewFrame() and
 // ImGui::Render()); appends what the user asked for to `requests`.

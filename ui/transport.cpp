@@ -1,4 +1,5 @@
-// A replay's transport bar (UI.md §1, §6): the timeline with its event ticks and the playhead,
+// A replay's transport bar (UI.md §1, §6): the timeline with the debrief's event ticks (SPEC
+// §10; the selected event's span under its tick) and the playhead,
 // play / pause, previous / next event, fly from here (SPEC §10), the speeds 0.25×–8× and the
 // "λ below" threshold.
 #include <algorithm>
@@ -10,82 +11,87 @@
 
 namespace mixpilot::ui {
 
-const char* to_string(EventKind k) {
-  switch (k) {
-    case EventKind::collision: return "collision";
-    case EventKind::fallback: return "fallback";
-    case EventKind::low_lambda: return "λ below threshold";
-    case EventKind::lost: return "lost";
-    case EventKind::input_lost: return "input lost";
-  }
-  return "?";
+std::vector<DebriefRow> debrief_rows(const std::vector<DebriefEvent>& events, double ball_radius) {
+  std::vector<DebriefRow> rows;
+  rows.reserve(events.size());
+  for (const DebriefEvent& e : events) rows.push_back({e.start, e.end, e.kind, describe(e, ball_radius)});
+  // The builder lists them as they closed; a list reads by start (ties: as they closed).
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const DebriefRow& a, const DebriefRow& b) { return a.t < b.t; });
+  return rows;
 }
 
-std::vector<TimelineEvent> timeline_events(const History& h, double lambda_threshold) {
-  std::vector<TimelineEvent> out;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    const Telemetry& s = h[i];
-    if (s.events & kEventCollision) out.push_back({s.t, EventKind::collision});
-    if (s.events & (kEventFallback | kEventOverrun)) out.push_back({s.t, EventKind::fallback});
-    if (s.events & kEventLost) out.push_back({s.t, EventKind::lost});
-    if (s.events & kEventInputLost) out.push_back({s.t, EventKind::input_lost});
-    if (s.mode == ModeKind::mixed_initiative && s.lambda < lambda_threshold &&
-        (i == 0 || h[i - 1].lambda >= lambda_threshold))
-      out.push_back({s.t, EventKind::low_lambda});
-  }
-  return out;
-}
-
-double event_after(const std::vector<TimelineEvent>& events, double t, int direction) {
+int event_after(const std::vector<DebriefRow>& events, double t, int direction) {
   // Half a millisecond of slack: the playhead sits on an event's time after a jump to it.
   constexpr double kSlack = 5e-4;
   if (direction > 0) {
-    for (const TimelineEvent& e : events)
-      if (e.t > t + kSlack) return e.t;
+    for (std::size_t i = 0; i < events.size(); ++i)
+      if (events[i].t > t + kSlack) return int(i);
   } else {
-    for (auto it = events.rbegin(); it != events.rend(); ++it)
-      if (it->t < t - kSlack) return it->t;
+    for (std::size_t i = events.size(); i-- > 0;)
+      if (events[i].t < t - kSlack) return int(i);
   }
-  return -1.0;
+  return -1;
 }
 
-namespace {
+ExportClip clip_of(const ReplayInfo& r) {
+  if (r.selected < 0 || std::size_t(r.selected) >= r.events.size()) return clip_around(r.t, r.duration);
+  const DebriefRow& e = r.events[std::size_t(r.selected)];
+  return ExportClip{std::max(0.0, e.t - kClipHalfWidth), std::min(r.duration, e.end + kClipHalfWidth)};
+}
 
-ImU32 event_colour(EventKind k) {
+ImU32 event_colour(DebriefKind k) {
   switch (k) {
-    case EventKind::collision: return colour::kCritical;
-    case EventKind::fallback: return colour::kCaution;
-    case EventKind::low_lambda: return colour::kPlanner;
-    case EventKind::lost: return colour::kCritical;
-    case EventKind::input_lost: return colour::kPilot;
+    case DebriefKind::takeover: return colour::kPlanner;
+    case DebriefKind::near_miss: return colour::kCaution;
+    case DebriefKind::collision: return colour::kCritical;
+    case DebriefKind::fallback: return colour::kCaution;
+    case DebriefKind::input_lost: return colour::kPilot;
+    case DebriefKind::lost: return colour::kCritical;
+    case DebriefKind::safe_hold: return colour::kCritical;
+    case DebriefKind::marker: return colour::kText;
   }
   return colour::kText;
 }
 
-// A tick's shape tells its kind without colour: collision ▲, fallback ■, λ below ▼, lost ✕,
-// input lost ○.
-void tick(ImDrawList* dl, float x, float top, float bottom, EventKind k) {
-  const ImU32 c = event_colour(k);
-  const float s = scaled(5.0f);
-  dl->AddLine(ImVec2(x, top), ImVec2(x, bottom), c, scaled(1.5f));
+// A mark's shape tells its kind without colour: takeover ▼, near miss ◆, collision ▲,
+// fallback ■, input lost ○, vehicle lost ✕, safe hold ●, marker ⚑.
+void draw_event_mark(ImDrawList* dl, ImVec2 c, float s, DebriefKind k) {
+  const ImU32 col = event_colour(k);
+  const float x = c.x, y = c.y;
   switch (k) {
-    case EventKind::collision:
-      dl->AddTriangleFilled(ImVec2(x, top - s), ImVec2(x - s, top + s), ImVec2(x + s, top + s), c);
+    case DebriefKind::takeover:
+      dl->AddTriangleFilled(ImVec2(x - s, y - s), ImVec2(x + s, y - s), ImVec2(x, y + s), col);
       break;
-    case EventKind::fallback:
-      dl->AddRectFilled(ImVec2(x - 0.8f * s, top - 0.8f * s), ImVec2(x + 0.8f * s, top + 0.8f * s), c);
+    case DebriefKind::near_miss:
+      dl->AddQuadFilled(ImVec2(x, y - s), ImVec2(x + s, y), ImVec2(x, y + s), ImVec2(x - s, y), col);
       break;
-    case EventKind::low_lambda:
-      dl->AddTriangleFilled(ImVec2(x - s, top - s), ImVec2(x + s, top - s), ImVec2(x, top + s), c);
+    case DebriefKind::collision:
+      dl->AddTriangleFilled(ImVec2(x, y - s), ImVec2(x - s, y + s), ImVec2(x + s, y + s), col);
       break;
-    case EventKind::lost:
-      dl->AddLine(ImVec2(x - s, top - s), ImVec2(x + s, top + s), c, scaled(2.0f));
-      dl->AddLine(ImVec2(x - s, top + s), ImVec2(x + s, top - s), c, scaled(2.0f));
+    case DebriefKind::fallback:
+      dl->AddRectFilled(ImVec2(x - 0.8f * s, y - 0.8f * s), ImVec2(x + 0.8f * s, y + 0.8f * s), col);
       break;
-    case EventKind::input_lost:
-      dl->AddCircle(ImVec2(x, top), s, c, 12, scaled(2.0f));
+    case DebriefKind::input_lost: dl->AddCircle(c, s, col, 12, scaled(2.0f)); break;
+    case DebriefKind::lost:
+      dl->AddLine(ImVec2(x - s, y - s), ImVec2(x + s, y + s), col, scaled(2.0f));
+      dl->AddLine(ImVec2(x - s, y + s), ImVec2(x + s, y - s), col, scaled(2.0f));
+      break;
+    case DebriefKind::safe_hold: dl->AddCircleFilled(c, s, col, 12); break;
+    case DebriefKind::marker:
+      dl->AddLine(ImVec2(x - 0.6f * s, y - s), ImVec2(x - 0.6f * s, y + s), col, scaled(1.5f));
+      dl->AddTriangleFilled(ImVec2(x - 0.6f * s, y - s), ImVec2(x + s, y - 0.5f * s),
+                            ImVec2(x - 0.6f * s, y), col);
       break;
   }
+}
+
+namespace {
+
+// A tick on the timeline: a line down from the mark.
+void tick(ImDrawList* dl, float x, float top, float bottom, DebriefKind k) {
+  dl->AddLine(ImVec2(x, top), ImVec2(x, bottom), event_colour(k), scaled(1.5f));
+  draw_event_mark(dl, ImVec2(x, top), scaled(5.0f), k);
 }
 
 }  // namespace
@@ -111,7 +117,15 @@ void draw_transport(const RunInfo& run, Requests& out) {
   dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(x_of(r.loaded * span), ty + th),
                     colour::rgb(0x50, 0x56, 0x60), th);
   dl->AddRectFilled(ImVec2(min.x, ty - th), ImVec2(x_of(r.t), ty + th), colour::kPilot, th);
-  for (const TimelineEvent& e : r.events)
+  // The selected event's span along the track, then every event's tick.
+  if (r.selected >= 0 && std::size_t(r.selected) < r.events.size()) {
+    const DebriefRow& e = r.events[std::size_t(r.selected)];
+    const ImU32 c = event_colour(e.kind);
+    dl->AddRectFilled(ImVec2(x_of(e.t) - scaled(2), ty - 2.5f * th),
+                      ImVec2(std::max(x_of(e.end), x_of(e.t)) + scaled(2), ty + 2.5f * th),
+                      (c & 0x00FFFFFFu) | 0xA0000000u, th);
+  }
+  for (const DebriefRow& e : r.events)
     tick(dl, x_of(e.t), min.y + scaled(6), max.y - scaled(2), e.kind);
   dl->AddCircleFilled(ImVec2(x_of(r.t), ty), scaled(7.0f), colour::kText, 16);
 
@@ -121,11 +135,19 @@ void draw_transport(const RunInfo& run, Requests& out) {
   if (ImGui::Button("< previous event [")) out.push_back(JumpToEvent{-1});
   same_line_or_wrap(button_width("] next event >"));
   if (ImGui::Button("] next event >")) out.push_back(JumpToEvent{+1});
-  same_line_or_wrap(button_width("Export clip (E)"));
-  if (ImGui::Button("Export clip (E)")) out.push_back(clip_around(r.t, r.duration));
-  if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("Saves %g s either side of the playhead as a video beside the recording",
-                      kClipHalfWidth);
+  // "Export clip" saves the selected event with kClipHalfWidth either side, or the playhead's.
+  const bool event_clip = r.selected >= 0 && std::size_t(r.selected) < r.events.size();
+  const char* clip_label = event_clip ? "Export event clip (E)" : "Export clip (E)";
+  same_line_or_wrap(button_width(clip_label));
+  if (ImGui::Button(clip_label)) out.push_back(clip_of(r));
+  if (ImGui::IsItemHovered()) {
+    if (event_clip)
+      ImGui::SetTooltip("Saves the selected event with %g s either side as a video beside the "
+                        "recording", kClipHalfWidth);
+    else
+      ImGui::SetTooltip("Saves %g s either side of the playhead as a video beside the recording",
+                        kClipHalfWidth);
+  }
   // Fly from here (SPEC §10): a new flight from the playhead's moment, READY there.
   if (r.can_fly_from_here) {
     same_line_or_wrap(button_width("Fly from here (T)"));
@@ -154,11 +176,16 @@ void draw_transport(const RunInfo& run, Requests& out) {
   float threshold = float(r.lambda_threshold);
   if (ImGui::SliderFloat("##lambda", &threshold, 0.05f, 0.95f, "λ below %.2f"))
     out.push_back(SetLambdaThreshold{threshold});
-  // The legend: each tick's shape and colour.
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("A takeover: the pilot's authority λ below this (the planner flies more)");
+  // The legend: each tick's shape and colour, of the kinds this flight's events have.
   const float lh = ImGui::GetTextLineHeight();
   const float mark = scaled(14.0f);
-  for (EventKind k : {EventKind::collision, EventKind::fallback, EventKind::low_lambda,
-                      EventKind::lost, EventKind::input_lost}) {
+  bool present[kDebriefKindCount] = {};
+  for (const DebriefRow& e : r.events) present[int(e.kind)] = true;
+  for (int i = 0; i < kDebriefKindCount; ++i) {
+    if (!present[i]) continue;
+    const auto k = DebriefKind(i);
     same_line_or_wrap(mark + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(to_string(k)).x);
     ImGui::AlignTextToFramePadding();
     const ImVec2 p = ImGui::GetCursorScreenPos();

@@ -23,6 +23,7 @@ enum MiChannel {
   kRotorSpeedBound,
   kRtiTime,
   kPredictedDeviation,
+  kClearance,
   kRttEstimate,
   kRttSample,
 };
@@ -162,6 +163,8 @@ void MiMode::set_channels() {
   s.set_channel(kRtiTime, "RTI time", "us", s.stats.total_us);
   // d_res of SPEC §5.4, which λ came from: the previous prediction's largest deviation.
   s.set_channel(kPredictedDeviation, "predicted deviation", "m", s.reason.d_res);
+  // Of the vehicle sphere to the obstacles, walls and floor (the debrief's near misses).
+  s.set_channel(kClearance, "clearance", "m", s.clearance);
   if (remote_.attached()) {
     s.set_channel(kRttEstimate, "RTT estimate", "s", remote_.rtt().estimate());
     s.set_channel(kRttSample, "RTT sample", "s", remote_.rtt().last_sample());
@@ -237,6 +240,7 @@ bool MiMode::step() {
   s.events |= deadline_event(run_.step, compute_us, s.stats.overrun);
   if (s.pilot.input == InputState::lost && was != InputState::lost) s.events |= kEventInputLost;
   if (scorer_.add(s)) s.events |= kEventCollision;
+  s.clearance = scorer_.clearance();
   set_channels();
 
   if (remote_.attached()) {
@@ -342,6 +346,7 @@ ModeView MiMode::view() const {
   v.reference = sample_path(sc.duration, [&sc](double t) { return sc.reference.position(t); });
   v.reference_at = [helix = sc.reference](double tau) { return helix.position(tau); };
   v.ball_radius = sc.controller.ph.r;
+  v.vehicle_radius = sc.controller.vehicle_radius;
   v.hover_rotor_speed = model_.hover_speed();
   using R = SeriesRole;
   v.plots = {{"authority λ", {{"lambda", R::pilot}}},

@@ -7,6 +7,7 @@
 // (core/modes/session.hpp) drives any mode and hands each step's telemetry to its sinks.
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -75,6 +76,9 @@ struct Telemetry {
   bool solved = false;   // an RTI step ran (false: an LQR step, or the run has not started)
   RtiStats stats{};      // of that RTI step; stats.total_us = prepare + feedback
   std::uint32_t events = 0;  // ModeEvent flags
+  // [m] the vehicle sphere's least distance to an obstacle, a wall or the floor at t_k
+  // (negative: in contact; core/modes/score.hpp); +∞ where the mode does not measure it.
+  double clearance = std::numeric_limits<double>::infinity();
 
   // Mixed initiative only.
   PilotCommand pilot;    // the pilot's command ν^r

@@ -60,6 +60,8 @@ struct ModeView {
   // a ghost's ahead / behind). It holds a copy of what it needs. Empty: the mode has none.
   ReferencePath reference_at;
   double ball_radius = 0.0;        // [m] r of the ball B (shared authority), 0: none
+  // [m] the vehicle's sphere, which Telemetry::clearance is measured from (0: none measured)
+  double vehicle_radius = 0.0;
   double hover_rotor_speed = 1.0;  // Ω at hover (shared authority: the thrust stick's centre)
   double link1 = 0.0, link2 = 0.0;  // [m] arm view: the two links
   // The plots, in order; empty: one plot per telemetry channel.

@@ -54,6 +54,7 @@ bool ScoreAccumulator::add(const Telemetry& s) {
   for (int i = 0; i < 3; ++i) {
     clearance = std::min({clearance, p(i) - a.min(i) - rv, a.max(i) - p(i) - rv});
   }
+  clearance_ = clearance;
   const bool contact = clearance < 0.0;
   const bool started = contact && !m.in_contact;
   if (started) ++m.collisions;

@@ -102,6 +102,9 @@ class ScoreAccumulator {
   void setup(const Scenario& scenario);
   // Adds one step; true when the vehicle sphere started touching something in it.
   bool add(const Telemetry& step);
+  // The clearance of the step added last: the vehicle sphere's least distance to an obstacle,
+  // a wall or the floor [m] (negative: in contact).
+  double clearance() const { return clearance_; }
   Score finish() const;
   // Starts the score afresh at step `first_step` of the same flight (fly from here): nothing
   // added so far counts, and progress is out of the waypoints from that step on. Keeps the
@@ -117,6 +120,7 @@ class ScoreAccumulator {
   const Scenario* scenario_ = nullptr;
   double dt_ = 0.015;
   Sums sums_;
+  double clearance_ = 1e9;
 };
 
 }  // namespace mixpilot

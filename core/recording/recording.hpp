@@ -127,6 +127,22 @@ struct LambdaReasonMsg {
   bool operator==(const LambdaReasonMsg&) const = default;
 };
 
+// rcl_interfaces/msg/Log on /rosout: the debrief's events (SPEC §10, core/modes/debrief.hpp),
+// one message per event, written when it closes, so Foxglove's and Lichtblick's Log panel list
+// them. Unlike the other topics, the stamp is the event's start, the log time the step that
+// closed it (the message then knows the event's end, its lowest λ and why).
+struct LogMsg {
+  RosTime stamp;
+  uint8_t level = 20;     // DEBUG 10, INFO 20, WARN 30, ERROR 40, FATAL 50
+  std::string name;       // the logger: "mixpilot.debrief"
+  std::string msg;        // the event in words
+  std::string file;       // "": no source file said it, the flight did
+  std::string function;   // the event's kind, as to_string(DebriefKind) names it ("takeover")
+  uint32_t line = 0;      // 0
+  bool operator==(const LogMsg&) const = default;
+};
+inline constexpr const char* kDebriefLogger = "mixpilot.debrief";
+
 // ---- encoding ---------------------------------------------------------------------------
 
 // The ros2msg schema (top-level definition followed by its dependencies) and schema name of
@@ -149,6 +165,7 @@ void encode(const SolverStatsMsg& m, CdrWriter& out);
 void encode(const PredictionMsg& m, CdrWriter& out);
 void encode(const ModeChannelsMsg& m, CdrWriter& out);
 void encode(const LambdaReasonMsg& m, CdrWriter& out);
+void encode(const LogMsg& m, CdrWriter& out);
 void encode_float64(double v, CdrWriter& out);
 bool decode(std::span<const uint8_t> data, JoyMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PilotCommandMsg& m, std::string& error);
@@ -158,6 +175,7 @@ bool decode(std::span<const uint8_t> data, SolverStatsMsg& m, std::string& error
 bool decode(std::span<const uint8_t> data, PredictionMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, ModeChannelsMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, LambdaReasonMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, LogMsg& m, std::string& error);
 bool decode_float64(std::span<const uint8_t> data, double& v, std::string& error);
 
 // ---- recording --------------------------------------------------------------------------
@@ -220,6 +238,8 @@ class SessionRecorder {
   bool record_prediction(const PredictionMsg& m);
   bool record_channels(const ModeChannelsMsg& m);
   bool record_reason(const LambdaReasonMsg& m);
+  // At log time step·Δt with the stamp the message has (an event's start, before that step).
+  bool record_log(uint64_t step, const LogMsg& m);
 
   bool flush() { return writer_.flush(); }
   // Writes the "mixpilot_end" Metadata record (steps = the /vehicle/state messages recorded),
@@ -231,7 +251,7 @@ class SessionRecorder {
 
  private:
   enum Topic {
-    kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kReason,
+    kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kReason, kLog,
     kTopicCount
   };
   template <class Msg>
@@ -259,6 +279,7 @@ struct RecordingContents {
   std::vector<PredictionMsg> predictions;
   std::vector<ModeChannelsMsg> channels;
   std::vector<LambdaReasonMsg> reasons;  // empty in recordings older than the topic
+  std::vector<LogMsg> log;  // /rosout: the debrief's events (none in recordings older than it)
   bool complete = true;  // false: read from a cut-short temporary (allow_truncated)
   // The "mixpilot_end" record: absent when the file was cut short (or is older than it).
   std::optional<RecordingEnd> end;

@@ -26,6 +26,10 @@ bool RecordingSink::open(const std::string& path, const Mode& mode, const Sessio
   SessionInfo planned = info;
   planned.planned_steps = mode.steps_total();
   if (!recorder_.open(path, period_ns, planned, error, overwrite)) return false;
+  debrief_.setup(debrief_settings(mode));
+  logged_ = 0;
+  log_ = LogMsg{};
+  log_.name = kDebriefLogger;
   // Slots sized like the mode's telemetry: copying a step into one then allocates nothing.
   slots_.assign(std::size_t(std::max(settings.slots, 2)), mode.telemetry());
   head_ = 0;
@@ -151,6 +155,23 @@ void RecordingSink::write(const Telemetry& s) {
     channels_.values[i] = s.channels[i].value;
   }
   recorder_.record_channels(channels_);
+
+  debrief_.add(s);
+  write_events();
+}
+
+void RecordingSink::write_events() {
+  const std::vector<DebriefEvent>& events = debrief_.events();
+  const double r = debrief_.settings().ball_radius;
+  for (; logged_ < events.size(); ++logged_) {
+    const DebriefEvent& e = events[logged_];
+    log_.stamp = ros_time_from_ns(recorder_.log_time_ns(std::uint64_t(e.start_step)));
+    log_.level = static_cast<std::uint8_t>(log_level(e.kind));
+    char words[320];
+    log_.msg.assign(words, describe(e, r, words, sizeof words));
+    log_.function = to_string(e.kind);
+    recorder_.record_log(std::uint64_t(e.closed_step), log_);
+  }
 }
 
 bool RecordingSink::close(std::string& error, bool interrupted) {
@@ -162,6 +183,9 @@ bool RecordingSink::close(std::string& error, bool interrupted) {
   wake_.notify_one();
   writer_.join();
   open_ = false;
+  // The events still open end with the flight (after the last step recorded).
+  debrief_.finish();
+  write_events();
   return recorder_.close(error, interrupted, std::uint64_t(dropped_.load()));
 }
 

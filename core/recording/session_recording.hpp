@@ -4,6 +4,9 @@
 // into a fresh mixed-initiative session. With the same scenario and build, a replay reproduces
 // the original telemetry exactly.
 //
+// The writer thread also builds the flight's debrief (core/modes/debrief.hpp) from the steps it
+// writes, and records each event on /rosout as it closes; close() records those still open.
+//
 // The sink never writes on the stepping thread: on_sample() copies the step's telemetry into a
 // ring of slots sized at open(), and a writer thread beside the session encodes and writes it.
 // A full ring either waits for the writer (lossless, for as-fast-as-possible runs: nothing is
@@ -17,6 +20,7 @@
 #include <vector>
 
 #include "core/control/pilot.hpp"
+#include "core/modes/debrief.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/recording.hpp"
 
@@ -57,10 +61,13 @@ class RecordingSink final : public TelemetrySink {
   const std::string& temp_path() const { return recorder_.writer().tmp_path(); }
 
   std::int64_t dropped() const { return dropped_.load(); }  // steps lost to a full ring
+  // The debrief's events recorded so far (read it after close(): the writer thread builds it).
+  const std::vector<DebriefEvent>& events() const { return debrief_.events(); }
 
  private:
   void writer_loop();
   void write(const Telemetry& s);
+  void write_events();  // the debrief's events closed since the last call, on /rosout
 
   SessionRecorder recorder_;
   Settings settings_;
@@ -85,6 +92,10 @@ class RecordingSink final : public TelemetrySink {
   JoyMsg joy_;
   ModeChannelsMsg channels_;
   LambdaReasonMsg reason_;
+  // The debrief, built on the writer thread.
+  DebriefBuilder debrief_;
+  std::size_t logged_ = 0;  // events recorded
+  LogMsg log_;
 };
 
 class ReplayPilot final : public PilotSource {

@@ -1,7 +1,7 @@
 // Independent check of a mixpilot recording with the reference MCAP implementation
 // (@mcap/core) and Foxglove's ROS 2 message parser and CDR deserializer.
 //
-//   node check.mjs <file.mcap>
+//   node check.mjs <file.mcap> [--all TOPIC]...
 //
 // Prints one JSON object (see summarize() below) on stdout and exits 0, or prints
 // {"error": "..."} and exits 1. tests/test_mcap_independent.cpp compares the output with what
@@ -20,7 +20,9 @@ function plain(_key, value) {
   return value;
 }
 
-async function summarize(path) {
+// `all`: topics whose every message the summary lists (under "all", in log-time order, each
+// with its log time), not only the last one.
+async function summarize(path, all) {
   const bytes = new Uint8Array(await readFile(path));
 
   // 1. Indexed reader: footer, summary CRC, Summary/Statistics/MetadataIndex records.
@@ -50,6 +52,8 @@ async function summarize(path) {
   const readers = new Map();
   const counts = new Map();
   const last = {};
+  const every = {};
+  for (const topic of all) every[topic] = [];
   let header;
   let previousLogTime = -1n;
   for (let record; (record = stream.nextRecord()); ) {
@@ -73,6 +77,7 @@ async function summarize(path) {
       const message = reader.readMessage(record.data);
       counts.set(channel.topic, (counts.get(channel.topic) ?? 0) + 1);
       last[channel.topic] = message;
+      if (every[channel.topic]) every[channel.topic].push({ logTime: record.logTime, message });
     }
   }
   if (!stream.done()) throw new Error("stream reader did not reach the footer and trailing magic");
@@ -93,7 +98,7 @@ async function summarize(path) {
   const lastSorted = {};
   for (const topic of Object.keys(last).sort()) lastSorted[topic] = last[topic];
 
-  return {
+  const summary = {
     profile: header.profile,
     library: header.library,
     dataSectionCrc,
@@ -109,12 +114,19 @@ async function summarize(path) {
     metadata,
     last: lastSorted,
   };
+  if (all.length > 0) summary.all = every;
+  return summary;
 }
 
 try {
-  const path = process.argv[2];
-  if (!path) throw new Error("usage: node check.mjs <file.mcap>");
-  process.stdout.write(JSON.stringify(await summarize(path), plain) + "\n");
+  let [path, ...options] = process.argv.slice(2);
+  const all = [];
+  for (let i = 0; i < options.length; i += 2) {
+    if (options[i] !== "--all" || options[i + 1] === undefined) path = undefined;
+    else all.push(options[i + 1]);
+  }
+  if (!path) throw new Error("usage: node check.mjs <file.mcap> [--all TOPIC]...");
+  process.stdout.write(JSON.stringify(await summarize(path, all), plain) + "\n");
 } catch (error) {
   process.stdout.write(JSON.stringify({ error: String(error?.message ?? error) }) + "\n");
   process.exitCode = 1;
