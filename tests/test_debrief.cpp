@@ -42,6 +42,7 @@
 #include "ui/theme.hpp"
 
 #include "run_mixpilot.hpp"
+#include "scripted_pad.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -344,17 +345,7 @@ TEST(Debrief, TheIndependentReaderDecodesTheLogTopic) {
   has(all + "]}");
 }
 
-// A stick source the test scripts: sticks centred, unplugged over the steps [from, to).
-struct ScriptedPad : input::StickSource {
-  input::StickReading r;
-  std::int64_t step = 0, from = 0, to = 0;
-  std::string name() const override { return "gamepad"; }
-  const input::StickReading& latest() override {
-    r.connected = step < from || step >= to;
-    ++step;
-    return r;
-  }
-};
+using test::ScriptedPad;
 
 // (c) The gamepad unplugged at step 100 and plugged back at 300 (SPEC §6): an input lost event
 // from 1.5 s to 4.5 s ("back"), recorded as a warning; the planner's takeover over it says the

@@ -38,6 +38,7 @@
 #include "ui/screen.hpp"
 #include "ui/theme.hpp"
 
+#include "scripted_pad.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -164,17 +165,7 @@ TEST(Reason, EveryStepOfANoviceFlightReproducesLambdaFromTheRecordedPrediction) 
   }
 }
 
-// A stick source the test scripts: sticks centred, unplugged over [from, to) steps.
-struct ScriptedPad : input::StickSource {
-  input::StickReading r;
-  std::int64_t step = 0, from = 0, to = 0;
-  std::string name() const override { return "gamepad"; }
-  const input::StickReading& latest() override {
-    r.connected = step < from || step >= to;
-    ++step;
-    return r;
-  }
-};
+using test::ScriptedPad;
 
 // (b) The gamepad unplugged at step 100 and plugged back at 300, sticks centred: from the unplug
 // the cap is the input's (λ = 0: the planner flies), until the authority has returned above the
