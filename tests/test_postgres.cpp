@@ -457,35 +457,15 @@ TEST(Postgres, AWriterKilledMidTransactionLosesNothingCommitted) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "killed");
   { ASSERT_TRUE(open_store(url)); }
-  int fds[2];
-  ASSERT_EQ(::pipe(fds), 0);
   constexpr int kMetrics = 3000;  // a long transaction: the kill lands inside one
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    ::close(fds[0]);
-    std::string error;
-    auto store = history::open_history(url, error);
-    if (!store) ::_exit(2);
-    for (int i = 0;; ++i) {
-      FlightRecord f = sample_flight("killed", i);
-      f.metrics.clear();
-      for (int m = 0; m < kMetrics; ++m) f.metrics.emplace_back("m" + std::to_string(m), m);
-      if (store->add(f, error) != HistoryStore::Added::added) ::_exit(3);
-      const std::int32_t done = i;
-      if (::write(fds[1], &done, sizeof done) != sizeof done) ::_exit(4);
-    }
-  }
-  ::close(fds[1]);
-  std::int32_t last = -1, got = 0;
-  while (last < 5 && ::read(fds[0], &got, sizeof got) == sizeof got) last = got;
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // inside the next transaction
-  ::kill(pid, SIGKILL);
-  int st = 0;
-  ::waitpid(pid, &st, 0);
-  ASSERT_TRUE(WIFSIGNALED(st)) << "the writer ended before the kill: " << st;
-  while (::read(fds[0], &got, sizeof got) == sizeof got) last = got;  // reported before dying
-  ::close(fds[0]);
+  const test::KilledWriter w = test::kill_a_writer_mid_transaction(
+      [&] {
+        std::string error;
+        return history::open_history(url, error);
+      },
+      [](int i) { return sample_flight("killed", i); }, kMetrics, 5, std::chrono::milliseconds(20));
+  ASSERT_TRUE(w.killed) << "the writer ended before the kill: " << w.status;
+  const int last = w.last_reported;
   auto store = open_store(url);
   ASSERT_TRUE(store);
   std::string error;
