@@ -40,6 +40,12 @@ std::string reason_text(const Telemetry& s, double ball_radius) {
       return buf;
     case LambdaCap::probe: return "probe flight: you fly alone";
     case LambdaCap::safe_hold: return "safe hold: the safe controller flies";
+    case LambdaCap::instructor_ceiling:
+      std::snprintf(buf, sizeof buf, "instructor's ceiling: the planner keeps %.0f %%", planner);
+      return buf;
+    case LambdaCap::instructor_floor:
+      std::snprintf(buf, sizeof buf, "instructor's floor: you keep %.0f %%", 100.0 * s.lambda);
+      return buf;
     case LambdaCap::none: break;
   }
   if (r.node < 0) {

@@ -46,6 +46,7 @@ class MiController {
     double lambda_used = 0.5;
     LambdaReason reason_next;  // this step's prediction read by the PH index (cap none)
     LambdaReason reason;       // what decided lambda_used
+    AuthorityBounds bounds;    // the instructor's bounds on λ from the next step on
   };
 
   MiController() = default;
@@ -60,6 +61,11 @@ class MiController {
   // Initializes the trajectory at x (hover guess at its position); λ restarts at its initial
   // value until a prediction exists.
   void reset(const Eigen::VectorXd& x);
+
+  // The instructor's bounds on λ (SPEC §10) from the next step on; kept by reset(). Valid
+  // bounds only (AuthorityBounds::valid()).
+  void set_bounds(const AuthorityBounds& bounds) { out_.bounds = bounds; }
+  const AuthorityBounds& bounds() const { return out_.bounds; }
 
   // One control step at time t from the measured state x with the pilot's reference.
   // Allocates nothing. control() then holds τ to apply (never NaN).

@@ -20,6 +20,8 @@ const char* to_string(LambdaCap cap) {
     case LambdaCap::input_lost: return "input lost";
     case LambdaCap::probe: return "probe";
     case LambdaCap::safe_hold: return "safe hold";
+    case LambdaCap::instructor_ceiling: return "instructor ceiling";
+    case LambdaCap::instructor_floor: return "instructor floor";
   }
   return "?";
 }

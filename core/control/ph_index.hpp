@@ -30,16 +30,28 @@ struct PhIndexSettings {
 // λ(d_max) for a distance d_res (clipped to r).
 double ph_lambda(double d_res, const PhIndexSettings& s);
 
-// What held the λ of a step below the PH index, if anything. (The instructor's bounds of
-// SPEC §10 will be one more.)
+// SPEC §10 "Instructor bounds": λ_applied = min(max(λ, floor), ceiling, the input's cap). A
+// floor above 0 guarantees the pilot a share, a ceiling below 1 guarantees the planner one.
+struct AuthorityBounds {
+  double floor = 0.0;    // λ never below it (unless the input is lost)
+  double ceiling = 1.0;  // λ never above it
+  bool operator==(const AuthorityBounds&) const = default;
+  // 0 ≤ floor ≤ ceiling ≤ 1, both finite.
+  bool valid() const { return floor >= 0.0 && floor <= ceiling && ceiling <= 1.0; }
+};
+
+// What set the λ of a step other than the PH index, if anything.
 enum class LambdaCap : std::uint8_t {
   none = 0,        // λ is the PH index of the previous step's prediction
   input_lost = 1,  // the pilot source's authority: its input is lost or not back yet (SPEC §6)
   probe = 2,       // a probe flight (SPEC §10): the PH index is computed but not applied
   safe_hold = 3,   // the safe controller flew the step (the MPC's plan was spent): λ = 0
+  instructor_ceiling = 4,  // the instructor's (or lesson's) ceiling held λ down (SPEC §10)
+  instructor_floor = 5,    // the instructor's floor held λ up (SPEC §10)
 };
-const char* to_string(LambdaCap cap);  // "none", "input lost", "probe", "safe hold"
-inline constexpr int kLambdaCapCount = 4;
+// "none", "input lost", "probe", "safe hold", "instructor ceiling", "instructor floor"
+const char* to_string(LambdaCap cap);
+inline constexpr int kLambdaCapCount = 6;
 
 // What decided the λ of a mixed-initiative step (SPEC §10 "Why λ fell"). A value of fixed
 // size: telemetry carries it without allocating.

@@ -136,8 +136,11 @@ void DebriefBuilder::add(const Telemetry& s) {
     return false;
   };
 
-  // Takeover: λ below λ_T where something decided it (not the initial λ of the first step).
-  const bool decided = mi && s.solved && (s.reason.node >= 0 || s.reason.cap != LambdaCap::none);
+  // Takeover: λ below λ_T where something decided it (not the initial λ of the first step),
+  // other than the instructor's ceiling: that share of the planner is the instructor's choice,
+  // not something the pilot's flying caused.
+  const bool decided = mi && s.solved && (s.reason.node >= 0 || s.reason.cap != LambdaCap::none) &&
+                       s.reason.cap != LambdaCap::instructor_ceiling;
   if (run(takeover_, DebriefKind::takeover, decided && s.lambda < settings_.takeover_lambda,
           hold_steps_)) {
     DebriefEvent& e = takeover_.e;
@@ -236,6 +239,10 @@ void why_words(const DebriefEvent& e, double ball_radius, char* out, std::size_t
       return;
     case LambdaCap::safe_hold: std::snprintf(out, size, "the safe controller flew"); return;
     case LambdaCap::probe: std::snprintf(out, size, "a probe flight"); return;
+    case LambdaCap::instructor_ceiling:
+      std::snprintf(out, size, "the instructor's ceiling held it");
+      return;
+    case LambdaCap::instructor_floor: std::snprintf(out, size, "the instructor's floor held it"); return;
     case LambdaCap::none: break;
   }
   if (e.reason.node < 0) {

@@ -10,19 +10,10 @@
 
 #include <Eigen/Core>
 
+#include "core/control/ph_index.hpp"  // AuthorityBounds
 #include "core/modes/debrief.hpp"
 
 namespace mixpilot {
-
-// SPEC §10 "Instructor bounds": λ_applied = min(max(λ, floor), ceiling, the input's cap). A
-// floor above 0 guarantees the pilot a share, a ceiling below 1 guarantees the planner one.
-struct AuthorityBounds {
-  double floor = 0.0;    // λ never below it (unless the input is lost)
-  double ceiling = 1.0;  // λ never above it
-  bool operator==(const AuthorityBounds&) const = default;
-  // 0 ≤ floor ≤ ceiling ≤ 1, both finite.
-  bool valid() const { return floor >= 0.0 && floor <= ceiling && ceiling <= 1.0; }
-};
 
 enum class InstructorCommandKind : std::uint8_t {
   bounds = 0,       // authority bounds from the next step on

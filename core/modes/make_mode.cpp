@@ -60,6 +60,10 @@ std::unique_ptr<Mode> make_mi_mode(std::string_view text, const std::string& sou
     error = source_name + ": " + r.reason();
     return nullptr;
   }
+  if (!mode->set_authority_bounds(request.bounds)) {
+    error = source_name + ": the mode refused its authority bounds";
+    return nullptr;
+  }
   return mode;
 }
 
@@ -96,6 +100,17 @@ std::unique_ptr<Mode> make_mode(std::string_view text, const std::string& source
   }
   if (*kind != ModeKind::mixed_initiative && (request.pilot_source || !request.pilot_name.empty())) {
     error = source_name + ": a pilot flies only mixed_initiative scenarios, this one is " + *name;
+    return nullptr;
+  }
+  if (!request.bounds.valid()) {
+    error = source_name + ": authority bounds floor " + std::to_string(request.bounds.floor) +
+            ", ceiling " + std::to_string(request.bounds.ceiling) +
+            " are not 0 <= floor <= ceiling <= 1";
+    return nullptr;
+  }
+  if (*kind != ModeKind::mixed_initiative && request.bounds != AuthorityBounds{}) {
+    error = source_name + ": authority bounds are for mixed_initiative scenarios (a pilot shares "
+            "the authority λ with the planner), this one is " + *name;
     return nullptr;
   }
   if (*kind != ModeKind::mixed_initiative && request.assist == Assistance::off) {

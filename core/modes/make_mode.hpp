@@ -20,6 +20,9 @@ struct ModeRequest {
   std::string pilot_name;
   // Mixed initiative only: off flies a probe (SPEC §10; core/control/mi_settings.hpp).
   Assistance assist = Assistance::on;
+  // Mixed initiative only: the instructor's (a lesson's) bounds on λ from the first step on
+  // (SPEC §10).
+  AuthorityBounds bounds = {};
 };
 
 // The mode of a scenario's text (`source_name` for messages and relative paths), set up and

@@ -52,6 +52,12 @@ class MiMode final : public Mode {
   double lost_at() const override { return run_.lost_at; }
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
+  [[nodiscard]] bool set_authority_bounds(const AuthorityBounds& bounds) override {
+    if (!bounds.valid()) return false;
+    controller_.set_bounds(bounds);
+    return true;
+  }
+  AuthorityBounds authority_bounds() const override { return controller_.bounds(); }
   // The score; with a remote vehicle also rtt_s (the median round-trip sample) and
   // rtt_estimated_s (the final estimate).
   Metrics metrics() const override;

@@ -190,6 +190,14 @@ class Mode {
     (void)link;
     return false;
   }
+  // Mixed initiative (SPEC §10 "Instructor bounds"): λ kept within `bounds` from the next step
+  // on, below the input's own cap. false, changing nothing: this mode has no λ, or the bounds
+  // are not valid (AuthorityBounds::valid()). Part of the flight: a snapshot saves them.
+  [[nodiscard]] virtual bool set_authority_bounds(const AuthorityBounds& bounds) {
+    (void)bounds;
+    return false;
+  }
+  virtual AuthorityBounds authority_bounds() const { return {}; }
   // The states its remote vehicle sends, for the link to check ({}: it has none).
   virtual VehicleStateSpec remote_state() const { return {}; }
 

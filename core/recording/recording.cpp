@@ -23,6 +23,15 @@ uint64_t ros_time_to_ns(const RosTime& t) {
   return static_cast<uint64_t>(t.sec) * 1'000'000'000u + t.nanosec;
 }
 
+namespace {
+// The shortest text that reads back as exactly v.
+std::string exact_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+}  // namespace
+
 // ---- schemas ----------------------------------------------------------------------------
 // ros2msg text as rosbag2 stores it: the top-level definition, then each dependency after a
 // line of 80 '=' and "MSG: pkg/Type" (MCAP well-known schema encoding "ros2msg").
@@ -118,7 +127,8 @@ constexpr const char kLambdaReasonSchema[] =
     "int32 node              # i*, the node of that maximum; -1: no prediction yet\n"
     "float64 ahead           # [s] i* * dt\n"
     "float64[3] direction    # unit (eta - eta_r) at node i*, world frame; 0 when d_res = 0\n"
-    "uint8 cap               # 0 none, 1 input lost, 2 probe, 3 safe hold\n"
+    "uint8 cap               # 0 none, 1 input lost, 2 probe, 3 safe hold,\n"
+    "                        # 4 instructor ceiling, 5 instructor floor\n"
     "\n" MIXPILOT_TIME_DEP;
 // ROS 2's own rcl_interfaces/msg/Log (github.com/ros2/rcl_interfaces), as rosbag2 stores
 // /rosout, so log panels recognise it.
@@ -461,6 +471,10 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
                              {"planned_steps", std::to_string(info.planned_steps)},
                              {"control_period_ns", std::to_string(period_ns_)}};
   if (!info.assist.empty()) metadata.emplace("assist", info.assist);
+  if (info.bounds != AuthorityBounds{}) {
+    metadata.emplace("authority_floor", exact_text(info.bounds.floor));
+    metadata.emplace("authority_ceiling", exact_text(info.bounds.ceiling));
+  }
   if (info.parent_step >= 0) {
     metadata.emplace("parent_recording", info.parent_recording);
     metadata.emplace("parent_sha256", info.parent_sha256);

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/control/ph_index.hpp"  // AuthorityBounds
 #include "core/recording/cdr.hpp"
 #include "core/recording/mcap.hpp"
 
@@ -194,6 +195,10 @@ struct SessionInfo {
   // a replay flies again as one; "" (other modes): no key is written. A recording without the
   // key was assisted.
   std::string assist = {};
+  // Mixed initiative: the instructor's (or a lesson's) bounds on λ at the first step (SPEC
+  // §10); written as authority_floor / authority_ceiling where not [0, 1], and a replay flies
+  // with them. RecordingSink::open() takes them from the mode.
+  AuthorityBounds bounds = {};
   // Fly from here (SPEC §10): a branch names its parent recording (its absolute path and
   // SHA-256) and the parent's step k it was taken over at, its own first step. "" / −1: none.
   std::string parent_recording = {};

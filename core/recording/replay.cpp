@@ -1,6 +1,9 @@
 #include "core/recording/replay.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <system_error>
 #include <cstdio>
 #include <cstdlib>
 
@@ -51,6 +54,37 @@ std::optional<Assistance> recorded_assistance(const RecordingContents& rec,
   return std::nullopt;
 }
 
+std::optional<AuthorityBounds> recorded_bounds(const RecordingContents& rec,
+                                               const std::string& path, std::string& error) {
+  AuthorityBounds b;
+  const auto read = [&](const char* key, double& out) {
+    const auto it = rec.metadata.find(key);
+    if (it == rec.metadata.end()) return true;
+    const std::string& text = it->second;
+    double v = 0.0;
+    const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (r.ec != std::errc{} || r.ptr != text.data() + text.size() || !std::isfinite(v)) {
+      error = path + ": its '" + key + "' metadata is '" + printable(text) +
+              "', expected a number from 0 to 1";
+      return false;
+    }
+    out = v;
+    return true;
+  };
+  if (!read("authority_floor", b.floor) || !read("authority_ceiling", b.ceiling))
+    return std::nullopt;
+  if (!b.valid()) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  ": its authority bounds (floor %.17g, ceiling %.17g) are not 0 <= floor <= "
+                  "ceiling <= 1",
+                  b.floor, b.ceiling);
+    error = path + text;
+    return std::nullopt;
+  }
+  return b;
+}
+
 namespace {
 
 // The steps of the recorded (real-time) flight marked with `event`.
@@ -91,6 +125,9 @@ std::unique_ptr<Mode> replay_own_steps(const RecordingContents& rec, const std::
   if (!duration && dt > 0.0)
     request.duration = double(std::max(planned_steps(rec), recorded)) * dt;
   if (mi) {
+    const std::optional<AuthorityBounds> bounds = recorded_bounds(rec, path, error);
+    if (!bounds) return nullptr;
+    request.bounds = *bounds;
     request.assist = assist;
     request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path, first);
   }

@@ -38,6 +38,11 @@ std::string embedded_scenario_source(const RecordingContents& rec, const std::st
 // nullopt with "<path>: ..." for a value other than on or off.
 std::optional<Assistance> recorded_assistance(const RecordingContents& rec,
                                               const std::string& path, std::string& error);
+// The authority bounds the recorded flight started with (its authority_floor /
+// authority_ceiling metadata; [0, 1] when absent); nullopt with "<path>: ..." for a value that
+// is not a number or bounds that are not 0 <= floor <= ceiling <= 1.
+std::optional<AuthorityBounds> recorded_bounds(const RecordingContents& rec,
+                                               const std::string& path, std::string& error);
 
 // A fresh flight of `scenario_text` for the recording: mixed initiative replays the recorded
 // pilot commands and is as long as they are, assisted or as a probe as it was recorded; other

@@ -25,6 +25,7 @@ bool RecordingSink::open(const std::string& path, const Mode& mode, const Sessio
   const auto period_ns = std::uint64_t(std::llround(mode.dt() * 1e9));
   SessionInfo planned = info;
   planned.planned_steps = mode.steps_total();
+  planned.bounds = mode.authority_bounds();
   if (!recorder_.open(path, period_ns, planned, error, overwrite)) return false;
   debrief_.setup(debrief_settings(mode));
   logged_ = 0;
