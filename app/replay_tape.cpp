@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 
 #include "app/cli.hpp"
 #include "core/modes/session.hpp"
@@ -42,10 +43,22 @@ class TapeSink final : public TelemetrySink {
 ReplayTape::ReplayTape(std::unique_ptr<FlightRig> rig, std::string path)
     : rig_(std::move(rig)), path_(std::move(path)) {
   const Mode& mode = rig_->mode();
-  const std::string& pilot = rig_->flight().pilot;
   dt_ = mode.dt();
-  scene_ = ui::scene_of(mode, pilot.empty() ? std::string("replay of ") + path_
-                                            : "replay of " + path_ + " (" + pilot + ")");
+  // "replay of FILE · flown by WHO": the recorded trainee, else the recorded pilot source (a
+  // replay's own pilot source is the recording, which the title already names).
+  std::string who;
+  if (const auto& rec = rig_->flight().recording) {
+    for (const char* key : {"trainee", "pilot"}) {
+      const auto it = rec->metadata.find(key);
+      if (it != rec->metadata.end() && !it->second.empty()) {
+        who = it->second;
+        break;
+      }
+    }
+  }
+  const std::string file = std::filesystem::path(path_).filename().string();
+  scene_ = ui::scene_of(mode, who.empty() ? "replay of " + file
+                                          : "replay of " + file + " \u00b7 flown by " + who);
   debrief_ = debrief_settings(mode);
   tape_.assign(std::size_t(std::max<std::int64_t>(mode.steps_total(), 0)), mode.telemetry());
 }
