@@ -51,7 +51,8 @@ constexpr const char* kUsage =
     "                     permissions.p7s; packaging/dds-security-ca.sh makes a test set)\n"
     "  --issuer NAME      who commands (default: login@host); a station keeps each issuer's\n"
     "                     commands in order\n"
-    "  --count N          --list: stop as soon as N stations and their telemetry are heard\n"
+    "  --count N          --list: stop as soon as N stations, their telemetry and a fresh\n"
+    "                     announcement of each are heard\n"
     "  --wait S           how long to wait for the stations, or for the answer (default 10)\n"
     "  --sequence N       number the command N instead of the next number (the system\n"
     "                     clock's microseconds): a number not above the last one a station\n"
@@ -263,7 +264,9 @@ int instruct_command(int argc, char** argv) {
       client.poll(0.05);
       if (count > 0) {
         int heard = 0;
-        for (const net::StationView& v : client.stations()) heard += v.poses > 0 ? 1 : 0;
+        // Its telemetry, and an announcement newer than the one kept for late joiners.
+        for (const net::StationView& v : client.stations())
+          heard += v.poses > 0 && v.announcements >= 2 ? 1 : 0;
         if (heard >= count) break;
       }
     }
@@ -296,7 +299,9 @@ int instruct_command(int argc, char** argv) {
     return kExitError;
   }
   std::optional<net::CommandRefusal> result;
-  while (clock::now() < deadline && !(result = client.result(station, number))) client.poll(0.05);
+  const std::int64_t issued = client.last_issued_ns();
+  while (clock::now() < deadline && !(result = client.result(station, number, issued)))
+    client.poll(0.05);
   const std::string what = net::describe(c);
   if (!result) {
     std::fprintf(stderr, "mixpilot %s: station %s did not say what became of %s (number %llu) "

@@ -170,7 +170,7 @@ void InstructorClient::read_status() {
     v.recent.clear();
     for (std::uint32_t r = 0; r < m.recent._length; ++r) {
       const auto& c = m.recent._buffer[r];
-      v.recent.push_back({text(c.issuer, sizeof c.issuer), c.sequence_number,
+      v.recent.push_back({text(c.issuer, sizeof c.issuer), c.sequence_number, c.issued_ns,
                           c.result < kCommandRefusals ? CommandRefusal(c.result)
                                                       : CommandRefusal::bad_value});
     }
@@ -297,6 +297,7 @@ bool InstructorClient::send_fields(const InstructorFields& f, std::string& error
   std::copy(f.force.begin(), f.force.end(), m.force);
   m.duration = f.duration;
   m.delay = f.delay;
+  last_issued_ns_ = f.issued_ns;
   const dds_return_t rc = dds_write(writer_, &m);
   if (rc < 0) {
     error = "DDS: the command was not written (" + dds_error(rc) + ")";
@@ -305,12 +306,16 @@ bool InstructorClient::send_fields(const InstructorFields& f, std::string& error
   return true;
 }
 
-std::optional<CommandRefusal> InstructorClient::result(const std::string& station,
-                                                       std::uint64_t sequence) const {
+std::optional<CommandRefusal> InstructorClient::result(
+    const std::string& station, std::uint64_t sequence,
+    std::optional<std::int64_t> issued_ns) const {
   const auto it = stations_.find(station);
   if (it == stations_.end()) return std::nullopt;
-  for (const CommandResultView& r : it->second.recent)
-    if (r.issuer == options_.issuer && r.sequence == sequence) return r.result;
+  const std::vector<CommandResultView>& recent = it->second.recent;
+  for (auto r = recent.rbegin(); r != recent.rend(); ++r)
+    if (r->issuer == options_.issuer && r->sequence == sequence &&
+        (!issued_ns || r->issued_ns == *issued_ns))
+      return r->result;
   return std::nullopt;
 }
 

@@ -27,6 +27,7 @@ namespace mixpilot::net {
 struct CommandResultView {
   std::string issuer;
   std::uint64_t sequence = 0;
+  std::int64_t issued_ns = 0;
   CommandRefusal result = CommandRefusal::none;
 };
 
@@ -86,8 +87,13 @@ class InstructorClient {
                           std::optional<std::int64_t> issued_ns = std::nullopt);
   // Sends raw fields, as given (tests: values a checked command never has).
   [[nodiscard]] bool send_fields(const InstructorFields& f, std::string& error);
-  // What `station` announced of `issuer`'s command `sequence`, once it has.
-  std::optional<CommandRefusal> result(const std::string& station, std::uint64_t sequence) const;
+  // What `station` announced of this issuer's command `sequence` (the newest so numbered; the
+  // one issued at `issued_ns` when given, so an earlier command of the same number, such as
+  // the original of a replay, is not taken for it), once it has.
+  std::optional<CommandRefusal> result(const std::string& station, std::uint64_t sequence,
+                                       std::optional<std::int64_t> issued_ns = std::nullopt) const;
+  // The issue time of the newest command sent.
+  std::int64_t last_issued_ns() const { return last_issued_ns_; }
 
   const Options& options() const { return options_; }
 
@@ -104,6 +110,7 @@ class InstructorClient {
   std::map<std::uint64_t, std::string> writers_;  // publication handle → station
   std::map<std::string, std::array<unsigned char, 16>> participants_;  // station → its participant
   std::uint64_t last_sequence_ = 0;
+  std::int64_t last_issued_ns_ = 0;
 };
 
 // The command in words: "ceiling 0.3", "gust (2, 0, 0) N for 0.5 s", "marker \"text\"", ...

@@ -258,6 +258,7 @@ void InstructorLink::take_commands() {
     const std::string_view issuer = f.issuer.substr(0, kMaxIssuer);
     std::memcpy(r.issuer.data(), issuer.data(), issuer.size());
     r.sequence = m.sequence_number;
+    r.issued_ns = m.issued_ns;
     r.result = std::uint8_t(result);
   }
   dds_return_loan(reader_, samples, n);
@@ -292,6 +293,7 @@ void InstructorLink::announce() {
   for (int i = 0; i < recent_count_; ++i) {
     put(recent[i].issuer, std::string_view(recent_[std::size_t(i)].issuer.data()));
     recent[i].sequence_number = recent_[std::size_t(i)].sequence;
+    recent[i].issued_ns = recent_[std::size_t(i)].issued_ns;
     recent[i].result = recent_[std::size_t(i)].result;
   }
   s.recent._maximum = s.recent._length = std::uint32_t(recent_count_);

@@ -131,6 +131,7 @@ class InstructorLink final : public TelemetrySink {
   struct Result {
     std::array<char, kMaxIssuer + 1> issuer{};
     std::uint64_t sequence = 0;
+    std::int64_t issued_ns = 0;
     std::uint8_t result = 0;
   };
   std::array<Result, kRecent> recent_{};
