@@ -14,6 +14,7 @@
 #include "app/flight.hpp"
 #include "app/flight_rig.hpp"
 #include "app/ghost.hpp"
+#include "app/station_settings.hpp"
 #include "core/recording/replay.hpp"
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
@@ -75,7 +76,9 @@ constexpr const char* kFlyUsage =
     "  --station NAME     with --publish: this station's name (default: host name-process id)\n"
     "  --instructor       with --publish: obey an instructor's commands (authority bounds,\n"
     "                     gusts, markers, pause...), checked and counted; only from a\n"
-    "                     certified instructor over DDS Security (docs/instructor-security.md)\n"
+    "                     certified instructor over DDS Security (docs/instructor-security.md).\n"
+    "                     $XDG_CONFIG_HOME/mixpilot/station.toml may set name, instructor and\n"
+    "                     dds_security for every flight that publishes (the options win)\n"
     "  --dds-security FOLDER  with --publish: authenticate with this identity's DDS Security\n"
     "                     files (identity_ca.pem, cert.pem, key.pem, permissions_ca.pem,\n"
     "                     governance.p7s, permissions.p7s; packaging/dds-security-ca.sh)\n"
@@ -568,8 +571,21 @@ int fly_command(int argc, char** argv) {
                                                                  : "--allow-unauthenticated-commands") +
                                " goes with --publish (the station is announced and commanded "
                                "over DDS)");
+  if (o.publish) {
+    // The station's settings, under what the command line says.
+    std::string error;
+    const std::optional<StationSettings> st = load_station_settings("", error);
+    if (!st) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+    if (o.station.empty()) o.station = st->name;
+    o.instructor = o.instructor || st->instructor;
+    if (o.dds_security.empty()) o.dds_security = st->dds_security;
+  }
   if (o.allow_unauthenticated_commands && !o.instructor)
-    usage_error(o.command, "--allow-unauthenticated-commands goes with --instructor");
+    usage_error(o.command, "--allow-unauthenticated-commands goes with --instructor (or "
+                           "instructor = true in station.toml)");
   if (o.ghost == "best" && o.history == "off")
     usage_error(o.command, "--ghost best is read from the history: not with --history off "
                            "(name a recording: --ghost REC.mcap)");

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <regex>
 #include <string>
@@ -428,6 +429,33 @@ TEST_F(InstructorNet, TheCommandLineSaysWhatIsWrong) {
   EXPECT_NE(read_file(dir / "off.txt").find("--allow-unauthenticated-commands is accepted only "
                                             "while DDS stays on this machine"),
             std::string::npos) << read_file(dir / "off.txt");
+}
+
+// $XDG_CONFIG_HOME/mixpilot/station.toml names the station and lets it obey an instructor for
+// every flight that publishes; the command line wins; a broken file is said with its place.
+TEST_F(InstructorNet, AStationsSettingsNameItAndAllowAnInstructor) {
+  const fs::path dir = test::fresh_path("instructor_net", "settings");
+  fs::create_directories(dir / "config" / "mixpilot");
+  const fs::path settings = dir / "config" / "mixpilot" / "station.toml";
+  std::ofstream(settings) << "name = \"from-settings\"\ninstructor = true\n";
+  const std::string fly = "fly --scenario " + kSrc + "/scenarios/mi_helix.toml --pilot novice "
+                          "--headless --duration 0.3 --history off --publish --domain " +
+                          std::to_string(domain_) + " --allow-unauthenticated-commands";
+  ASSERT_EQ(run(fly, dir), 0) << read_file(dir / "out.txt");
+  EXPECT_NE(read_file(dir / "out.txt").find("station from-settings announced on "
+                                            "rt/mixpilot/station"), std::string::npos)
+      << read_file(dir / "out.txt");
+  EXPECT_NE(read_file(dir / "out.txt").find("obeyed unauthenticated"), std::string::npos);
+  ASSERT_EQ(run(fly + " --station cli-name", dir), 0) << read_file(dir / "out.txt");
+  EXPECT_NE(read_file(dir / "out.txt").find("station cli-name announced"), std::string::npos);
+  std::ofstream(settings) << "name = \"s\"\ninstructor = \"yes\"\n";
+  EXPECT_EQ(run(fly, dir), 1);
+  EXPECT_NE(read_file(dir / "out.txt").find("station.toml:2:14: instructor: expected true or "
+                                            "false"), std::string::npos)
+      << read_file(dir / "out.txt");
+  std::ofstream(settings) << "nmae = \"s\"\n";
+  EXPECT_EQ(run(fly, dir), 1);
+  EXPECT_NE(read_file(dir / "out.txt").find("nmae: not a station setting"), std::string::npos);
 }
 
 // --- DDS Security -------------------------------------------------------------------------------
