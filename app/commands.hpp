@@ -13,5 +13,6 @@ int gamepad_script_command(int argc, char** argv);
 int joy_publish_command(int argc, char** argv);
 int vehicle_command(int argc, char** argv);
 int history_command(int argc, char** argv);
+int instruct_command(int argc, char** argv);
 
 }  // namespace mixpilot::cli

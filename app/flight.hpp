@@ -64,7 +64,12 @@ struct FlyOptions {
   // flight, as recorded for a replay (which refuses another value).
   std::optional<Assistance> assist;
   std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
-  bool publish = false;            // --publish: telemetry out over DDS
+  bool publish = false;            // --publish: telemetry out over DDS, the station announced
+  // The instructor's network (SPEC §10, docs/instructor-security.md), with --publish:
+  std::string station;             // --station: this station's name ("" → host-pid)
+  bool instructor = false;         // --instructor: obey an instructor's commands
+  std::string dds_security;        // --dds-security FOLDER: this identity's DDS Security files
+  bool allow_unauthenticated_commands = false;  // --allow-unauthenticated-commands (loopback)
   std::string vehicle;             // --vehicle: "" (simulated) or "dds" (mixpilot vehicle)
   double vehicle_wait_s = 30.0;    // --vehicle-wait: how long to wait for the vehicle
   std::string trainee;             // --trainee: who flies ("" → the login name; SPEC §10)

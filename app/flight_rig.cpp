@@ -71,13 +71,47 @@ void FlightRig::cancel_vehicle_wait() {
 
 bool FlightRig::publish(std::string& error) {
   net::use_loopback_unless_configured();
+  // The station's identity and policy first: a station that cannot say what it obeys does not
+  // fly.
+  net::InstructorLink::Options lo;
+  lo.domain = options_.domain;
+  if (!options_.dds_security.empty()) {
+    const std::optional<net::SecurityFiles> files =
+        net::security_files(options_.dds_security, error);
+    if (!files) return false;
+    net::use_security(*files);
+  }
+  if (!net::command_security(options_.instructor, net::security_configured(),
+                             options_.allow_unauthenticated_commands, lo.security, error))
+    return false;
+  lo.station.name = options_.station.empty() ? net::default_station_name() : options_.station;
+  if (const std::string why = net::check_station_name(lo.station.name); !why.empty()) {
+    error = "--station: " + why;
+    return false;
+  }
+  const Mode& mode = *flight_.mode;
+  lo.station.trainee = options_.trainee.empty() ? history::login_name() : options_.trainee;
+  lo.station.scenario = mode.scenario_name();
+  lo.station.mode = to_string(mode.kind());
+  lo.station.duration = double(mode.steps_total()) * mode.dt();
+  lo.station.ball_radius = mode.view().ball_radius;
   publisher_.emplace();
-  if (!publisher_->start(options_.domain, flight_.mode->telemetry(), error)) {
+  if (!publisher_->start(options_.domain, mode.telemetry(), error, lo.station.name)) {
+    publisher_.reset();
+    error = "--publish: " + error;
+    return false;
+  }
+  instructor_commands_.setup(64, InstructorCommand{});
+  instructor_.emplace();
+  if (!instructor_->start(lo, &instructor_commands_, error)) {
+    instructor_.reset();
+    publisher_->stop();
     publisher_.reset();
     error = "--publish: " + error;
     return false;
   }
   session_->add_sink(&*publisher_);
+  session_->add_sink(&*instructor_);
   return true;
 }
 
@@ -131,6 +165,13 @@ FlightRig::Closed FlightRig::close(bool interrupted) {
     c.published = true;
     c.published_steps = publisher_->published();
     c.publish_dropped = publisher_->dropped();
+  }
+  if (instructor_) {
+    instructor_->set_state(net::StationState::ended);
+    instructor_->stop();
+    c.station = instructor_->options().station.name;
+    c.command_security = instructor_->options().security;
+    c.instructor = instructor_->stats();
   }
   if (flight_.vehicle) flight_.vehicle->finish();
   if (!record_path_.empty()) {
@@ -228,6 +269,48 @@ std::string FlightRig::replay_difference_so_far() const {
   if (!check_) return {};
   if (std::string d = parent_difference(*flight_.mode); !d.empty()) return d;
   return check_->difference_so_far();
+}
+
+namespace {
+
+const char* obeys(net::CommandSecurity s) {
+  switch (s) {
+    case net::CommandSecurity::no_instructor: return "refused (it obeys no instructor: --instructor)";
+    case net::CommandSecurity::dds_security: return "obeyed from a certified instructor (DDS Security)";
+    case net::CommandSecurity::unauthenticated_loopback:
+      return "obeyed unauthenticated (--allow-unauthenticated-commands, loopback only)";
+    case net::CommandSecurity::unauthenticated_refused:
+      return "refused: no DDS Security configured (--dds-security FOLDER)";
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string station_started(const net::InstructorLink& link) {
+  const auto& o = link.options();
+  return "station " + o.station.name + " announced on " + net::kStationTopic + " (domain " +
+         std::to_string(o.domain) + "); instructor commands " + obeys(o.security);
+}
+
+std::string station_summary(const FlightRig::Closed& c) {
+  if (c.station.empty()) return {};
+  const net::InstructorLinkStats& s = c.instructor;
+  std::string out = "  station " + c.station + ": instructor commands " +
+                    obeys(c.command_security) + "; " + std::to_string(s.accepted) +
+                    " accepted, " + std::to_string(s.refused_total()) + " refused";
+  std::string reasons;
+  for (int r = 1; r < net::kCommandRefusals; ++r)
+    if (const std::uint64_t n = s.refused[std::size_t(r)]; n > 0)
+      reasons += (reasons.empty() ? "" : ", ") + std::to_string(n) + " " +
+                 net::to_string(net::CommandRefusal(r));
+  if (!reasons.empty()) out += " (" + reasons + ")";
+  out += "\n";
+  if (!s.last_refusal.empty()) out += "    the newest refused: " + s.last_refusal + "\n";
+  if (s.security_refused > 0)
+    out += "    DDS Security refused peers " + std::to_string(s.security_refused) +
+           " times; the newest: " + s.security_last + "\n";
+  return out;
 }
 
 }  // namespace mixpilot::cli

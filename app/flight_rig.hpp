@@ -14,6 +14,8 @@
 //   control       RealtimeRunner (core/runtime), SCHED_FIFO 10   the rig of a paced flight
 //   recorder      RecordingSink's writer (core/recording)        the rig, while recording
 //   publisher     net::TelemetryPublisher (input/net)            the rig, with --publish
+//   instructor    net::InstructorLink (input/net): announces the  the rig, with --publish
+//                 station, takes commands into the rig's ring
 //   vehicle link  net::RemoteVehicle's reader (input/net), and   the rig's Flight, with
 //                 Cyclone's receive threads, SCHED_FIFO 10 where  --vehicle dds
 //                 allowed (core/base/realtime_priority.hpp)
@@ -46,6 +48,9 @@
 #include "core/recording/replay.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
+#include "core/base/spsc_ring.hpp"
+#include "core/modes/instructor.hpp"
+#include "input/net/instructor_link.hpp"
 #include "input/net/telemetry_publisher.hpp"
 
 namespace mixpilot::cli {
@@ -74,7 +79,10 @@ class FlightRig {
   // Stops waiting (Esc): the next poll fails with "no vehicle heard".
   void cancel_vehicle_wait();
 
-  // Sinks, added before start(). publish(): the telemetry over DDS (--publish);
+  // Sinks, added before start(). publish(): the telemetry over DDS (--publish), and the
+  // station announced to instructors, whose commands it takes (--instructor) into
+  // instructor_commands() (SPEC §10; --station, --dds-security,
+  // --allow-unauthenticated-commands);
   // record(): the flight into `path` (a paced flight drops steps rather than wait for the
   // disk: `settings`). False with the reason.
   [[nodiscard]] bool publish(std::string& error);
@@ -112,6 +120,10 @@ class FlightRig {
     std::string error;           // the recording could not be completed ("" when fine)
     bool published = false;      // --publish: the publisher's counts
     std::uint64_t published_steps = 0, publish_dropped = 0;
+    // --publish: the station's name and what became of the instructor's commands.
+    std::string station;
+    net::CommandSecurity command_security = net::CommandSecurity::no_instructor;
+    net::InstructorLinkStats instructor;
     // remember(): the flight's row was handed to the writer (its outcome comes from there).
     bool remembering = false;
   };
@@ -144,6 +156,11 @@ class FlightRig {
   Flight& flight() { return flight_; }
   const FlyOptions& options() const { return options_; }
   net::TelemetryPublisher* publisher() { return publisher_ ? &*publisher_ : nullptr; }
+  // --publish: the station's link to instructors (nullptr otherwise).
+  net::InstructorLink* instructor_link() { return instructor_ ? &*instructor_ : nullptr; }
+  // The commands the station's link took, oldest first: the control thread is their consumer
+  // (it applies them between two steps); sized once, a full ring refuses a command as busy.
+  SpscRing<InstructorCommand>& instructor_commands() { return instructor_commands_; }
 
  private:
   FlightRig(FlyOptions o, Flight f);
@@ -154,6 +171,8 @@ class FlightRig {
   std::optional<ReplayCheck> check_;             // flying a recording's pilot commands
   std::optional<HapticSink> haptic_;             // a gamepad pilot: λ to the rumble
   std::optional<net::TelemetryPublisher> publisher_;
+  SpscRing<InstructorCommand> instructor_commands_;  // before the link: it outlives it
+  std::optional<net::InstructorLink> instructor_;
   RecordingSink recorder_;
   std::string record_path_;                      // "" when not recording
   std::unique_ptr<RealtimeRunner> runner_;
@@ -165,5 +184,12 @@ class FlightRig {
   std::string trainee_, front_end_;
   bool completed_recording_ = false;        // close() completed record_path_
 };
+
+// The station's lines of a summary (--publish): its name, how it treats an instructor's
+// commands, how many it accepted and refused by reason, the newest refusal, and what DDS
+// Security refused of the peers. "" without a station.
+std::string station_summary(const FlightRig::Closed& c);
+// "station NAME on rt/mixpilot/station (domain N): instructor commands ..." when it starts.
+std::string station_started(const net::InstructorLink& link);
 
 }  // namespace mixpilot::cli

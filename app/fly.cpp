@@ -14,6 +14,7 @@
 #include "app/flight.hpp"
 #include "app/flight_rig.hpp"
 #include "app/ghost.hpp"
+#include "app/station_settings.hpp"
 #include "core/recording/replay.hpp"
 #include "app/screenshot.hpp"
 #include "app/offscreen.hpp"
@@ -68,7 +69,21 @@ constexpr const char* kFlyUsage =
     "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
     "                     user's $XDG_CONFIG_HOME/mixpilot/input.toml, docs/input-settings.md)\n"
     "  --publish          publish the telemetry over DDS at the control rate (ROS 2 types:\n"
-    "                     rt/mixpilot/pose, lambda, predicted_path, reference_path)\n"
+    "                     rt/mixpilot/pose, lambda, predicted_path, reference_path) and\n"
+    "                     announce this station to instructors (rt/mixpilot/station, twice\n"
+    "                     a second: trainee, scenario, state, t, λ, deviation, the\n"
+    "                     commands accepted and refused; SPEC §10)\n"
+    "  --station NAME     with --publish: this station's name (default: host name-process id)\n"
+    "  --instructor       with --publish: obey an instructor's commands (authority bounds,\n"
+    "                     gusts, markers, pause...), checked and counted; only from a\n"
+    "                     certified instructor over DDS Security (docs/instructor-security.md).\n"
+    "                     $XDG_CONFIG_HOME/mixpilot/station.toml may set name, instructor and\n"
+    "                     dds_security for every flight that publishes (the options win)\n"
+    "  --dds-security FOLDER  with --publish: authenticate with this identity's DDS Security\n"
+    "                     files (identity_ca.pem, cert.pem, key.pem, permissions_ca.pem,\n"
+    "                     governance.p7s, permissions.p7s; packaging/dds-security-ca.sh)\n"
+    "  --allow-unauthenticated-commands  with --instructor: obey commands without DDS\n"
+    "                     Security; accepted only while CYCLONEDDS_URI keeps DDS on loopback\n"
     "  --vehicle sim|dds  sim (default): the plant is simulated in this process; dds: the\n"
     "                     vehicle of `mixpilot vehicle` flies over DDS, with the round-trip\n"
     "                     time estimated online (crazyflie_tracking, mixed_initiative;\n"
@@ -310,6 +325,7 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
     std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
                 (unsigned long long)closed.published_steps, unsigned(o.domain),
                 (unsigned long long)closed.publish_dropped);
+  std::fputs(station_summary(closed).c_str(), stdout);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
   if (ghost) print_ghost(*ghost, mode);
   if (!o.report.empty()) {
@@ -409,9 +425,13 @@ int run_fly(const FlyOptions& o) {
       return kExitError;
     }
   }
-  if (o.publish && !rig->publish(error)) {
-    std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
-    return kExitError;
+  if (o.publish) {
+    if (!rig->publish(error)) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+    std::printf("mixpilot %s: %s\n", o.command, station_started(*rig->instructor_link()).c_str());
+    std::fflush(stdout);
   }
   if (!o.record.empty()) {
     // Real-time runs never wait for the disk: a full ring drops (and counts) steps.
@@ -505,6 +525,16 @@ int fly_command(int argc, char** argv) {
       o.input_settings = value();
     } else if (a == "--publish") {
       o.publish = true;
+    } else if (a == "--station") {
+      o.station = value();
+      if (const std::string why = net::check_station_name(o.station); !why.empty())
+        usage_error(o.command, "--station: " + why);
+    } else if (a == "--instructor") {
+      o.instructor = true;
+    } else if (a == "--dds-security") {
+      o.dds_security = value();
+    } else if (a == "--allow-unauthenticated-commands") {
+      o.allow_unauthenticated_commands = true;
     } else if (a == "--vehicle") {
       o.vehicle = value();
       if (o.vehicle == "sim") o.vehicle.clear();
@@ -533,6 +563,29 @@ int fly_command(int argc, char** argv) {
       usage_error(o.command, "unknown option '" + std::string(a) + "'");
     }
   }
+  if (!o.publish && (o.instructor || !o.station.empty() || !o.dds_security.empty() ||
+                     o.allow_unauthenticated_commands))
+    usage_error(o.command, std::string(o.instructor ? "--instructor"
+                                       : !o.station.empty() ? "--station"
+                                       : !o.dds_security.empty() ? "--dds-security"
+                                                                 : "--allow-unauthenticated-commands") +
+                               " goes with --publish (the station is announced and commanded "
+                               "over DDS)");
+  if (o.publish) {
+    // The station's settings, under what the command line says.
+    std::string error;
+    const std::optional<StationSettings> st = load_station_settings("", error);
+    if (!st) {
+      std::fprintf(stderr, "mixpilot %s: %s\n", o.command, error.c_str());
+      return kExitError;
+    }
+    if (o.station.empty()) o.station = st->name;
+    o.instructor = o.instructor || st->instructor;
+    if (o.dds_security.empty()) o.dds_security = st->dds_security;
+  }
+  if (o.allow_unauthenticated_commands && !o.instructor)
+    usage_error(o.command, "--allow-unauthenticated-commands goes with --instructor (or "
+                           "instructor = true in station.toml)");
   if (o.ghost == "best" && o.history == "off")
     usage_error(o.command, "--ghost best is read from the history: not with --history off "
                            "(name a recording: --ghost REC.mcap)");

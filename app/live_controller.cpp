@@ -221,6 +221,7 @@ int LiveController::finish() {
     std::printf("  published %llu steps on rt/mixpilot/* (domain %u; %llu dropped)\n",
                 (unsigned long long)f.closing.published_steps, unsigned(options_.domain),
                 (unsigned long long)f.closing.publish_dropped);
+  std::fputs(station_summary(f.closing).c_str(), stdout);
   if (!options_.report.empty()) {
     const std::string json = to_json(f.rig->labels(!mode.finished()), f.rig->metrics()) + "\n";
     std::string error;

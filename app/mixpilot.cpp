@@ -28,6 +28,7 @@ constexpr const char* kUsage =
     "  gamepad-script  a recording's pilot commands as a virtual gamepad's script\n"
     "  joy-publish     a recording's sticks as sensor_msgs/msg/Joy over DDS\n"
     "  vehicle         a scenario's vehicle in its own process, for fly --vehicle dds\n"
+    "  instruct        the instructor: list the stations (fly --publish), command one\n"
     "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
@@ -144,6 +145,7 @@ int dispatch(int argc, char** argv) {
   if (cmd == "joy-publish") return joy_publish_command(argc, argv);
   if (cmd == "vehicle") return vehicle_command(argc, argv);
   if (cmd == "history") return history_command(argc, argv);
+  if (cmd == "instruct") return instruct_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

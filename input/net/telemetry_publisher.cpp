@@ -24,20 +24,26 @@ char kWorld[] = "world";
 }  // namespace
 
 bool TelemetryPublisher::start(std::uint32_t domain, const Telemetry& prototype,
-                               std::string& error) {
+                               std::string& error, const std::string& station) {
   if (!participant_.open(domain, error)) return false;
+  dds_qos_t* qos = dds_create_qos();
+  const std::string tag = station_tag(station);
+  if (!station.empty()) dds_qset_userdata(qos, tag.data(), tag.size());
   const auto writer = [&](const dds_topic_descriptor_t* type, const char* name,
                           std::int32_t& out) {
     const dds_entity_t t = dds_create_topic(participant_.handle(), type, name, nullptr, nullptr);
-    out = t < 0 ? t : dds_create_writer(participant_.handle(), t, nullptr, nullptr);
+    out = t < 0 ? t : dds_create_writer(participant_.handle(), t, qos, nullptr);
     if (out < 0) error = std::string("DDS: cannot publish ") + name + " (" + dds_error(out) + ")";
     return out > 0;
   };
   if (!writer(&geometry_msgs_msg_dds__PoseStamped__desc, "rt/mixpilot/pose", pose_) ||
       !writer(&std_msgs_msg_dds__Float64__desc, "rt/mixpilot/lambda", lambda_) ||
       !writer(&nav_msgs_msg_dds__Path__desc, "rt/mixpilot/predicted_path", predicted_) ||
-      !writer(&nav_msgs_msg_dds__Path__desc, "rt/mixpilot/reference_path", reference_))
+      !writer(&nav_msgs_msg_dds__Path__desc, "rt/mixpilot/reference_path", reference_)) {
+    dds_delete_qos(qos);
     return false;
+  }
+  dds_delete_qos(qos);
   ring_ = std::make_unique<SpscRing<Telemetry>>();
   ring_->setup(kRingSteps, prototype);
   taken_ = prototype;

@@ -4,6 +4,9 @@
 //   rt/mixpilot/lambda           std_msgs/msg/Float64           the authority λ (mixed initiative)
 //   rt/mixpilot/predicted_path   nav_msgs/msg/Path              the NMPC's predicted positions
 //   rt/mixpilot/reference_path   nav_msgs/msg/Path              the reference at the same nodes
+// Each writer names its station in its USER_DATA ("mixpilot.station=NAME"), so an instructor
+// (input/net/instructor_client.hpp) tells the stations' telemetry apart while ROS 2 tools see the
+// usual topics.
 // The control thread only copies each step into a ring sized once (a full ring drops the step
 // and counts it); a thread of its own encodes and writes, so DDS never blocks a step.
 #include <atomic>
@@ -26,9 +29,10 @@ class TelemetryPublisher final : public TelemetrySink {
   TelemetryPublisher(const TelemetryPublisher&) = delete;
   TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
 
-  // Joins the domain, creates the four writers, sizes the ring from `prototype` (the mode's
-  // telemetry) and starts the writing thread.
-  [[nodiscard]] bool start(std::uint32_t domain, const Telemetry& prototype, std::string& error);
+  // Joins the domain, creates the four writers (of `station`, "" for none), sizes the ring from
+  // `prototype` (the mode's telemetry) and starts the writing thread.
+  [[nodiscard]] bool start(std::uint32_t domain, const Telemetry& prototype, std::string& error,
+                           const std::string& station = "");
   // Writes what the ring still holds, then stops.
   void stop();
 
