@@ -21,8 +21,9 @@ packages=(
   ffmpeg
   # gamepads
   libsdl2-dev
-  # network peers (C API + idlc)
-  cyclonedds-dev cyclonedds-tools
+  # network peers (C API + idlc); openssl makes a training centre's DDS Security CA and
+  # certificates (packaging/dds-security-ca.sh, and the security tests' test CA)
+  cyclonedds-dev cyclonedds-tools openssl
   # tests and benchmarks; the PostgreSQL server the history tests start themselves
   libgtest-dev libgmock-dev libbenchmark-dev valgrind postgresql
   # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
