@@ -329,7 +329,8 @@ int run_lesson(const LessonOptions& lo) {
   std::string error;
   std::optional<Lesson> lesson = load_lesson(path, error);
   if (!lesson) {
-    if (!fs::exists(path) && lo.lesson_arg.find('/') == std::string::npos &&
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(path, ec)) && lo.lesson_arg.find('/') == std::string::npos &&
         !lo.lesson_arg.ends_with(".toml"))
       error = "no shipped lesson '" + lo.lesson_arg + "' (mixpilot lesson --list)";
     std::fprintf(stderr, "mixpilot lesson: %s\n", escape_controls(error, true).c_str());
