@@ -370,8 +370,8 @@ int run_lesson(const LessonOptions& lo) {
     }
     std::printf("%zu attempt%s\n", attempts.size(), attempts.size() == 1 ? "" : "s");
     for (const history::StoredAttempt& a : attempts)
-      std::printf("  step %d: %s (skill %.1f): %s\n", a.step + 1, a.passed ? "passed" : "failed",
-                  a.skill, escape_controls(a.detail).c_str());
+      std::printf("  step %d: %s (skill %.1f)%s%s\n", a.step + 1, a.passed ? "passed" : "failed",
+                  a.skill, a.passed ? "" : ": ", a.passed ? "" : escape_controls(a.detail).c_str());
     say_next(*lesson, p);
     return kExitOk;
   }

@@ -825,6 +825,13 @@ void LiveController::handle(const ui::LiveRequest& r) {
             if (lesson()) show_lesson();
           },
           [&](const ui::PickLesson& p) { pick_lesson(p.index); },
+          [&](const ui::ChooseLesson& c) {
+            for (std::size_t i = 0; i < lessons_.size(); ++i)
+              if (lessons_[i].name == c.name) return pick_lesson(int(i) + 1);
+            status_line_.say("no lesson named " + c.name +
+                                 (history_ ? "" : " (lessons need the history: --history is off)"),
+                             true);
+          },
           [&](const ui::FlyFromStart&) {
             if (!from_ || is_flying(*live_)) return;
             const FlyOptions before = options_;

@@ -708,6 +708,16 @@ TEST_P(LessonPicker, StartFliesTheStepThenTheVerdictAndTheNextStep) {
   int status = 0;
   ASSERT_TRUE(app.open_live(error, status)) << error;
   app.act(ui::LiveRequest{ui::SetTrainee{"Grace"}});
+  // By name, as a first launch would offer it ("none" first, then the shipped beginner and
+  // this file's lesson).
+  app.act(ui::LiveRequest{ui::ChooseLesson{"no such lesson"}});
+  frame(app);
+  EXPECT_NE(app.run_info().message.find("no lesson named no such lesson"), std::string::npos);
+  app.act(ui::LiveRequest{ui::ChooseLesson{"beginner"}});
+  frame(app);
+  EXPECT_EQ(app.run_info().session->lessons[std::size_t(app.run_info().session->lesson)],
+            "beginner");
+  app.act(ui::LiveRequest{ui::ChooseLesson{"two"}});
   ASSERT_TRUE(frames_until(app, [&] {
     const ui::SessionChoices* c = app.run_info().session;
     return c && c->lesson_view.step == 0 && app.live() && app.live()->flight().lesson.step == 0;

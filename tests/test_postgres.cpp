@@ -227,7 +227,7 @@ TEST(Postgres, LessonAttemptsAndProgressAsInSqlite) {
   auto store = open_store(url);
   ASSERT_TRUE(store);
   std::string error;
-  ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(store->add(sample_flight("Before"), error), HistoryStore::Added::added) << error;
   store.reset();
   ASSERT_TRUE(server->exec("lessons", "DROP TABLE lesson_attempts, lesson_progress", error))
       << error;
@@ -241,6 +241,7 @@ TEST(Postgres, LessonAttemptsAndProgressAsInSqlite) {
             "1");
   progress_round_trip(*store);
   EXPECT_EQ(sql(*server, "lessons", "SELECT count(*) FROM lesson_attempts"), "7");
+  EXPECT_EQ(sql(*server, "lessons", "SELECT count(*) FROM flights"), "9");  // 7 + 1 plain + Before
 }
 
 // Fly from here (SPEC §10): a branch's parent link (the parent flight's recording hash and the

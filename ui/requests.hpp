@@ -47,10 +47,13 @@ struct PickGhost {
 struct PickLesson {
   int index;                  // into SessionChoices::lessons (0: none)
 };
+struct ChooseLesson {         // a lesson by its name ("beginner"): what a first launch offers
+  std::string name;
+};
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
                                  SetRecord, SetTrainee, SetAssist, FlyFromStart, PickGhost,
-                                 PickLesson>;
+                                 PickLesson, ChooseLesson>;
 
 // A replay's transport.
 struct TogglePlay {};
