@@ -720,7 +720,9 @@ TEST_P(LessonPicker, StartFliesTheStepThenTheVerdictAndTheNextStep) {
   app.act(ui::LiveRequest{ui::ChooseLesson{"two"}});
   ASSERT_TRUE(frames_until(app, [&] {
     const ui::SessionChoices* c = app.run_info().session;
-    return c && c->lesson_view.step == 0 && app.live() && app.live()->flight().lesson.step == 0;
+    return c && c->lessons[std::size_t(c->lesson)] == "two" && c->lesson_view.step == 0 &&
+           app.live() && app.live()->flight().lesson.lesson == "two" &&
+           app.live()->flight().lesson.step == 0;
   }));
   EXPECT_EQ(app.live()->mode().authority_bounds(), (AuthorityBounds{0.0, 0.4}));
   // Start, as a click on the panel's button would.
