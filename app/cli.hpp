@@ -15,6 +15,7 @@ enum ExitCode : int {
   kExitError = 1,           // bad input (file, scenario, recording) or a failure on the way
   kExitUsage = 2,           // bad command line
   kExitReplayMismatch = 3,  // a replay differs from its recording
+  kExitStepFailed = 4,      // `lesson`: the step was flown and judged, and it did not pass
   kExitInterrupted = 130,   // SIGINT or SIGTERM ended the flight (what shells report for ^C)
 };
 

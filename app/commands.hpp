@@ -3,6 +3,8 @@
 
 namespace mixpilot::cli {
 
+struct FlyOptions;
+
 int fly_command(int argc, char** argv);
 int replay_command(int argc, char** argv);
 int demo_command();
@@ -14,5 +16,8 @@ int joy_publish_command(int argc, char** argv);
 int vehicle_command(int argc, char** argv);
 int history_command(int argc, char** argv);
 int instruct_command(int argc, char** argv);
+int lesson_command(int argc, char** argv);
+// A flight as `fly` flies it (the window, or headless), from its options.
+int run_fly(const FlyOptions& o);
 
 }  // namespace mixpilot::cli

@@ -287,6 +287,7 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     ModeRequest request;
     request.duration = o.duration;
     request.assist = o.assist.value_or(Assistance::on);
+    request.bounds = o.bounds;
     if (o.from) {  // as long and as assisted as the flight it goes on from
       request.duration = o.from->duration;
       request.assist = o.from->assist;
@@ -310,6 +311,7 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     }
   }
   f->pilot = f->mode->identity().pilot;
+  if (!f->recording) f->lesson = o.lesson;
   if (o.vehicle == "dds") {
     if (!open_vehicle_link(o, *f, error)) return std::nullopt;
     if (wait == VehicleWait::block) {
@@ -341,6 +343,13 @@ SessionInfo session_info(const Flight& f, const std::string& trainee) {
     info.parent_recording = f.from->parent;
     info.parent_sha256 = f.from->parent_sha256;
     info.parent_step = f.from->step;
+  }
+  if (f.lesson.active()) {
+    info.lesson = f.lesson.lesson;
+    info.lesson_hash = f.lesson.lesson_hash;
+    info.lesson_step = f.lesson.step + 1;
+    info.lesson_steps = f.lesson.steps;
+    info.lesson_step_title = f.lesson.title;
   }
   return info;
 }

@@ -41,6 +41,16 @@ struct FlyFrom {
   Assistance assist = Assistance::on;
 };
 
+// A lesson step's flight (SPEC §10, core/scenario/lesson.hpp): what its recording and its
+// history row say of it.
+struct LessonTag {
+  std::string lesson, lesson_hash;
+  int step = -1;  // 0-based; −1: not a lesson's flight
+  int steps = 0;
+  std::string title;
+  bool active() const { return step >= 0; }
+};
+
 struct FlyOptions {
   std::string scenario_path;
   std::string pilot;
@@ -81,6 +91,12 @@ struct FlyOptions {
   const char* command = "fly";     // for messages
   // Fly from here: the new flight goes on from this moment of a recording (the window's).
   std::shared_ptr<const FlyFrom> from;
+  // Mixed initiative: bounds on λ from the first step (a lesson step's ceiling, SPEC §10).
+  AuthorityBounds bounds = {};
+  // A lesson step's flight: recorded in its metadata.
+  LessonTag lesson;
+  // The window: the lesson its picker starts on (a file; `mixpilot lesson` without --headless).
+  std::string lesson_file;
 };
 
 // A person's device flying the session (--pilot gamepad | keyboard, SPEC §6), kept alive for
@@ -113,6 +129,7 @@ struct Flight {
   std::shared_ptr<Devices> devices;  // --pilot gamepad | keyboard
   std::unique_ptr<net::RemoteVehicle> vehicle;  // --vehicle dds
   std::shared_ptr<const FlyFrom> from;  // a branch: flown on from this moment of its parent
+  LessonTag lesson;                      // a lesson step's flight
 };
 
 // The haptic cue from the control thread: each step's λ to the gamepad (an atomic store).

@@ -181,13 +181,46 @@ FlightRig::Closed FlightRig::close(bool interrupted) {
       completed_recording_ = true;
     }
   }
+  const bool flown = started_ && !flight_.recording && flight_.mode->steps_done() > 0;
+  // A lesson step's verdict (SPEC §10): the step's criteria against the score.
+  if (lesson_step_ && flown && flight_.lesson.active()) {
+    const Metrics m = metrics();
+    const auto field = [&m](const char* name) {
+      for (const auto& [k, v] : m)
+        if (k == name) return v;
+      return 0.0;
+    };
+    LessonScore score;
+    score.skill = field("skill");
+    score.time_in_ball = field("time_in_ball");
+    score.collisions = field("collisions");
+    score.completed = !interrupted && !flight_.mode->lost();
+    c.verdict = judge(*lesson_step_, score);
+    history::LessonAttempt a;
+    a.lesson = flight_.lesson.lesson;
+    a.lesson_hash = flight_.lesson.lesson_hash;
+    a.steps = flight_.lesson.steps;
+    a.step = flight_.lesson.step;
+    a.step_title = flight_.lesson.title;
+    a.ceiling = lesson_step_->flown_ceiling();
+    a.passed = c.verdict->passed;
+    a.failed_criterion = c.verdict->failed;
+    if (a.passed) {
+      for (const CriterionResult& r : c.verdict->results)
+        a.detail += (a.detail.empty() ? "" : "; ") + r.text;
+    } else {
+      a.detail = c.verdict->detail;
+    }
+    c.attempt = std::move(a);
+  }
   // The history's row, after the recording is complete (its hash is the finished file's, taken
   // on the writer's thread). A failure is said by the front end from the writer's outcome; the
   // flight and its recording stand.
-  if (history_ && started_ && !flight_.recording && flight_.mode->steps_done() > 0) {
+  if (history_ && flown) {
     std::string error;
     if (std::optional<history::FlightRecord> row = flight_record(interrupted, error, false)) {
-      history_->remember(std::move(*row), completed_recording_ ? record_path_ : std::string());
+      history_->remember(std::move(*row), completed_recording_ ? record_path_ : std::string(),
+                         c.attempt);
       c.remembering = true;
     }
   }

@@ -47,6 +47,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/replay.hpp"
 #include "core/recording/session_recording.hpp"
+#include "core/scenario/lesson.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/base/spsc_ring.hpp"
 #include "core/modes/instructor.hpp"
@@ -96,6 +97,10 @@ class FlightRig {
   // (which outlives the rig): its recording is hashed and the row written on the writer's
   // thread, so neither the control thread nor the UI ever waits for the history.
   void remember(HistoryWriter* writer, std::string trainee, std::string front_end);
+  // A lesson step's flight (SPEC §10; the options' LessonTag names it): close() judges it
+  // against `step`'s criteria (Closed::verdict), and a remembered flight goes into the history
+  // with its verdict, as the step's attempt.
+  void judge_as(LessonStep step) { lesson_step_ = std::move(step); }
   // Another sink (screenshots, a replay's tape), called on the thread that steps the session.
   void watch(TelemetrySink& sink) { session_->add_sink(&sink); }
 
@@ -126,6 +131,9 @@ class FlightRig {
     net::InstructorLinkStats instructor;
     // remember(): the flight's row was handed to the writer (its outcome comes from there).
     bool remembering = false;
+    // judge_as(): the verdict of a flight that flew (nullopt: none, or it never started).
+    std::optional<LessonVerdict> verdict;
+    std::optional<history::LessonAttempt> attempt;  // and the attempt it makes
   };
   // Stops the runner, the publisher and the vehicle link, and completes the recording
   // (`interrupted`: the flight stopped before its end). Once; later calls return {}.
@@ -183,6 +191,7 @@ class FlightRig {
   HistoryWriter* history_ = nullptr;        // remember()
   std::string trainee_, front_end_;
   bool completed_recording_ = false;        // close() completed record_path_
+  std::optional<LessonStep> lesson_step_;   // judge_as()
 };
 
 // The station's lines of a summary (--publish): its name, how it treats an instructor's

@@ -374,6 +374,8 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
   return status;
 }
 
+}  // namespace
+
 int run_fly(const FlyOptions& o) {
   std::string error;
   // ffmpeg is looked for before the outputs: without it nothing else matters.
@@ -454,6 +456,8 @@ int run_fly(const FlyOptions& o) {
   return finish_headless(*rig, o, shots, wall, realtime, history ? &*history : nullptr,
                          ghost.get());
 }
+
+namespace {
 
 // --screenshot, --size, --scale and --exit-at-end, shared by fly and replay: true when `a` is one of them
 // (its value taken through `value`).

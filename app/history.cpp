@@ -48,7 +48,10 @@ constexpr const char* kHistoryUsage =
     "prompt. A table on the terminal, or every field with --csv or --json. A branch (fly from\n"
     "here: flown on from a moment of a recorded flight) names that flight by its recording's\n"
     "hash and the step it was taken over at (parent_recording_hash, parent_step; ^ in the\n"
-    "table).\n"
+    "table). A lesson step's attempt (mixpilot lesson, the window's lesson picker) names the\n"
+    "lesson, the step (1-based) and its verdict (lesson, lesson_step, lesson_passed,\n"
+    "lesson_failed: the criterion that failed; the table's lesson column), and the table ends\n"
+    "with where each trainee is in each lesson.\n"
     "\n"
     "  --trainee NAME     only this trainee's flights\n"
     "  --scenario NAME    only this scenario's flights (its name, as in the table)\n"
@@ -212,6 +215,9 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
   add("ended", 13);  // "interrupted*^"
   add("skill", 6, true);
   add("from", 7);
+  const bool lessons =
+      std::any_of(rows.begin(), rows.end(), [](const auto& f) { return f.lesson_step >= 0; });
+  if (lessons) add("lesson", 16);
   line += "recording\n";
   std::fputs(line.c_str(), stdout);
   char number_text[32];
@@ -231,6 +237,19 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
     const auto skill = metric_of(f, "skill");
     add(skill ? number(*skill, "%.1f") : "-", 6, true);
     add(f.front_end, 7);
+    if (lessons) {
+      // "beginner 2 ✓": the lesson, the step (1-based) and its verdict.
+      if (f.lesson_step < 0) {
+        add("-", 16);
+      } else {
+        const std::string tail = " " + std::to_string(f.lesson_step + 1) +
+                                 (f.lesson_passed ? " \u2713" : " \u2717");
+        const std::string name = cell(f.lesson, tail.size() > 14 ? 1 : 16 - (tail.size() - 2));
+        std::string trimmed = name;
+        while (!trimmed.empty() && trimmed.back() == ' ') trimmed.pop_back();
+        add(trimmed + tail, 16);
+      }
+    }
     line += f.recording_path.empty() ? "-" : printable_path(f.recording_path);
     line += '\n';
     std::fputs(line.c_str(), stdout);
@@ -243,8 +262,30 @@ void print_table(const std::vector<history::StoredFlight>& rows) {
   if (branches)
     notes += std::string(notes.empty() ? "" : "; ") +
              "^ a branch: flown on from a moment of another flight";
+  if (lessons)
+    notes += std::string(notes.empty() ? "" : "; ") +
+             "lesson: the lesson and step the flight was an attempt at, \u2713 passed, \u2717 not";
   std::printf("%zu flight%s%s\n", rows.size(), rows.size() == 1 ? "" : "s",
               notes.empty() ? "" : (" (" + notes + ")").c_str());
+}
+
+// Where each trainee is in each lesson they attempted (the table's footer).
+void print_lesson_progress(const std::vector<history::LessonProgress>& progress) {
+  if (progress.empty()) return;
+  std::printf("lessons:\n");
+  for (const history::LessonProgress& p : progress) {
+    std::string where;
+    if (p.completed()) {
+      where = "every step passed (" + std::to_string(p.steps) + ")";
+    } else {
+      where = "on step " + std::to_string(p.step + 1) + " of " + std::to_string(p.steps);
+      if (p.failed_attempts > 0)
+        where += ", " + std::to_string(p.failed_attempts) + " failed attempt" +
+                 (p.failed_attempts == 1 ? "" : "s") + " at it";
+    }
+    std::printf("  %s  %s (%.12s)  %s\n", escape_controls(p.trainee).c_str(),
+                escape_controls(p.lesson).c_str(), p.lesson_hash.c_str(), where.c_str());
+  }
 }
 
 // A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line break.
@@ -262,7 +303,8 @@ const char* const kFields[] = {"id", "trainee", "station", "scenario", "scenario
                                "pilot", "input_device", "input_settings_hash", "started",
                                "started_unix_ms", "duration_s", "ended", "probe",
                                "recording_path", "recording_hash", "app_version", "front_end",
-                               "parent_recording_hash", "parent_step"};
+                               "parent_recording_hash", "parent_step", "lesson", "lesson_step",
+                               "lesson_passed", "lesson_failed"};
 
 std::vector<std::string> field_values(const history::StoredFlight& f) {
   return {std::to_string(f.id),  f.trainee, f.station, f.scenario, f.scenario_hash, f.mode,
@@ -270,7 +312,11 @@ std::vector<std::string> field_values(const history::StoredFlight& f) {
           local_time(f.started_unix_ms, "%Y-%m-%dT%H:%M:%S%z"), std::to_string(f.started_unix_ms),
           number(f.duration_s), history::to_string(f.ended), f.probe ? "1" : "0",
           f.recording_path, f.recording_hash, f.app_version, f.front_end,
-          f.parent_recording_hash, f.branch() ? std::to_string(f.parent_step) : std::string()};
+          f.parent_recording_hash, f.branch() ? std::to_string(f.parent_step) : std::string(),
+          f.lesson,
+          f.lesson_step >= 0 ? std::to_string(f.lesson_step + 1) : std::string(),
+          f.lesson_step >= 0 ? (f.lesson_passed ? "1" : "0") : std::string(),
+          f.lesson_failed};
 }
 
 void print_csv(const std::vector<history::StoredFlight>& rows) {
@@ -337,6 +383,12 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
         out += values[k].empty() ? "null" : values[k];
       else if (name == "parent_recording_hash" && values[k].empty())
         out += "null";  // not a branch
+      else if (name == "lesson_step")
+        out += values[k].empty() ? "null" : values[k];  // 1-based
+      else if (name == "lesson_passed")
+        out += values[k].empty() ? "null" : f.lesson_passed ? "true" : "false";
+      else if ((name == "lesson" || name == "lesson_failed") && values[k].empty())
+        out += "null";  // not a lesson's attempt, or it passed
       else if (name == "probe")
         out += f.probe ? "true" : "false";
       else
@@ -648,6 +700,7 @@ int history_command(int argc, char** argv) {
     usage_error(cmd, "which folder? (mixpilot history import DIR)");
   std::string error;
   std::vector<history::StoredFlight> rows;
+  std::vector<history::LessonProgress> progress;  // the table's footer
   // The report's file is checked before any work (never clobbered without --force).
   OutputFile report;
   if (!html.empty() && !report.open(html, force, error)) {
@@ -672,12 +725,14 @@ int history_command(int argc, char** argv) {
                   escape_controls(html).c_str());
       return kExitOk;
     }
-    if (as_csv)
+    if (as_csv) {
       print_csv(rows);
-    else if (as_json)
+    } else if (as_json) {
       print_json(rows);
-    else
+    } else {
       print_table(rows);
+      print_lesson_progress(progress);
+    }
     return kExitOk;
   };
   // A listing never creates a history: no SQLite file yet is no flight yet.
@@ -697,7 +752,8 @@ int history_command(int argc, char** argv) {
   // The table shows one score field: reading the others (twenty a flight) is what would make a
   // long history slow to list.
   if (!as_csv && !as_json && html.empty()) q.metrics = {"skill"};
-  if (!store->query(q, rows, error)) {
+  if (!store->query(q, rows, error) ||
+      (!as_csv && !as_json && html.empty() && !store->lesson_progress(q.trainee, progress, error))) {
     report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;

@@ -33,12 +33,14 @@ HistoryWriter::~HistoryWriter() {
   thread_.join();
 }
 
-void HistoryWriter::remember(history::FlightRecord record, std::string hash_path) {
+void HistoryWriter::remember(history::FlightRecord record, std::string hash_path,
+                             std::optional<history::LessonAttempt> attempt) {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     Job j;
     j.record = std::move(record);
     j.hash_path = std::move(hash_path);
+    j.attempt = std::move(attempt);
     jobs_.push_back(std::move(j));
   }
   wake_.notify_all();
@@ -50,6 +52,22 @@ void HistoryWriter::show(std::string trainee, std::string scenario) {
     trainee_ = std::move(trainee);
     scenario_ = std::move(scenario);
     // One load is enough however often it is asked for before it runs.
+    for (const Job& j : jobs_)
+      if (j.kind == Job::Kind::load) return;
+    Job j;
+    j.kind = Job::Kind::load;
+    jobs_.push_back(std::move(j));
+  }
+  wake_.notify_all();
+}
+
+void HistoryWriter::show_lesson(std::string trainee, std::string lesson,
+                                std::string lesson_hash) {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    lesson_trainee_ = std::move(trainee);
+    lesson_ = std::move(lesson);
+    lesson_hash_ = std::move(lesson_hash);
     for (const Job& j : jobs_)
       if (j.kind == Job::Kind::load) return;
     Job j;
@@ -107,6 +125,7 @@ void HistoryWriter::write(Job& job) {
   Outcome o;
   o.trainee = job.record.trainee;
   o.scenario = job.record.scenario;
+  o.lesson_attempt = job.attempt.has_value();
   std::string error;
   bool hashed = true;
   if (!job.hash_path.empty()) {
@@ -115,7 +134,10 @@ void HistoryWriter::write(Job& job) {
     hashed = hash.has_value();
   }
   if (hashed) {
-    if (history::HistoryStore* s = store(error)) o.remembered = s->add(job.record, error).has_value();
+    if (history::HistoryStore* s = store(error))
+      o.remembered = (job.attempt ? s->add_attempt(job.record, *job.attempt, error)
+                                  : s->add(job.record, error))
+                         .has_value();
   }
   if (!o.remembered) o.error = error;
   bool reload = false;
@@ -128,12 +150,15 @@ void HistoryWriter::write(Job& job) {
 }
 
 void HistoryWriter::load() {
-  std::string file, trainee, scenario;
+  std::string file, trainee, scenario, lesson_trainee, lesson, lesson_hash;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     file = file_;
     trainee = trainee_;
     scenario = scenario_;
+    lesson_trainee = lesson_trainee_;
+    lesson = lesson_;
+    lesson_hash = lesson_hash_;
   }
   auto v = std::make_shared<ui::HistoryView>();
   v->loaded = true;
@@ -152,6 +177,29 @@ void HistoryWriter::load() {
   }
   v->progress = progress_view(rows, trainee, scenario);
   v->progress.error = error;
+  // The lesson's progress: none yet (step 1) when the history has none.
+  if (!lesson.empty()) {
+    ui::LessonProgressView& l = v->lesson;
+    l.trainee = lesson_trainee;
+    l.lesson = lesson;
+    l.lesson_hash = lesson_hash;
+    std::string lesson_error;
+    std::vector<history::LessonProgress> progress;
+    std::vector<history::StoredAttempt> attempts;
+    history::HistoryStore* s = none_yet ? nullptr : store(lesson_error);
+    if (s && s->lesson_progress(lesson_trainee, progress, lesson_error) &&
+        s->lesson_attempts(lesson_trainee, lesson, lesson_hash, attempts, lesson_error))
+      lesson_error.clear();
+    for (const history::LessonProgress& p : progress)
+      if (p.lesson == lesson && p.lesson_hash == lesson_hash) {
+        l.step = p.step;
+        l.failed_attempts = p.failed_attempts;
+      }
+    for (const history::StoredAttempt& a : attempts)
+      l.attempts.push_back({a.step, a.passed, a.detail, a.skill});
+    l.error = lesson_error;
+    l.loaded = true;
+  }
   const std::lock_guard<std::mutex> lock(mutex_);
   view_ = std::move(v);
 }

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,8 +36,12 @@ class HistoryWriter {
   HistoryWriter& operator=(const HistoryWriter&) = delete;
 
   // A finished flight: `record` is written once `hash_path` (its recording, "" none) is hashed
-  // into record.recording_hash.
-  void remember(history::FlightRecord record, std::string hash_path);
+  // into record.recording_hash. With `attempt`, a lesson step's flight: the flight and its
+  // verdict are written together and the trainee's progress moves on (add_attempt).
+  void remember(history::FlightRecord record, std::string hash_path,
+                std::optional<history::LessonAttempt> attempt = std::nullopt);
+  // The snapshot should also show `trainee`'s progress in the lesson (name, hash; "" none).
+  void show_lesson(std::string trainee, std::string lesson, std::string lesson_hash);
   // The snapshot should show `trainee`'s progress on `scenario` (and every trainee): loaded now,
   // and again after each flight remembered.
   void show(std::string trainee, std::string scenario);
@@ -44,6 +49,7 @@ class HistoryWriter {
   // What became of a flight handed over.
   struct Outcome {
     std::string trainee, scenario;
+    bool lesson_attempt = false;   // it was a lesson step's attempt
     bool remembered = false;       // its row is in the history (new or already known)
     std::string error;             // why not ("" when remembered)
   };
@@ -60,6 +66,7 @@ class HistoryWriter {
     enum class Kind { write, load } kind = Kind::write;
     history::FlightRecord record;
     std::string hash_path;
+    std::optional<history::LessonAttempt> attempt;
   };
   void run();
   history::HistoryStore* store(std::string& error);
@@ -77,6 +84,7 @@ class HistoryWriter {
   std::deque<Job> jobs_;
   bool busy_ = false, stopping_ = false;
   std::string trainee_, scenario_;               // what show() asked for
+  std::string lesson_trainee_, lesson_, lesson_hash_;  // what show_lesson() asked for
   std::vector<Outcome> outcomes_;
   std::shared_ptr<const ui::HistoryView> view_;
   std::thread thread_;                            // last: started once the rest exists

@@ -106,6 +106,12 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
     status = kExitError;
     return nullptr;
   }
+  if (o.lesson.active()) {
+    for (const Lesson& l : lessons_)
+      if (l.name == o.lesson.lesson && l.hash == o.lesson.lesson_hash &&
+          o.lesson.step < int(l.steps.size()))
+        f->rig->judge_as(l.steps[std::size_t(o.lesson.step)]);
+  }
   f->rig->pace(8192);
   const Mode& mode = f->rig->mode();
   std::string source = flight.pilot.empty() ? std::string("the thesis's controller")
@@ -151,6 +157,24 @@ void LiveController::close_live(LiveFlight& f) {
   while (f.runner().telemetry().pop(f.sample)) f.history.push(f.sample);
   const bool flown = f.started();
   const FlightRig::Closed& c = f.closing = f.rig->close(!f.mode().finished());
+  if (c.verdict && c.attempt) {
+    // The lesson's verdict: said, shown in the panel, and the progress moved on at once (the
+    // history's snapshot, reloaded once the attempt is written, says the same).
+    verdict_ = *c.verdict;
+    verdict_step_ = c.attempt->step;
+    ++lesson_attempts_known_;
+    if (lesson() && lesson()->hash == c.attempt->lesson_hash && lesson_step_ == c.attempt->step) {
+      if (c.verdict->passed) {
+        ++lesson_step_;
+        lesson_failed_ = 0;
+      } else {
+        ++lesson_failed_;
+      }
+    }
+    status_line_.say("step " + std::to_string(c.attempt->step + 1) +
+                         (c.verdict->passed ? " passed" : " not passed: " + c.verdict->detail),
+                     !c.verdict->passed);
+  }
   if (c.published && flown)
     status_line_.say("published " + std::to_string(c.published_steps) +
                          " steps on rt/mixpilot/* (domain " + std::to_string(options_.domain) +
@@ -248,6 +272,8 @@ int LiveController::finish() {
 LiveController::LiveController(FlyOptions o, InputController& input, StatusLine& status,
                                HistoryWriter* history)
     : options_(std::move(o)), history_(history), input_(input), status_line_(status) {
+  choices_.trainee = options_.trainee;  // --trainee: who flies (the session panel may change it)
+  load_lessons();
   ghost_choice_ = GhostChoice::of(options_.ghost);
   first_record_ = options_.record;
   choices_.record = !options_.record.empty();
@@ -267,6 +293,159 @@ LiveController::LiveController(FlyOptions o, InputController& input, StatusLine&
 }
 
 LiveController::~LiveController() { close(); }
+
+// ---- Lessons (SPEC §10) --------------------------------------------------------------------
+
+void LiveController::load_lessons() {
+  // Their progress lives in the history: without one, no lessons.
+  if (!history_) return;
+  std::vector<std::string> files = shipped_lessons();
+  const std::string mine =
+      options_.lesson_file.empty() ? std::string() : absolute_path(options_.lesson_file);
+  if (!mine.empty() && std::find(files.begin(), files.end(), mine) == files.end())
+    files.push_back(mine);
+  for (const std::string& file : files) {
+    std::string error;
+    std::optional<Lesson> l = load_lesson(file, error);
+    if (!l) {
+      status_line_.say("lesson " + error, true);
+      continue;
+    }
+    if (file == mine) lesson_ = int(lessons_.size());
+    lessons_.push_back(std::move(*l));
+  }
+  if (lessons_.empty()) return;
+  choices_.lessons.push_back("none");
+  for (const Lesson& l : lessons_) choices_.lessons.push_back(l.name);
+}
+
+void LiveController::show_lesson() {
+  if (!history_ || !lesson()) return;
+  const std::string trainee = choices_.trainee.empty() ? history::login_name() : choices_.trainee;
+  history_->show_lesson(trainee, lesson()->name, lesson()->hash);
+  lesson_for_ = trainee + '\n' + lesson()->name + '\n' + lesson()->hash;
+  lesson_step_ = -1;  // until the snapshot says
+  lesson_failed_ = 0;
+  lesson_attempts_known_ = 0;
+  lesson_seen_ = nullptr;
+  lesson_made_for_ = -2;
+  verdict_.reset();
+  last_attempt_.reset();
+}
+
+void LiveController::pick_lesson(int index) {
+  if (index < 0 || index >= int(choices_.lessons.size())) return;
+  if (live_ && is_flying(*live_)) return;
+  lesson_ = index - 1;
+  choices_.lesson = index;
+  if (lesson()) {
+    show_lesson();  // the step's flight is made once the history says which step
+    return;
+  }
+  // No lesson: the flights are the session panel's again, from the scenario chosen.
+  const FlyOptions before = options_;
+  options_.lesson = {};
+  options_.bounds = {};
+  options_.assist.reset();
+  verdict_.reset();
+  std::string error;
+  if (!replace_live(error)) {
+    options_ = before;
+    status_line_.say(error, true);
+  }
+}
+
+bool LiveController::fly_lesson_step(std::string& error) {
+  const FlyOptions before = options_;
+  if (options_.pilot.ends_with(".mcap")) options_.pilot.clear();
+  options_ = lesson_flight(*lesson(), lesson_step_, options_);
+  from_.reset();
+  from_shown_.clear();
+  if (replace_live(error)) {
+    // The scenario the step flies, among the choices.
+    const std::string file = absolute_path(options_.scenario_path);
+    auto it = std::find(scenario_paths_.begin(), scenario_paths_.end(), file);
+    if (it == scenario_paths_.end()) {
+      scenario_paths_.push_back(file);
+      choices_.scenarios.push_back(fs::path(file).filename().string());
+      it = scenario_paths_.end() - 1;
+    }
+    choices_.scenario = int(it - scenario_paths_.begin());
+    return true;
+  }
+  options_ = before;
+  return false;
+}
+
+void LiveController::update_lesson(const ui::HistoryView* h) {
+  choices_.lesson = lesson_ + 1;
+  if (!lesson()) return;
+  const Lesson& l = *lesson();
+  // The snapshot's progress, when it is of this trainee and lesson and knows every attempt
+  // this window made (an older snapshot must not move the trainee back).
+  if (h && h != lesson_seen_ && h->lesson.loaded &&
+      h->lesson.trainee + '\n' + h->lesson.lesson + '\n' + h->lesson.lesson_hash == lesson_for_ &&
+      int(h->lesson.attempts.size()) >= lesson_attempts_known_) {
+    lesson_seen_ = h;
+    lesson_step_ = h->lesson.step;
+    lesson_failed_ = h->lesson.failed_attempts;
+    lesson_attempts_known_ = int(h->lesson.attempts.size());
+    last_attempt_.reset();
+    if (!h->lesson.attempts.empty()) last_attempt_ = h->lesson.attempts.back();
+  }
+  // A flight READY for the trainee's step (never in place of one that flew: its score card and
+  // verdict stay until R).
+  const int steps = int(l.steps.size());
+  if (live_ && !live_->started() && lesson_step_ >= 0 && lesson_step_ < steps &&
+      lesson_made_for_ != lesson_step_) {
+    const LessonTag& tag = live_->flight().lesson;
+    if (!(tag.active() && tag.lesson_hash == l.hash && tag.step == lesson_step_)) {
+      std::string error;
+      if (!fly_lesson_step(error)) status_line_.say(error, true);
+    }
+    lesson_made_for_ = lesson_step_;
+  }
+  lesson_view(h);
+}
+
+void LiveController::lesson_view(const ui::HistoryView* h) {
+  ui::LessonChoice& v = choices_.lesson_view;
+  const Lesson& l = *lesson();
+  v = ui::LessonChoice{};
+  v.description = l.description;
+  for (const LessonStep& s : l.steps) v.steps.push_back(s.title);
+  if (h && h->lesson.loaded && !h->lesson.error.empty()) v.error = "history: " + h->lesson.error;
+  v.step = lesson_step_;
+  const int steps = int(l.steps.size());
+  if (lesson_step_ >= 0 && lesson_step_ < steps) {
+    const LessonStep& s = l.steps[std::size_t(lesson_step_)];
+    v.heading = step_heading(l, lesson_step_);
+    v.rule = step_rule(s);
+    v.conditions = step_conditions(s);
+    v.criteria = criteria_text(s.pass);
+    v.attempts = attempts_text(s, lesson_failed_);
+    v.closed = out_of_attempts(s, lesson_failed_);
+  }
+  if (!verdict_ && last_attempt_) {
+    // The last attempt the history holds (a trainee coming back sees where they left off).
+    v.verdict_passed = last_attempt_->passed;
+    v.verdict = "step " + std::to_string(last_attempt_->step + 1) +
+                (last_attempt_->passed ? " PASSED" : " NOT PASSED: " + last_attempt_->detail);
+  }
+  if (verdict_) {
+    v.verdict_passed = verdict_->passed;
+    v.verdict = "step " + std::to_string(verdict_step_ + 1) +
+                (verdict_->passed ? " PASSED" : " NOT PASSED: " + verdict_->detail);
+    for (const CriterionResult& r : verdict_->results)
+      v.verdict_lines.push_back(std::string(r.passed ? "pass  " : "FAIL  ") + r.text);
+  }
+  if (lesson_step_ >= 0 && lesson_step_ < steps && !v.closed)
+    v.next = verdict_ && verdict_->passed && verdict_step_ + 1 == lesson_step_
+                 ? "Next: step " + std::to_string(lesson_step_ + 1) + " (R)"
+             : verdict_ && verdict_step_ == lesson_step_
+                 ? "Try step " + std::to_string(lesson_step_ + 1) + " again (R)"
+                 : "Fly step " + std::to_string(lesson_step_ + 1) + " (R)";
+}
 
 // ---- The ghost (SPEC §10) ------------------------------------------------------------------
 
@@ -478,6 +657,7 @@ void LiveController::refresh_choices() {
     choices_.scenario = int(it - scenario_paths_.begin());
   }
   show_progress();
+  if (lesson() && lesson_for_.empty()) show_lesson();
 }
 
 void LiveController::fly_scenario(std::size_t index) {
@@ -530,6 +710,18 @@ void LiveController::settings_changed() {
 
 void LiveController::start() {
   if (!live_ || live_->started()) return;
+  if (const Lesson* l = lesson()) {
+    const LessonTag& tag = live_->flight().lesson;
+    if (lesson_step_ < 0 || lesson_step_ >= int(l->steps.size()) ||
+        out_of_attempts(l->steps[std::size_t(lesson_step_)], lesson_failed_) ||
+        !tag.active() || tag.step != lesson_step_ || tag.lesson_hash != l->hash) {
+      status_line_.say(lesson_step_ < 0 ? "the lesson's progress is still being read"
+                       : lesson_step_ >= int(l->steps.size()) ? "every step of the lesson is passed"
+                                                               : "this step is closed (its attempts are used up)",
+                       true);
+      return;
+    }
+  }
   if (live_->awaiting_vehicle || live_->no_vehicle) return;  // the status line says why
   // A gamepad pilot starts once a pad is connected (the banner asks for one meanwhile).
   if (live_->flight().devices && live_->flight().devices->gamepad &&
@@ -586,7 +778,10 @@ void LiveController::handle(const ui::LiveRequest& r) {
           },
           [&](const ui::RestartFlight&) {
             const double speed = live_->runner().speed();
-            if (!replace_live(error)) {
+            // A lesson flies the trainee's step now (the next one after a pass).
+            const Lesson* l = lesson();
+            if (l && (lesson_step_ < 0 || lesson_step_ >= int(l->steps.size()))) return;
+            if (l ? !fly_lesson_step(error) : !replace_live(error)) {
               status_line_.say(error, true);
               return;
             }
@@ -607,6 +802,7 @@ void LiveController::handle(const ui::LiveRequest& r) {
               d->keyboard->set_key(input::Key(i), (k.keys >> i) & 1u);
           },
           [&](const ui::PickScenario& p) {
+            if (lesson()) return;  // the lesson's step sets the scenario
             if (p.index >= 0 && p.index < int(scenario_paths_.size()) && !is_flying(*live_))
               fly_scenario(std::size_t(p.index));
           },
@@ -627,6 +823,15 @@ void LiveController::handle(const ui::LiveRequest& r) {
           [&](const ui::SetTrainee& t) {
             choices_.trainee = t.name;
             show_progress();
+            if (lesson()) show_lesson();
+          },
+          [&](const ui::PickLesson& p) { pick_lesson(p.index); },
+          [&](const ui::ChooseLesson& c) {
+            for (std::size_t i = 0; i < lessons_.size(); ++i)
+              if (lessons_[i].name == c.name) return pick_lesson(int(i) + 1);
+            status_line_.say("no lesson named " + c.name +
+                                 (history_ ? "" : " (lessons need the history: --history is off)"),
+                             true);
           },
           [&](const ui::FlyFromStart&) {
             if (!from_ || is_flying(*live_)) return;
@@ -651,7 +856,7 @@ void LiveController::handle(const ui::LiveRequest& r) {
           },
           [&](const ui::SetAssist& a) {
             // The unstarted flight is made again with the choice, as for a pilot.
-            if (is_flying(*live_) || !choices_.assist_choosable) return;
+            if (is_flying(*live_) || !choices_.assist_choosable || lesson()) return;
             const FlyOptions before = options_;
             options_.assist = a.on ? Assistance::on : Assistance::off;
             if (!replace_live(error)) {
@@ -664,6 +869,7 @@ void LiveController::handle(const ui::LiveRequest& r) {
 }
 
 void LiveController::update(bool pad_connected, ui::RunInfo& run) {
+  update_lesson(run.history);  // first: it may make the step's flight anew
   LiveFlight& f = *live_;
   if (f.waiting && pad_connected) start();  // the gamepad it waited for has come
   if (f.awaiting_vehicle) update_vehicle_wait(f);

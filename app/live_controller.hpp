@@ -13,6 +13,7 @@
 #include "app/flight_rig.hpp"
 #include "app/ghost.hpp"
 #include "app/input_controller.hpp"
+#include "app/lesson.hpp"
 #include "app/status_line.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "ui/requests.hpp"
@@ -119,6 +120,17 @@ class LiveController {
   // on the status line.
   void update_ghost(LiveFlight& f, const ui::HistoryView* h);
   void ghost_options(const LiveFlight& f, const ui::HistoryView* h);
+  // Lessons (SPEC §10): the lesson chosen (nullptr: none); its progress from the history's
+  // snapshot `h`; a flight READY for the trainee's step; the panel's view of it.
+  const Lesson* lesson() const {
+    return lesson_ >= 0 ? &lessons_[std::size_t(lesson_)] : nullptr;
+  }
+  void load_lessons();
+  void pick_lesson(int index);
+  void update_lesson(const ui::HistoryView* h);
+  void show_lesson();
+  [[nodiscard]] bool fly_lesson_step(std::string& error);  // a new, unstarted flight of the step
+  void lesson_view(const ui::HistoryView* h);
 
   FlyOptions options_;
   HistoryWriter* history_;  // outlives live_: its rig hands its row over at close
@@ -148,6 +160,20 @@ class LiveController {
   std::unique_ptr<GhostLoader> ghost_loader_;
   std::vector<std::unique_ptr<GhostLoader>> ghost_retired_;
   std::string ghost_refused_;  // the recording refused for the choice (not read again for it)
+  // Lessons: the shipped ones (and --lesson's file), parallel to choices_.lessons after "none";
+  // the one chosen (−1: none); the trainee's step in it and the failed attempts there (−1:
+  // not read yet), from the history's snapshot and moved on by each verdict; the snapshot
+  // they were last taken from; the last flight's verdict and the step it judged.
+  std::vector<Lesson> lessons_;
+  int lesson_ = -1;
+  int lesson_step_ = -1, lesson_failed_ = 0;
+  int lesson_attempts_known_ = 0;  // attempts the snapshot must hold to be taken
+  int lesson_made_for_ = -2;       // the step a READY flight was last made for
+  const ui::HistoryView* lesson_seen_ = nullptr;
+  std::string lesson_for_;  // "trainee\nlesson hash" the progress is of
+  std::optional<LessonVerdict> verdict_;
+  int verdict_step_ = -1;
+  std::optional<ui::LessonAttemptView> last_attempt_;  // the history's newest, before any here
 };
 
 }  // namespace mixpilot::cli

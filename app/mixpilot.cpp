@@ -30,6 +30,7 @@ constexpr const char* kUsage =
     "  vehicle         a scenario's vehicle in its own process, for fly --vehicle dds\n"
     "  instruct        the instructor: list the stations (fly --publish), command one\n"
     "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
+    "  lesson  fly a trainee's current step of a lesson, judged and remembered\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -47,7 +48,7 @@ constexpr const char* kUsage =
     "  --version       print the version\n"
     "\n"
     "exit status: 0 done, 1 bad input or failure, 2 usage, 3 a replay differs from its\n"
-    "recording, 130 interrupted\n";
+    "recording, 4 (lesson) a step was flown and did not pass, 130 interrupted\n";
 
 constexpr const char* kDemoUsage =
     "usage: mixpilot demo\n"
@@ -146,6 +147,7 @@ int dispatch(int argc, char** argv) {
   if (cmd == "vehicle") return vehicle_command(argc, argv);
   if (cmd == "history") return history_command(argc, argv);
   if (cmd == "instruct") return instruct_command(argc, argv);
+  if (cmd == "lesson") return lesson_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

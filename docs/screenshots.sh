@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
-# why λ fell, a ghost run, and the input settings and Progress panels, fly from here and the
-# debrief at
+# why λ fell, a ghost run, and the input settings, Progress and lesson panels, fly from here and
+# the debrief at
 # 1280x720 (app tests render them). The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
@@ -56,6 +56,11 @@ MIXPILOT_SHOT_DIR="$tmp" "$tests/test_fly_from_here_app" \
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
 cp "$tmp/fly_from_here.png" $out/fly_from_here.png
+# The lesson picker: the beginner course of a trainee two steps in, after a failed attempt at
+# the third (the test fills a history of its own).
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_lesson" \
+  --gtest_filter='Scales/LessonPicker.ShowsTheTraineesStepOfTheCourse/0' >/dev/null
+cp "$tmp/lesson_picker_100.png" $out/lesson_picker.png
 # The debrief: a replay of the reckless pilot's whole flight (`fly --pilot reckless --record`),
 # its Debrief panel listing the events, the last one clicked (selected, the playhead there).
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_debrief" \

@@ -28,6 +28,9 @@ mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless
   --record "$work/novice.mcap" --report "$work/novice.json"
 mixpilot score "$work/novice.mcap" --json "$work/score.json"
 grep -q skill "$work/score.json"
+say "the shipped lessons"
+mixpilot lesson --list | grep -q '^beginner ' || { say "no beginner lesson installed"; exit 1; }
+mixpilot lesson beginner --check >/dev/null
 say "headless screenshot"
 mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless --duration 3 \
   --screenshot "2:$work/shot.png"
@@ -46,7 +49,7 @@ else
   grep -q "apt install ffmpeg" "$work/video.err" || { say "no word of the ffmpeg package"; exit 1; }
 fi
 say "man pages"
-for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-reference; do
+for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-lesson mixpilot-reference; do
   [ -f /usr/share/man/man1/$page.1.gz ] || { say "no man page $page(1)"; exit 1; }
   zcat /usr/share/man/man1/$page.1.gz | grep -q '^\.TH' || { say "$page(1) is not a man page"; exit 1; }
 done

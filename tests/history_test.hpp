@@ -12,9 +12,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
+#include <vector>
 #include <memory>
 #include <thread>
 
+#include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
 
 namespace mixpilot::test {
@@ -92,6 +95,148 @@ inline KilledWriter kill_a_writer_mid_transaction(
   while (::read(fds[0], &got, sizeof got) == sizeof got) out.last_reported = got;  // before dying
   ::close(fds[0]);
   return out;
+}
+
+inline history::FlightRecord flight(const std::string& trainee, std::int64_t started, double skill,
+                             const std::string& recording_hash = "") {
+  history::FlightRecord f;
+  f.trainee = trainee;
+  f.station = "station-1";
+  f.scenario = "lesson_hover";
+  f.scenario_hash = sha256_hex("scenario");
+  f.mode = "mixed_initiative";
+  f.pilot = "novice";
+  f.started_unix_ms = started;
+  f.duration_s = 10.0;
+  f.app_version = "mixpilot test";
+  f.front_end = "lesson";
+  f.recording_hash = recording_hash;
+  if (!recording_hash.empty()) f.recording_path = "/r/" + recording_hash.substr(0, 8) + ".mcap";
+  f.metrics = {{"skill", skill}};
+  return f;
+}
+
+inline history::LessonAttempt attempt(int step, bool passed, const std::string& hash = "h1") {
+  history::LessonAttempt a;
+  a.lesson = "beginner";
+  a.lesson_hash = hash;
+  a.steps = 3;
+  a.step = step;
+  a.step_title = "step " + std::to_string(step);
+  a.ceiling = 0.3 + 0.2 * step;
+  a.passed = passed;
+  a.failed_criterion = passed ? "" : "min_skill";
+  a.detail = passed ? "skill 80.0 (at least 60)" : "skill 41.0 (at least 60)";
+  return a;
+}
+
+inline history::LessonProgress progress_of(history::HistoryStore& store, const std::string& trainee,
+                                    const std::string& hash = "h1") {
+  std::vector<history::LessonProgress> all;
+  std::string error;
+  EXPECT_TRUE(store.lesson_progress(trainee, all, error)) << error;
+  for (const auto& p : all)
+    if (p.lesson == "beginner" && p.lesson_hash == hash) return p;
+  return {};
+}
+
+// Lessons (SPEC §10), for both backends' tests: a flight of `trainee` and a lesson attempt of
+// the 3-step lesson "beginner" (version `hash`).
+// The attempts and the progress (SPEC §10), written with the flight in one transaction: a
+// failure counts, a pass moves on, an attempt at another step than the trainee's is refused
+// and writes nothing, a known recording adds nothing, a reset starts over and keeps the
+// attempts, another version of the lesson (hash) is its own, and each flight's row says its
+// lesson, step and verdict.
+inline void progress_round_trip(history::HistoryStore& store) {
+  std::string error;
+  using Added = history::HistoryStore::Added;
+  ASSERT_EQ(store.add_attempt(flight("Ada", 1000, 41.0, "rec1"), attempt(0, false), error),
+            Added::added)
+      << error;
+  history::LessonProgress p = progress_of(store, "Ada");
+  EXPECT_EQ(p.step, 0);
+  EXPECT_EQ(p.failed_attempts, 1);
+  EXPECT_EQ(p.steps, 3);
+  ASSERT_EQ(store.add_attempt(flight("Ada", 2000, 80.0), attempt(0, true), error), Added::added)
+      << error;
+  p = progress_of(store, "Ada");
+  EXPECT_EQ(p.step, 1);
+  EXPECT_EQ(p.failed_attempts, 0);
+  // Step 0 again, or step 2: not the trainee's step; nothing written (no flight either).
+  for (int wrong : {0, 2}) {
+    EXPECT_FALSE(store.add_attempt(flight("Ada", 3000, 80.0), attempt(wrong, true), error));
+    EXPECT_NE(error.find("the trainee is on step 2 of beginner, not step " +
+                         std::to_string(wrong + 1)),
+              std::string::npos)
+        << error;
+  }
+  // The same recording again: already known, the progress unmoved.
+  EXPECT_EQ(store.add_attempt(flight("Ada", 4000, 80.0, "rec1"), attempt(1, true), error),
+            Added::already_known);
+  EXPECT_EQ(progress_of(store, "Ada").step, 1);
+  // A refused attempt: its texts checked like a flight's.
+  history::LessonAttempt bad = attempt(1, true);
+  bad.failed_criterion = "min_skill";
+  EXPECT_FALSE(store.add_attempt(flight("Ada", 5000, 80.0), bad, error));
+  EXPECT_NE(error.find("a verdict names a failed criterion exactly when it failed"),
+            std::string::npos)
+      << error;
+  bad = attempt(3, true);
+  EXPECT_FALSE(store.add_attempt(flight("Ada", 5000, 80.0), bad, error));
+  EXPECT_NE(error.find("step 3 is not one of the lesson's 3"), std::string::npos) << error;
+  ASSERT_EQ(store.add_attempt(flight("Ada", 6000, 81.0), attempt(1, true), error), Added::added);
+  ASSERT_EQ(store.add_attempt(flight("Ada", 7000, 82.0), attempt(2, true), error), Added::added);
+  p = progress_of(store, "Ada");
+  EXPECT_EQ(p.step, 3);
+  EXPECT_TRUE(p.completed());
+  EXPECT_FALSE(store.add_attempt(flight("Ada", 8000, 80.0), attempt(2, true), error));
+  EXPECT_NE(error.find("has passed every step of beginner already"), std::string::npos) << error;
+  // Another trainee, another version of the lesson: their own progress.
+  ASSERT_EQ(store.add_attempt(flight("Grace", 9000, 50.0), attempt(0, false), error),
+            Added::added);
+  ASSERT_EQ(store.add_attempt(flight("Ada", 9500, 90.0), attempt(0, true, "h2"), error),
+            Added::added);
+  EXPECT_EQ(progress_of(store, "Grace").failed_attempts, 1);
+  EXPECT_EQ(progress_of(store, "Ada", "h2").step, 1);
+  std::vector<history::LessonProgress> all;
+  ASSERT_TRUE(store.lesson_progress("", all, error)) << error;
+  EXPECT_EQ(all.size(), 3u);
+  // The attempts, oldest first, with their flights' skill and verdicts.
+  std::vector<history::StoredAttempt> attempts;
+  ASSERT_TRUE(store.lesson_attempts("Ada", "beginner", "h1", attempts, error)) << error;
+  ASSERT_EQ(attempts.size(), 4u);
+  EXPECT_FALSE(attempts[0].passed);
+  EXPECT_EQ(attempts[0].failed_criterion, "min_skill");
+  EXPECT_EQ(attempts[0].detail, "skill 41.0 (at least 60)");
+  EXPECT_EQ(attempts[0].skill, 41.0);
+  EXPECT_EQ(attempts[0].recording_path, "/r/rec1.mcap");
+  EXPECT_EQ(attempts[0].ceiling, 0.3);
+  EXPECT_EQ(attempts[3].step, 2);
+  EXPECT_EQ(attempts[3].step_title, "step 2");
+  EXPECT_EQ(attempts[3].steps, 3);
+  // Every flight's row names its attempt; a plain flight none.
+  ASSERT_EQ(store.add(flight("Ada", 9900, 70.0), error), Added::added) << error;
+  std::vector<history::StoredFlight> rows;
+  history::Query q;
+  q.trainee = "Ada";
+  ASSERT_TRUE(store.query(q, rows, error)) << error;
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_EQ(rows[0].lesson, "beginner");
+  EXPECT_EQ(rows[0].lesson_step, 0);
+  EXPECT_FALSE(rows[0].lesson_passed);
+  EXPECT_EQ(rows[0].lesson_failed, "min_skill");
+  EXPECT_TRUE(rows[1].lesson_passed);
+  EXPECT_EQ(rows[1].lesson_failed, "");
+  EXPECT_EQ(rows[5].lesson, "");
+  EXPECT_EQ(rows[5].lesson_step, -1);
+  // A reset: step 1 again, the attempts kept.
+  ASSERT_TRUE(store.reset_lesson("Ada", "beginner", "h1", error)) << error;
+  EXPECT_EQ(progress_of(store, "Ada").steps, 0);  // no row: step 0
+  ASSERT_TRUE(store.lesson_attempts("Ada", "beginner", "h1", attempts, error)) << error;
+  EXPECT_EQ(attempts.size(), 4u);
+  ASSERT_EQ(store.add_attempt(flight("Ada", 9990, 80.0), attempt(0, true), error), Added::added)
+      << error;
+  EXPECT_EQ(progress_of(store, "Ada").step, 1);
 }
 
 }  // namespace mixpilot::test

@@ -8,7 +8,7 @@ Inputs (each through every command that reads it):
   ($XDG_CONFIG_HOME/mixpilot/; fly --pilot gamepad, gamepad-script), --gamepad-script (fly),
   the reference CSVs a scenario names (fly), recordings (score, replay, replay --video, fly
   --pilot, gamepad-script, joy-publish, recover), a ghost's recording (fly --ghost, replay
-  --ghost) and MIXPILOT_DATA_DIR (demo); replay --video's
+  --ghost), a lesson (lesson --check, lesson --status) and MIXPILOT_DATA_DIR (demo); replay --video's
   --from, --to, --fps and --size values out of range or no numbers.
 File types: a regular file, an empty one, a directory, a FIFO, /dev/zero, /dev/full, a
 symbolic-link loop, a dangling link, an unreadable file (as root, which reads mode-000 files,
@@ -178,6 +178,12 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("joy-publish", ["joy-publish", "--from", "{X}", "--wait", "0"], "refused"),
             ("recover", ["recover", "{X}", "-o", "{D}/out.mcap"], "refused"),
         ], {}),
+        # A lesson (SPEC §10): read to check it, and to say a trainee's progress in it.
+        ("lesson", file_input("l.toml", (scen_dir / "lessons" / "beginner.toml").read_bytes()), [
+            ("lesson --check", ["lesson", "{X}", "--check"], "refused"),
+            ("lesson --status", ["lesson", "{X}", "--trainee", "t", "--status", "--history",
+                                 "{D}/h.sqlite"], "refused"),
+        ], {}),
         # A ghost (SPEC §10): a recording of the scenario flown, read beside the flight.
         ("--ghost", file_input("g.mcap", rec.read_bytes()), [
             ("fly", ["fly", "--scenario", str(scen_dir / "mi_helix.toml"), "--pilot", "novice",
@@ -282,6 +288,10 @@ def build_cases(base, binary, scen_dir, setpriv):
             cases.append(Case(f"nesting {label} in --scenario via fly",
                               ["fly", "--scenario", "{X}", "--headless"] + short, "toml", None,
                               {}, "regular", file_input("deep.toml", text)))
+            ltext = (scen_dir / "lessons" / "beginner.toml").read_bytes() + b"\n" + extra.encode()
+            cases.append(Case(f"nesting {label} in a lesson via lesson --check",
+                              ["lesson", "{X}", "--check"], "toml", None, {}, "regular",
+                              file_input("deep_lesson.toml", ltext)))
             stext = settings_text + extra.encode()
             cases.append(Case(f"nesting {label} in --input-settings via gamepad-script",
                               ["gamepad-script", str(rec), "-o", "{D}/out.csv",
@@ -353,7 +363,14 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("fly --ghost", fly + ["--ghost", ""], "--ghost"),
             ("replay --ghost", ["replay", R, "--headless", "--ghost", ""], "--ghost"),
             ("history --history", ["history", "--history", ""], "--history"),
-            ("history import DIR", ["history", "import", ""], "empty")):
+            ("history import DIR", ["history", "import", ""], "empty"),
+            ("lesson FILE", ["lesson", "", "--check"], "empty"),
+            ("lesson --trainee", ["lesson", "beginner", "--trainee", "", "--status"],
+             "--trainee"),
+            ("lesson --record-dir", ["lesson", "beginner", "--trainee", "t", "--headless",
+                                     "--record-dir", ""], "--record-dir"),
+            ("lesson --history", ["lesson", "beginner", "--trainee", "t", "--status",
+                                  "--history", ""], "--history")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
 
     # replay --video's values: out of range, not numbers, not finite; each a usage error

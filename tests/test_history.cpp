@@ -290,7 +290,8 @@ TEST(HistoryStore, HostileTraineeNames) {
 }
 
 // A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
-// columns, one schema_version row) is brought forward on open; its flights stay.
+// columns, no lesson tables, one schema_version row) is brought forward on open; its flights
+// stay.
 TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   const fs::path p = test::fresh_path("history", "migrate.sqlite");
   auto store = open_store(p);
@@ -301,7 +302,8 @@ TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'metrics_by_name'"), 1);
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
-  EXPECT_EQ(sqlite3_exec(db, "DROP INDEX metrics_by_name; DROP INDEX flights_by_parent; "
+  EXPECT_EQ(sqlite3_exec(db, "DROP TABLE lesson_attempts; DROP TABLE lesson_progress; "
+                             "DROP INDEX metrics_by_name; DROP INDEX flights_by_parent; "
                              "ALTER TABLE flights DROP COLUMN parent_step; "
                              "ALTER TABLE flights DROP COLUMN parent_recording_hash; "
                              "DELETE FROM schema_version WHERE version > 1",

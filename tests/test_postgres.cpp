@@ -183,8 +183,8 @@ TEST(Postgres, AFlightComesBackWithEveryField) {
 }
 
 // A database an older mixpilot made (schema 1: no metrics_by_name index, no branches' parent
-// columns, one schema_version row) is brought forward on open by the same migrations SQLite
-// runs; its flights stay.
+// columns, no lesson tables, one schema_version row) is brought forward on open by the same
+// migrations SQLite runs; its flights stay.
 TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "migrate");
@@ -193,6 +193,8 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   std::string error;
   ASSERT_EQ(store->add(sample_flight(), error), HistoryStore::Added::added) << error;
   store.reset();
+  ASSERT_TRUE(server->exec("migrate", "DROP TABLE lesson_attempts, lesson_progress", error))
+      << error;
   ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
   ASSERT_TRUE(server->exec("migrate",
                            "ALTER TABLE flights DROP COLUMN parent_step, "
@@ -215,6 +217,31 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   const auto rows = all(*store);
   ASSERT_EQ(rows.size(), 1u);
   expect_same_flight(sample_flight(), rows[0]);
+}
+
+// Lessons (SPEC §10): the attempts and the progress as in SQLite (tests/history_test.hpp), and
+// the lesson tables made by the migration to schema 4 from a database of schema 3.
+TEST(Postgres, LessonAttemptsAndProgressAsInSqlite) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  const std::string url = fresh_database(*server, "lessons");
+  auto store = open_store(url);
+  ASSERT_TRUE(store);
+  std::string error;
+  ASSERT_EQ(store->add(sample_flight("Before"), error), HistoryStore::Added::added) << error;
+  store.reset();
+  ASSERT_TRUE(server->exec("lessons", "DROP TABLE lesson_attempts, lesson_progress", error))
+      << error;
+  ASSERT_TRUE(server->exec("lessons", "DELETE FROM schema_version WHERE version > 3", error))
+      << error;
+  store = open_store(url);
+  ASSERT_TRUE(store);
+  EXPECT_EQ(sql(*server, "lessons", "SELECT max(version) FROM schema_version"), "4");
+  EXPECT_EQ(sql(*server, "lessons",
+                "SELECT count(*) FROM pg_indexes WHERE indexname = 'lesson_attempts_by_lesson'"),
+            "1");
+  progress_round_trip(*store);
+  EXPECT_EQ(sql(*server, "lessons", "SELECT count(*) FROM lesson_attempts"), "7");
+  EXPECT_EQ(sql(*server, "lessons", "SELECT count(*) FROM flights"), "9");  // 7 + 1 plain + Before
 }
 
 // Fly from here (SPEC §10): a branch's parent link (the parent flight's recording hash and the

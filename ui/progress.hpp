@@ -50,12 +50,29 @@ struct ProgressView {
   std::string error;               // why the history could not be read ("" fine)
 };
 
+// A trainee's progress in a lesson (SPEC §10), read from the history.
+struct LessonAttemptView {
+  int step = 0;                    // 0-based
+  bool passed = false;
+  std::string detail;              // the verdict in words ("" when passed)
+  double skill = kNoValue;
+};
+struct LessonProgressView {
+  std::string trainee, lesson, lesson_hash;
+  bool loaded = false;             // read from the history (or there was none to read)
+  int step = 0;                    // the step the trainee is on, 0-based (= steps: every one passed)
+  int failed_attempts = 0;         // at it, since they reached it
+  std::vector<LessonAttemptView> attempts;  // oldest first
+  std::string error;               // why the history could not be read ("" fine)
+};
+
 // What the app knows of the history: its trainees (the session panel's picker) and the progress
 // of the chosen trainee on the chosen scenario. Immutable once published.
 struct HistoryView {
   bool loaded = false;             // false until the first load finished
   std::vector<std::string> trainees;  // sorted
   ProgressView progress;
+  LessonProgressView lesson;       // the lesson shown (HistoryWriter::show_lesson)
 };
 
 // The Progress panel (ui.show_progress, H): skill per attempt (assisted and probe flights), D,

@@ -44,9 +44,16 @@ struct FlyFromStart {};       // a flight flown on from a recording's moment: fr
 struct PickGhost {
   int index;                  // into SessionChoices::ghosts
 };
+struct PickLesson {
+  int index;                  // into SessionChoices::lessons (0: none)
+};
+struct ChooseLesson {         // a lesson by its name ("beginner"): what a first launch offers
+  std::string name;
+};
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
-                                 SetRecord, SetTrainee, SetAssist, FlyFromStart, PickGhost>;
+                                 SetRecord, SetTrainee, SetAssist, FlyFromStart, PickGhost,
+                                 PickLesson, ChooseLesson>;
 
 // A replay's transport.
 struct TogglePlay {};

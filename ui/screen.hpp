@@ -62,6 +62,26 @@ struct ReplayInfo {
   double taking_over = -1.0;
 };
 
+// A lesson (SPEC §10) as the session panel shows it: the trainee's current step, how it is
+// flown and judged, and the last flight's verdict. Texts made by the app.
+struct LessonChoice {
+  std::string description;
+  std::vector<std::string> steps;  // the steps' titles
+  int step = -1;                   // the trainee's step, 0-based (= steps.size(): all passed;
+                                   // −1: the history is being read)
+  std::string heading;             // "step 2 of 5: A slow climb"
+  std::string rule;                // one line: "λ ≤ 0.50 · pass: skill ≥ 72, no collision, in B ≥ 90 %"
+  std::string conditions;          // in words: "ceiling: λ at most 0.50 (the planner keeps ...)"
+  std::string criteria;            // in words: "skill at least 72, no collision, ..."
+  std::string attempts;            // "attempts: 1 failed, 2 left" ("" nothing to say)
+  bool closed = false;             // the step's attempts are used up: nothing flies
+  std::string verdict;             // the last flight's: "PASSED" / "NOT PASSED: ..." ("" none)
+  bool verdict_passed = false;
+  std::vector<std::string> verdict_lines;  // each criterion: "✓ skill 80.1 (at least 70)"
+  std::string next;                // what R flies now: "Next: step 3 (R)", "Try again (R)"
+  std::string error;               // the history could not be read ("" fine)
+};
+
 // The session panel's choices (SPEC §8): what the next flight flies.
 struct SessionChoices {
   std::vector<std::string> scenarios;  // labels: shipped scenarios, then opened files
@@ -87,6 +107,11 @@ struct SessionChoices {
   int ghost = -1;
   std::string ghost_note;
   bool ghost_note_is_error = false;
+  // Lessons (SPEC §10): "none" then the lessons' names (empty: no lessons, or no history to
+  // keep the progress in), the one chosen (0: none) and what the panel shows of it.
+  std::vector<std::string> lessons;
+  int lesson = 0;
+  LessonChoice lesson_view;
 };
 
 // A joystick SDL sees.

@@ -61,6 +61,64 @@ void trainee_field(const RunInfo& run, UiState& ui, float fields, Requests& out)
   ImGui::TextUnformatted("trainee");
 }
 
+// The lesson picker (SPEC §10): the lesson, the trainee's step (its place among the steps, how
+// it is flown and judged, the attempts) and the last flight's verdict.
+void lesson_section(const SessionChoices& c, float fields, Requests& out) {
+  int chosen = -1;
+  ImGui::SetNextItemWidth(fields);
+  if (combo("lesson", c.lessons, c.lesson, chosen)) out.push_back(PickLesson{chosen});
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("A course of steps: each a scenario flown with a ceiling on your authority\n"
+                      "and pass criteria. Passing a step moves you to the next, with a higher\n"
+                      "ceiling: the planner's help fades. Your progress is kept in the history.");
+  if (c.lesson <= 0) return;
+  const LessonChoice& l = c.lesson_view;
+  const ImVec4 pilot = ImGui::ColorConvertU32ToFloat4(colour::kPilot);
+  if (!l.error.empty()) {
+    ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", l.error.c_str());
+    return;
+  }
+  if (l.step < 0) {
+    ImGui::TextDisabled("reading the trainee's progress...");
+    return;
+  }
+  // The steps in a row: passed ●, current ▶, to come ○ (their titles on hover), then the
+  // trainee's step, how it is flown and judged in one line (in words on hover).
+  for (int i = 0; i < int(l.steps.size()); ++i) {
+    if (i > 0) ImGui::SameLine(0.0f, ImGui::GetStyle().ItemInnerSpacing.x);
+    const char* mark = i < l.step ? "\xE2\x97\x8F" : i == l.step ? "\xE2\x96\xB6" : "\xE2\x97\x8B";
+    if (i == l.step)
+      ImGui::TextColored(pilot, "%s", mark);
+    else
+      ImGui::TextUnformatted(mark);
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("%d. %s%s", i + 1, l.steps[std::size_t(i)].c_str(),
+                        i < l.step ? " (passed)" : i == l.step ? " (yours now)" : "");
+  }
+  ImGui::SameLine();
+  if (l.step >= int(l.steps.size())) {
+    ImGui::TextColored(pilot, "every step passed");
+  } else {
+    ImGui::TextColored(pilot, "%s", l.heading.c_str());
+    ImGui::TextDisabled("%s", l.rule.c_str());
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("%s\npass: %s", l.conditions.c_str(), l.criteria.c_str());
+    if (!l.attempts.empty()) {
+      if (l.closed)
+        ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical),
+                           "%s: the step is closed", l.attempts.c_str());
+      else
+        ImGui::TextDisabled("%s", l.attempts.c_str());
+    }
+  }
+  if (!l.verdict.empty()) {
+    ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(l.verdict_passed ? colour::kPilot
+                                                                       : colour::kCaution),
+                       "last: %s", l.verdict.c_str());
+    for (const std::string& line : l.verdict_lines) ImGui::TextDisabled("  %s", line.c_str());
+  }
+}
+
 }  // namespace
 
 void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
@@ -71,9 +129,15 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
   // The fields take what their labels leave (the longest label, "scenario", and its gap).
   const float fields = -(ImGui::CalcTextSize("scenario").x + ImGui::GetStyle().ItemInnerSpacing.x);
   ImGui::PushTextWrapPos(0.0f);
+  // A lesson chooses the scenario (and the assistance) of each step.
+  const bool lesson = c.lesson > 0;
+  ImGui::BeginDisabled(lesson);
   ImGui::SetNextItemWidth(fields);
   int chosen = -1;
   if (combo("scenario", c.scenarios, c.scenario, chosen)) out.push_back(PickScenario{chosen});
+  if (lesson && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("The lesson's step sets the scenario (lesson: none to choose one)");
+  ImGui::EndDisabled();
   if (!c.pilots.empty()) {
     ImGui::SetNextItemWidth(fields);
     if (combo("pilot", c.pilots, c.pilot, chosen)) out.push_back(PickPilot{chosen});
@@ -98,7 +162,8 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
       ImGui::SetTooltip("This trainee's flights of this scenario: skill per attempt, best run, trend");
   }
   trainee_field(run, ui, fields, out);
-  if (c.assist_choosable) {
+  if (!c.lessons.empty()) lesson_section(c, fields, out);
+  if (c.assist_choosable && !lesson) {
     bool assist = c.assist;
     if (ImGui::Checkbox("assistance", &assist)) out.push_back(SetAssist{assist});
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
@@ -138,11 +203,22 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());
   ImGui::PopTextWrapPos();
   ImGui::EndDisabled();
+  const bool lesson_closed = lesson && (c.lesson_view.closed || c.lesson_view.step < 0 ||
+                                        c.lesson_view.step >= int(c.lesson_view.steps.size()));
   if (run.state == RunState::ready) {
-    if (ImGui::Button("Start flight (Space)", ImVec2(-1, 0))) out.push_back(StartFlight{});
+    ImGui::BeginDisabled(lesson_closed);
+    const std::string start = lesson && !lesson_closed
+                                  ? "Start step " + std::to_string(c.lesson_view.step + 1) + " (Space)"
+                                  : std::string("Start flight (Space)");
+    if (ImGui::Button(start.c_str(), ImVec2(-1, 0))) out.push_back(StartFlight{});
+    ImGui::EndDisabled();
   } else if (run.can_restart) {
-    if (ImGui::Button(flying ? "Restart (R)" : "Fly again (R)", ImVec2(-1, 0)))
-      out.push_back(RestartFlight{});
+    const std::string again = !flying && lesson && !c.lesson_view.next.empty()
+                                  ? c.lesson_view.next
+                                  : std::string(flying ? "Restart (R)" : "Fly again (R)");
+    ImGui::BeginDisabled(!flying && lesson_closed);
+    if (ImGui::Button(again.c_str(), ImVec2(-1, 0))) out.push_back(RestartFlight{});
+    ImGui::EndDisabled();
   }
 }
 

@@ -60,6 +60,7 @@ std::string load_fonts(float scale) {
   ImGuiIO& io = ImGui::GetIO();
   io.Fonts->Clear();
   static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x2212,
+                                   0x2264, 0x2265,  // ≤ ≥
                                    0x25A0, 0x25FF, 0};  // + geometric shapes (● ▶ ◆)
   const float px = std::round(15.0f * scale);
   const std::string sans = find_font("DejaVu Sans");

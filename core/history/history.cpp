@@ -120,6 +120,46 @@ std::string check_record(const FlightRecord& f) {
   return {};
 }
 
+std::string check_attempt(const LessonAttempt& a) {
+  const std::pair<const char*, const std::string*> texts[] = {
+      {"the lesson", &a.lesson},           {"the lesson hash", &a.lesson_hash},
+      {"the step's title", &a.step_title}, {"the failed criterion", &a.failed_criterion},
+      {"the verdict", &a.detail}};
+  for (const auto& [field, text] : texts)
+    if (std::string why = check_text(field, *text); !why.empty()) return why;
+  if (a.lesson.empty() || a.lesson_hash.empty()) return "the lesson's name or hash is empty";
+  if (a.steps < 1 || a.step < 0 || a.step >= a.steps)
+    return "step " + std::to_string(a.step) + " is not one of the lesson's " +
+           std::to_string(a.steps);
+  if (!(a.ceiling > 0.0 && a.ceiling <= 1.0)) return "the ceiling is outside (0, 1]";
+  if (a.passed != a.failed_criterion.empty())
+    return "a verdict names a failed criterion exactly when it failed";
+  return {};
+}
+
+LessonProgress progress_after(const LessonProgress& before, const LessonAttempt& a,
+                              std::string& why) {
+  why.clear();
+  LessonProgress p = before;
+  if (before.steps > 0 && before.step >= before.steps) {
+    why = "the trainee has passed every step of " + a.lesson + " already";
+    return p;
+  }
+  if (a.step != before.step) {
+    why = "the trainee is on step " + std::to_string(before.step + 1) + " of " + a.lesson +
+          ", not step " + std::to_string(a.step + 1) + " (another flight moved them on)";
+    return p;
+  }
+  p.steps = a.steps;
+  if (a.passed) {
+    p.step = a.step + 1;
+    p.failed_attempts = 0;
+  } else {
+    ++p.failed_attempts;
+  }
+  return p;
+}
+
 std::string host_name() {
   char name[HOST_NAME_MAX + 1] = {};
   if (::gethostname(name, sizeof name - 1) != 0) return {};

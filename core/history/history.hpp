@@ -33,8 +33,42 @@ struct FlightRecord {
   std::int64_t parent_step = -1;
   bool branch() const { return parent_step >= 0; }
 };
+// A lesson step's attempt (SPEC §10): the flight flown for step `step` of the lesson `lesson`
+// (its name) whose file has the SHA-256 `lesson_hash`, and its verdict.
+struct LessonAttempt {
+  std::string lesson, lesson_hash;
+  int steps = 0;                 // how many steps the lesson has (≥ 1)
+  int step = 0;                  // the step flown, 0-based
+  std::string step_title;
+  double ceiling = 1.0;          // the authority ceiling on λ it was flown with, (0, 1]
+  bool passed = false;
+  std::string failed_criterion;  // the first criterion that failed ("" when passed)
+  std::string detail;            // the verdict in words ("skill 41.2 (at least 70)")
+};
+// Where a trainee is in a lesson: on step `step` (0-based; = steps once every step is passed),
+// with `failed_attempts` failed attempts at it since they reached it.
+struct LessonProgress {
+  std::string trainee, lesson, lesson_hash;
+  int steps = 0, step = 0, failed_attempts = 0;
+  std::int64_t updated_unix_ms = 0;
+  bool completed() const { return steps > 0 && step >= steps; }
+};
+struct StoredAttempt : LessonAttempt {
+  std::int64_t id = 0, flight_id = 0;
+  std::string trainee;
+  std::int64_t started_unix_ms = 0;  // the flight's
+  std::string recording_path;        // the flight's ("" when not recorded)
+  double skill = 0.0;                // the flight's score field `skill` (NaN when it has none)
+  bool probe = false;                // the flight was a probe
+};
+
 struct StoredFlight : FlightRecord {
   std::int64_t id = 0;
+  // The lesson step this flight was an attempt at ("" and −1: none), and its verdict.
+  std::string lesson;
+  int lesson_step = -1;
+  bool lesson_passed = false;
+  std::string lesson_failed;  // the criterion that failed ("" when passed or not a lesson's)
 };
 // Which flights query() returns: all of them where a field is empty / 0. `limit` keeps the
 // newest `limit` flights. The answer is oldest first (by start time, then id).
@@ -61,6 +95,27 @@ class HistoryStore {
   [[nodiscard]] virtual bool trainees(std::vector<std::string>& out, std::string& error) = 0;
   [[nodiscard]] virtual bool knows_recording(const std::string& hash, bool& known,
                                              std::string& error) = 0;
+
+  // Lessons (SPEC §10). add_attempt(): a lesson step's flight (as add()) and its verdict in one
+  // transaction, and the trainee's progress moved on: a pass to the next step (its failed
+  // attempts 0), a failure one more failed attempt at this step. The attempt must be at the
+  // step the trainee is on (else it is refused with the reason, nothing written: another
+  // station moved them on); a known recording adds nothing (already_known).
+  [[nodiscard]] virtual std::optional<Added> add_attempt(const FlightRecord& f,
+                                                         const LessonAttempt& a,
+                                                         std::string& error) = 0;
+  // Every lesson `trainee` has attempted ("": every trainee's), by trainee, lesson, hash.
+  [[nodiscard]] virtual bool lesson_progress(const std::string& trainee,
+                                             std::vector<LessonProgress>& out,
+                                             std::string& error) = 0;
+  // The attempts of `trainee` at the lesson (name and hash), oldest first.
+  [[nodiscard]] virtual bool lesson_attempts(const std::string& trainee, const std::string& lesson,
+                                             const std::string& lesson_hash,
+                                             std::vector<StoredAttempt>& out,
+                                             std::string& error) = 0;
+  // The trainee starts the lesson over (step 0, no failed attempt); the attempts stay.
+  [[nodiscard]] virtual bool reset_lesson(const std::string& trainee, const std::string& lesson,
+                                          const std::string& lesson_hash, std::string& error) = 0;
   virtual std::string where() const = 0;  // for messages: the file, or the server WITHOUT credentials
 };
 
@@ -83,6 +138,14 @@ std::string check_trainee(std::string_view name);
 // most kMaxTextBytes; metric names as a trainee's), else why not. Both backends call it.
 inline constexpr std::size_t kMaxTextBytes = 4096;
 std::string check_record(const FlightRecord& f);
+// "" when the attempt can be stored (its texts as check_record's, 0 ≤ step < steps, the ceiling
+// in (0, 1], a failed criterion exactly when it failed), else why not.
+std::string check_attempt(const LessonAttempt& a);
+// The progress after `a`, from `before` (the trainee's progress at that lesson, step 0 when
+// none): passed → the next step, failed → one more failed attempt. "" in `why` when `a` is at
+// the step `before` is on, else why it is refused.
+LessonProgress progress_after(const LessonProgress& before, const LessonAttempt& a,
+                              std::string& why);
 
 // This machine's host name ("" when it has none).
 std::string host_name();

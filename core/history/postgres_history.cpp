@@ -237,6 +237,15 @@ class PostgresHistory final : public HistoryStore {
   bool query(const Query& q, std::vector<StoredFlight>& out, std::string& error) override;
   bool trainees(std::vector<std::string>& out, std::string& error) override;
   bool knows_recording(const std::string& hash, bool& known, std::string& error) override;
+  std::optional<Added> add_attempt(const FlightRecord& f, const LessonAttempt& a,
+                                   std::string& error) override;
+  bool lesson_progress(const std::string& trainee, std::vector<LessonProgress>& out,
+                       std::string& error) override;
+  bool lesson_attempts(const std::string& trainee, const std::string& lesson,
+                       const std::string& lesson_hash, std::vector<StoredAttempt>& out,
+                       std::string& error) override;
+  bool reset_lesson(const std::string& trainee, const std::string& lesson,
+                    const std::string& lesson_hash, std::string& error) override;
   std::string where() const override { return where_; }
 
   // "SERVER: what failed: the message (hint)", scrubbed of every password.
@@ -246,6 +255,13 @@ class PostgresHistory final : public HistoryStore {
   }
 
  private:
+  // Inside a transaction begun by the caller: the flight's rows (trainee, flight, metrics). The
+  // new flight's id and its trainee's (as text); an empty flight id when its recording is known
+  // (nothing written); nullopt with the error (the caller rolls back).
+  struct Inserted {
+    std::string flight_id, trainee_id;
+  };
+  std::optional<Inserted> insert_flight(const FlightRecord& f, std::string& error);
   // Runs `sql` with `p`; the result when its status is `expected`, else nullopt with `error`.
   std::optional<Result> run(const std::string& sql, const Params& p, ExecStatusType expected,
                             const char* what, std::string& error);
@@ -349,44 +365,30 @@ bool PostgresHistory::init(std::string& error) {
   return true;
 }
 
-std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, std::string& error) {
-  if (std::string why = check_record(f); !why.empty()) {
-    error = where_ + ": the flight is not stored: " + why;
-    return std::nullopt;
-  }
-  if (!std::isfinite(f.duration_s)) {
-    error = where_ + ": the flight is not stored: its duration is not a finite number";
-    return std::nullopt;
-  }
-  const std::lock_guard<std::mutex> lock(mutex_);
-  if (!begin("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
-  const auto failed = [&] {
-    rollback();
-    return std::nullopt;
-  };
+std::optional<PostgresHistory::Inserted> PostgresHistory::insert_flight(const FlightRecord& f,
+                                                                      std::string& error) {
   if (!f.recording_hash.empty()) {
     const auto known =
         run("SELECT 1 FROM flights WHERE recording_hash = $1", Params{}.text(f.recording_hash),
             PGRES_TUPLES_OK, "cannot look the recording up", error);
-    if (!known) return failed();
-    if (known->rows() > 0) {
-      rollback();  // nothing was written
-      return Added::already_known;
-    }
+    if (!known) return std::nullopt;
+    if (known->rows() > 0) return Inserted{};  // nothing was written
   }
   // Two stations adding a new trainee at once: one inserts, the other waits for it and reads it.
   if (!run("INSERT INTO trainees (name) VALUES ($1) ON CONFLICT (name) DO NOTHING",
            Params{}.text(f.trainee), PGRES_COMMAND_OK, "cannot add the trainee", error))
-    return failed();
+    return std::nullopt;
   const auto trainee = run("SELECT id FROM trainees WHERE name = $1", Params{}.text(f.trainee),
                            PGRES_TUPLES_OK, "cannot find the trainee", error);
-  if (!trainee) return failed();
+  if (!trainee) return std::nullopt;
   if (trainee->rows() != 1) {
     error = where_ + ": cannot find the trainee just added";
-    return failed();
+    return std::nullopt;
   }
+  Inserted out;
+  out.trainee_id = trainee->text(0, 0);
   Params p;
-  p.text(trainee->text(0, 0))
+  p.text(out.trainee_id)
       .text(f.station)
       .text(f.scenario)
       .text(f.scenario_hash)
@@ -417,19 +419,16 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, s
           "$12::integer, $13, $14, $15, $16, $17, $18::bigint) "
           "ON CONFLICT (recording_hash) DO NOTHING RETURNING id",
           p, PGRES_TUPLES_OK, "cannot add the flight", error);
-  if (!flight) return failed();
-  if (flight->rows() == 0) {
-    rollback();
-    return Added::already_known;
-  }
-  const std::string flight_id = flight->text(0, 0);
+  if (!flight) return std::nullopt;
+  if (flight->rows() == 0) return Inserted{};
+  out.flight_id = flight->text(0, 0);
   // The metrics, a few hundred rows per statement.
   constexpr std::size_t kRowsPerStatement = 500;
   for (std::size_t first = 0; first < f.metrics.size(); first += kRowsPerStatement) {
     const std::size_t last = std::min(f.metrics.size(), first + kRowsPerStatement);
     std::string sql = "INSERT INTO metrics (flight_id, position, name, value) VALUES ";
     Params mp;
-    mp.text(flight_id);
+    mp.text(out.flight_id);
     for (std::size_t i = first; i < last; ++i) {
       const int n = mp.size();
       if (i > first) sql += ", ";
@@ -443,10 +442,187 @@ std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, s
       else
         mp.null();
     }
-    if (!run(sql, mp, PGRES_COMMAND_OK, "cannot add the flight's metrics", error)) return failed();
+    if (!run(sql, mp, PGRES_COMMAND_OK, "cannot add the flight's metrics", error))
+      return std::nullopt;
   }
-  if (!command("COMMIT", "cannot commit the flight", error)) return failed();
+  return out;
+}
+
+std::optional<HistoryStore::Added> PostgresHistory::add(const FlightRecord& f, std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = where_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!std::isfinite(f.duration_s)) {
+    error = where_ + ": the flight is not stored: its duration is not a finite number";
+    return std::nullopt;
+  }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!begin("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
+  const std::optional<Inserted> in = insert_flight(f, error);
+  if (!in) return rollback(), std::nullopt;
+  if (in->flight_id.empty()) {
+    rollback();  // nothing was written
+    return Added::already_known;
+  }
+  if (!command("COMMIT", "cannot commit the flight", error)) return rollback(), std::nullopt;
   return Added::added;
+}
+
+std::optional<HistoryStore::Added> PostgresHistory::add_attempt(const FlightRecord& f,
+                                                                const LessonAttempt& a,
+                                                                std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = where_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (std::string why = check_attempt(a); !why.empty()) {
+    error = where_ + ": the lesson attempt is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!std::isfinite(f.duration_s)) {
+    error = where_ + ": the flight is not stored: its duration is not a finite number";
+    return std::nullopt;
+  }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!begin("BEGIN", "cannot start adding a lesson attempt", error)) return std::nullopt;
+  const std::optional<Inserted> in = insert_flight(f, error);
+  if (!in) return rollback(), std::nullopt;
+  if (in->flight_id.empty()) {
+    rollback();
+    return Added::already_known;
+  }
+  // The trainee's row of the lesson, made if need be and locked: two stations flying the same
+  // trainee's lesson move it on one after the other.
+  const Params key = Params{}.text(in->trainee_id).text(a.lesson).text(a.lesson_hash);
+  Params made = key;
+  made.integer(a.steps).integer(now_unix_ms());
+  if (!run("INSERT INTO lesson_progress (trainee_id, lesson, lesson_hash, steps, step, "
+           "failed_attempts, updated_unix_ms) VALUES ($1::bigint, $2, $3, $4::integer, 0, 0, "
+           "$5::bigint) ON CONFLICT (trainee_id, lesson, lesson_hash) DO NOTHING",
+           made, PGRES_COMMAND_OK, "cannot start the lesson's progress", error))
+    return rollback(), std::nullopt;
+  const auto row = run("SELECT steps, step, failed_attempts FROM lesson_progress WHERE "
+                       "trainee_id = $1::bigint AND lesson = $2 AND lesson_hash = $3 FOR UPDATE",
+                       key, PGRES_TUPLES_OK, "cannot read the lesson's progress", error);
+  if (!row) return rollback(), std::nullopt;
+  if (row->rows() != 1) {
+    error = where_ + ": cannot read the lesson's progress just made";
+    return rollback(), std::nullopt;
+  }
+  LessonProgress before;
+  before.steps = int(read_int(row->at(0, 0)));
+  before.step = int(read_int(row->at(0, 1)));
+  before.failed_attempts = int(read_int(row->at(0, 2)));
+  std::string why;
+  const LessonProgress after = progress_after(before, a, why);
+  if (!why.empty()) {
+    rollback();
+    error = where_ + ": the lesson attempt is not stored: " + why;
+    return std::nullopt;
+  }
+  Params ap;
+  ap.text(in->flight_id)
+      .text(in->trainee_id)
+      .text(a.lesson)
+      .text(a.lesson_hash)
+      .integer(a.step)
+      .text(a.step_title)
+      .text(number(a.ceiling))
+      .integer(a.passed ? 1 : 0)
+      .text_or_null(a.failed_criterion)
+      .text(a.detail);
+  if (!run("INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, step, "
+           "step_title, ceiling, passed, failed_criterion, detail) VALUES ($1::bigint, "
+           "$2::bigint, $3, $4, $5::integer, $6, $7::double precision, $8::integer, $9, $10)",
+           ap, PGRES_COMMAND_OK, "cannot add the lesson attempt", error))
+    return rollback(), std::nullopt;
+  Params up = key;
+  up.integer(after.steps).integer(after.step).integer(after.failed_attempts).integer(now_unix_ms());
+  if (!run("UPDATE lesson_progress SET steps = $4::integer, step = $5::integer, "
+           "failed_attempts = $6::integer, updated_unix_ms = $7::bigint WHERE "
+           "trainee_id = $1::bigint AND lesson = $2 AND lesson_hash = $3",
+           up, PGRES_COMMAND_OK, "cannot move the lesson's progress on", error))
+    return rollback(), std::nullopt;
+  if (!command("COMMIT", "cannot commit the lesson attempt", error))
+    return rollback(), std::nullopt;
+  return Added::added;
+}
+
+bool PostgresHistory::lesson_progress(const std::string& trainee, std::vector<LessonProgress>& out,
+                                      std::string& error) {
+  out.clear();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const auto r = first("SELECT t.name, p.lesson, p.lesson_hash, p.steps, p.step, "
+                       "p.failed_attempts, p.updated_unix_ms FROM lesson_progress p "
+                       "JOIN trainees t ON t.id = p.trainee_id "
+                       "WHERE ($1::text = '' OR t.name = $1::text) "
+                       "ORDER BY t.name COLLATE \"C\", p.lesson COLLATE \"C\", p.updated_unix_ms",
+                       Params{}.text(trainee), PGRES_TUPLES_OK,
+                       "cannot read the lessons' progress", error);
+  if (!r) return false;
+  for (int i = 0; i < r->rows(); ++i) {
+    LessonProgress l;
+    l.trainee = r->text(i, 0);
+    l.lesson = r->text(i, 1);
+    l.lesson_hash = r->text(i, 2);
+    l.steps = int(read_int(r->at(i, 3)));
+    l.step = int(read_int(r->at(i, 4)));
+    l.failed_attempts = int(read_int(r->at(i, 5)));
+    l.updated_unix_ms = read_int(r->at(i, 6));
+    out.push_back(std::move(l));
+  }
+  return true;
+}
+
+bool PostgresHistory::lesson_attempts(const std::string& trainee, const std::string& lesson,
+                                      const std::string& lesson_hash,
+                                      std::vector<StoredAttempt>& out, std::string& error) {
+  out.clear();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const auto r = first(
+      "SELECT a.id, a.flight_id, t.name, a.lesson, a.lesson_hash, a.step, a.step_title, "
+      "a.ceiling, a.passed, a.failed_criterion, a.detail, f.started_unix_ms, f.recording_path, "
+      "f.probe, m.value, (SELECT p.steps FROM lesson_progress p WHERE p.trainee_id = "
+      "a.trainee_id AND p.lesson = a.lesson AND p.lesson_hash = a.lesson_hash) "
+      "FROM lesson_attempts a JOIN trainees t ON t.id = a.trainee_id "
+      "JOIN flights f ON f.id = a.flight_id "
+      "LEFT JOIN metrics m ON m.flight_id = a.flight_id AND m.name = 'skill' "
+      "WHERE t.name = $1 AND a.lesson = $2 AND a.lesson_hash = $3 ORDER BY a.id",
+      Params{}.text(trainee).text(lesson).text(lesson_hash), PGRES_TUPLES_OK,
+      "cannot read the lesson's attempts", error);
+  if (!r) return false;
+  for (int i = 0; i < r->rows(); ++i) {
+    StoredAttempt a;
+    a.id = read_int(r->at(i, 0));
+    a.flight_id = read_int(r->at(i, 1));
+    a.trainee = r->text(i, 2);
+    a.lesson = r->text(i, 3);
+    a.lesson_hash = r->text(i, 4);
+    a.step = int(read_int(r->at(i, 5)));
+    a.step_title = r->text(i, 6);
+    a.ceiling = read_double(r->at(i, 7));
+    a.passed = read_int(r->at(i, 8)) != 0;
+    a.failed_criterion = r->text(i, 9);
+    a.detail = r->text(i, 10);
+    a.started_unix_ms = read_int(r->at(i, 11));
+    a.recording_path = r->text(i, 12);
+    a.probe = read_int(r->at(i, 13)) != 0;
+    a.skill = read_double(r->at(i, 14));
+    a.steps = int(read_int(r->at(i, 15)));
+    out.push_back(std::move(a));
+  }
+  return true;
+}
+
+bool PostgresHistory::reset_lesson(const std::string& trainee, const std::string& lesson,
+                                   const std::string& lesson_hash, std::string& error) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return first("DELETE FROM lesson_progress WHERE trainee_id = (SELECT id FROM trainees WHERE "
+               "name = $1) AND lesson = $2 AND lesson_hash = $3",
+               Params{}.text(trainee).text(lesson).text(lesson_hash), PGRES_COMMAND_OK,
+               "cannot start the lesson over", error)
+      .has_value();
 }
 
 bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
@@ -466,8 +642,9 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
       "SELECT * FROM (SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, "
       "f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, "
       "f.probe, f.recording_path, f.recording_hash, f.app_version, f.front_end, "
-      "f.parent_recording_hash, f.parent_step "
+      "f.parent_recording_hash, f.parent_step, a.lesson, a.step, a.passed, a.failed_criterion "
       "FROM flights f JOIN trainees t ON t.id = f.trainee_id "
+      "LEFT JOIN lesson_attempts a ON a.flight_id = f.id "
       "WHERE ($1::text = '' OR t.name = $1::text) AND ($2::text = '' OR f.scenario = $2::text) "
       "AND f.started_unix_ms >= $3::bigint "
       "ORDER BY f.started_unix_ms DESC, f.id DESC LIMIT $4::bigint) newest "
@@ -501,6 +678,12 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
     f.front_end = s.text(r, 16);
     f.parent_recording_hash = s.text(r, 17);
     f.parent_step = s.at(r, 18) ? read_int(s.at(r, 18)) : -1;
+    if (s.at(r, 19)) {
+      f.lesson = s.text(r, 19);
+      f.lesson_step = int(read_int(s.at(r, 20)));
+      f.lesson_passed = read_int(s.at(r, 21)) != 0;
+      f.lesson_failed = s.text(r, 22);
+    }
     if (r > 0) ids += ',';
     ids += std::to_string(f.id);
     at.emplace(f.id, out.size());

@@ -54,6 +54,37 @@ const std::vector<std::vector<const char*>>& migrations() {
           "ALTER TABLE flights ADD COLUMN parent_step BIGINT CHECK (parent_step >= 0)",
           "CREATE INDEX flights_by_parent ON flights (parent_recording_hash, parent_step)",
       },
+      // 4: lessons (SPEC §10). A lesson is its name and the SHA-256 of its file (a changed file
+      // is another lesson). lesson_progress: the step each trainee is on (0-based; = steps once
+      // every step is passed) and the failed attempts at it since they reached it.
+      // lesson_attempts: each attempt, one flight's row, with its verdict (failed_criterion
+      // NULL when passed). A flight is at most one attempt.
+      {
+          "CREATE TABLE lesson_progress ("
+          " trainee_id BIGINT NOT NULL REFERENCES trainees (id),"
+          " lesson TEXT NOT NULL,"
+          " lesson_hash TEXT NOT NULL,"
+          " steps INTEGER NOT NULL CHECK (steps >= 1),"
+          " step INTEGER NOT NULL CHECK (step >= 0 AND step <= steps),"
+          " failed_attempts INTEGER NOT NULL CHECK (failed_attempts >= 0),"
+          " updated_unix_ms BIGINT NOT NULL,"
+          " PRIMARY KEY (trainee_id, lesson, lesson_hash))",
+          "CREATE TABLE lesson_attempts ("
+          " id {pk},"
+          " flight_id BIGINT NOT NULL UNIQUE REFERENCES flights (id) ON DELETE CASCADE,"
+          " trainee_id BIGINT NOT NULL REFERENCES trainees (id),"
+          " lesson TEXT NOT NULL,"
+          " lesson_hash TEXT NOT NULL,"
+          " step INTEGER NOT NULL CHECK (step >= 0),"
+          " step_title TEXT NOT NULL,"
+          " ceiling {real} NOT NULL CHECK (ceiling > 0 AND ceiling <= 1),"
+          " passed INTEGER NOT NULL CHECK (passed IN (0, 1)),"
+          " failed_criterion TEXT,"
+          " detail TEXT NOT NULL,"
+          " CHECK ((passed = 1) = (failed_criterion IS NULL)))",
+          "CREATE INDEX lesson_attempts_by_lesson ON lesson_attempts (trainee_id, lesson, "
+          "lesson_hash, step, id)",
+      },
   };
   return m;
 }

@@ -2,7 +2,8 @@
 // The history's schema, one for both backends (SPEC §10): a schema_version table (one row per
 // applied migration), trainees (unique name), flights (the FlightRecord's fields; a recording
 // hash is unique, NULL for an unrecorded flight; a branch's parent recording hash and step,
-// NULL for any other flight) and metrics (flight, position, name, value).
+// NULL for any other flight), metrics (flight, position, name, value), and the lessons'
+// lesson_progress (trainee, lesson, step) and lesson_attempts (a flight's verdict).
 // Forward migrations are an ordered list of SQL texts; the few words the dialects spell
 // differently are written as {placeholders} and filled in by dialect().
 //
@@ -21,7 +22,7 @@ namespace mixpilot::history {
 enum class Dialect { sqlite, postgresql };
 
 // The schema this build writes and reads.
-inline constexpr int kSchemaVersion = 3;
+inline constexpr int kSchemaVersion = 4;
 
 inline constexpr const char* kCreateVersionTable =
     "CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL PRIMARY KEY, "

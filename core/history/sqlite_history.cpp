@@ -65,9 +65,25 @@ class SqliteHistory final : public HistoryStore {
   bool query(const Query& q, std::vector<StoredFlight>& out, std::string& error) override;
   bool trainees(std::vector<std::string>& out, std::string& error) override;
   bool knows_recording(const std::string& hash, bool& known, std::string& error) override;
+  std::optional<Added> add_attempt(const FlightRecord& f, const LessonAttempt& a,
+                                   std::string& error) override;
+  bool lesson_progress(const std::string& trainee, std::vector<LessonProgress>& out,
+                       std::string& error) override;
+  bool lesson_attempts(const std::string& trainee, const std::string& lesson,
+                       const std::string& lesson_hash, std::vector<StoredAttempt>& out,
+                       std::string& error) override;
+  bool reset_lesson(const std::string& trainee, const std::string& lesson,
+                    const std::string& lesson_hash, std::string& error) override;
   std::string where() const override { return path_; }
 
  private:
+  // Inside a write transaction: the flight's rows (trainee, flight, metrics). The new flight's
+  // id and its trainee's; 0 when its recording is known (nothing written); nullopt with the
+  // error (the caller rolls back).
+  struct Inserted {
+    std::int64_t flight_id = 0, trainee_id = 0;
+  };
+  std::optional<Inserted> insert_flight(const FlightRecord& f, std::string& error);
   // "FILE: what failed: SQLite's message", with the usual causes said in words.
   std::string fail(const char* what) const;
   bool exec(const char* sql, std::string& error, const char* what);
@@ -175,45 +191,38 @@ std::string column_text(sqlite3_stmt* s, int i) {
   return p ? std::string(p, std::size_t(sqlite3_column_bytes(s, i))) : std::string();
 }
 
-std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std::string& error) {
-  if (std::string why = check_record(f); !why.empty()) {
-    error = path_ + ": the flight is not stored: " + why;
-    return std::nullopt;
-  }
-  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to add a flight"))
-    return std::nullopt;
-  const auto failed = [&](const char* what) {
-    error = fail(what);
-    rollback();
-    return std::nullopt;
-  };
+std::optional<SqliteHistory::Inserted> SqliteHistory::insert_flight(const FlightRecord& f,
+                                                                  std::string& error) {
   if (!f.recording_hash.empty()) {
     Stmt k;
-    if (!prepare(k, "SELECT 1 FROM flights WHERE recording_hash = ?", error))
-      return rollback(), std::nullopt;
+    if (!prepare(k, "SELECT 1 FROM flights WHERE recording_hash = ?", error)) return std::nullopt;
     bind_text(k.get(), 1, f.recording_hash);
     const int rc = sqlite3_step(k.get());
-    if (rc == SQLITE_ROW) {
-      rollback();  // nothing was written
-      return Added::already_known;
+    if (rc == SQLITE_ROW) return Inserted{};  // nothing was written
+    if (rc != SQLITE_DONE) {
+      error = fail("cannot look the recording up");
+      return std::nullopt;
     }
-    if (rc != SQLITE_DONE) return failed("cannot look the recording up");
   }
-  std::int64_t trainee_id = 0;
+  Inserted out;
   {
     Stmt t;
     if (!prepare(t, "INSERT INTO trainees (name) VALUES (?) ON CONFLICT (name) DO NOTHING", error))
-      return rollback(), std::nullopt;
+      return std::nullopt;
     bind_text(t.get(), 1, f.trainee);
-    if (sqlite3_step(t.get()) != SQLITE_DONE) return failed("cannot add the trainee");
+    if (sqlite3_step(t.get()) != SQLITE_DONE) {
+      error = fail("cannot add the trainee");
+      return std::nullopt;
+    }
     Stmt id;
-    if (!prepare(id, "SELECT id FROM trainees WHERE name = ?", error))
-      return rollback(), std::nullopt;
+    if (!prepare(id, "SELECT id FROM trainees WHERE name = ?", error)) return std::nullopt;
     bind_text(id.get(), 1, f.trainee);
-    if (sqlite3_step(id.get()) != SQLITE_ROW) return failed("cannot find the trainee");
-    trainee_id = sqlite3_column_int64(id.get(), 0);
+    if (sqlite3_step(id.get()) != SQLITE_ROW) {
+      error = fail("cannot find the trainee");
+      return std::nullopt;
+    }
+    out.trainee_id = sqlite3_column_int64(id.get(), 0);
   }
-  std::int64_t flight_id = 0;
   {
     Stmt s;
     if (!prepare(s,
@@ -223,9 +232,9 @@ std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std
                  "parent_step) "
                  "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
                  error))
-      return rollback(), std::nullopt;
+      return std::nullopt;
     sqlite3_stmt* p = s.get();
-    sqlite3_bind_int64(p, 1, trainee_id);
+    sqlite3_bind_int64(p, 1, out.trainee_id);
     bind_text(p, 2, f.station);
     bind_text(p, 3, f.scenario);
     bind_text(p, 4, f.scenario_hash);
@@ -246,17 +255,20 @@ std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std
       sqlite3_bind_int64(p, 18, f.parent_step);
     else
       sqlite3_bind_null(p, 18);
-    if (sqlite3_step(p) != SQLITE_ROW) return failed("cannot add the flight");
-    flight_id = sqlite3_column_int64(p, 0);
+    if (sqlite3_step(p) != SQLITE_ROW) {
+      error = fail("cannot add the flight");
+      return std::nullopt;
+    }
+    out.flight_id = sqlite3_column_int64(p, 0);
   }
   {
     Stmt m;
     if (!prepare(m, "INSERT INTO metrics (flight_id, position, name, value) VALUES (?, ?, ?, ?)",
                  error))
-      return rollback(), std::nullopt;
+      return std::nullopt;
     for (std::size_t i = 0; i < f.metrics.size(); ++i) {
       sqlite3_reset(m.get());
-      sqlite3_bind_int64(m.get(), 1, flight_id);
+      sqlite3_bind_int64(m.get(), 1, out.flight_id);
       sqlite3_bind_int64(m.get(), 2, std::int64_t(i));
       bind_text(m.get(), 3, f.metrics[i].first);
       // Not a finite number: NULL (as the reports' JSON null).
@@ -264,12 +276,226 @@ std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std
         sqlite3_bind_double(m.get(), 4, f.metrics[i].second);
       else
         sqlite3_bind_null(m.get(), 4);
-      if (sqlite3_step(m.get()) != SQLITE_DONE) return failed("cannot add the flight's metrics");
+      if (sqlite3_step(m.get()) != SQLITE_DONE) {
+        error = fail("cannot add the flight's metrics");
+        return std::nullopt;
+      }
     }
   }
-  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK)
-    return failed("cannot commit the flight");
+  return out;
+}
+
+std::optional<HistoryStore::Added> SqliteHistory::add(const FlightRecord& f, std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = path_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to add a flight"))
+    return std::nullopt;
+  const std::optional<Inserted> in = insert_flight(f, error);
+  if (!in) return rollback(), std::nullopt;
+  if (in->flight_id == 0) {
+    rollback();  // nothing was written
+    return Added::already_known;
+  }
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+    error = fail("cannot commit the flight");
+    rollback();
+    return std::nullopt;
+  }
   return Added::added;
+}
+
+std::optional<HistoryStore::Added> SqliteHistory::add_attempt(const FlightRecord& f,
+                                                              const LessonAttempt& a,
+                                                              std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = path_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (std::string why = check_attempt(a); !why.empty()) {
+    error = path_ + ": the lesson attempt is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to add a lesson attempt"))
+    return std::nullopt;
+  const auto failed = [&](const char* what) {
+    error = fail(what);
+    rollback();
+    return std::nullopt;
+  };
+  const std::optional<Inserted> in = insert_flight(f, error);
+  if (!in) return rollback(), std::nullopt;
+  if (in->flight_id == 0) {
+    rollback();
+    return Added::already_known;
+  }
+  LessonProgress before;
+  before.step = 0;
+  {
+    Stmt p;
+    if (!prepare(p,
+                 "SELECT steps, step, failed_attempts FROM lesson_progress WHERE trainee_id = ? "
+                 "AND lesson = ? AND lesson_hash = ?",
+                 error))
+      return rollback(), std::nullopt;
+    sqlite3_bind_int64(p.get(), 1, in->trainee_id);
+    bind_text(p.get(), 2, a.lesson);
+    bind_text(p.get(), 3, a.lesson_hash);
+    const int rc = sqlite3_step(p.get());
+    if (rc == SQLITE_ROW) {
+      before.steps = sqlite3_column_int(p.get(), 0);
+      before.step = sqlite3_column_int(p.get(), 1);
+      before.failed_attempts = sqlite3_column_int(p.get(), 2);
+    } else if (rc != SQLITE_DONE) {
+      return failed("cannot read the lesson's progress");
+    }
+  }
+  std::string why;
+  const LessonProgress after = progress_after(before, a, why);
+  if (!why.empty()) {
+    rollback();
+    error = path_ + ": the lesson attempt is not stored: " + why;
+    return std::nullopt;
+  }
+  {
+    Stmt s;
+    if (!prepare(s,
+                 "INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, step, "
+                 "step_title, ceiling, passed, failed_criterion, detail) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                 error))
+      return rollback(), std::nullopt;
+    sqlite3_stmt* p = s.get();
+    sqlite3_bind_int64(p, 1, in->flight_id);
+    sqlite3_bind_int64(p, 2, in->trainee_id);
+    bind_text(p, 3, a.lesson);
+    bind_text(p, 4, a.lesson_hash);
+    sqlite3_bind_int(p, 5, a.step);
+    bind_text(p, 6, a.step_title);
+    sqlite3_bind_double(p, 7, a.ceiling);
+    sqlite3_bind_int(p, 8, a.passed ? 1 : 0);
+    bind_text(p, 9, a.failed_criterion, true);
+    bind_text(p, 10, a.detail);
+    if (sqlite3_step(p) != SQLITE_DONE) return failed("cannot add the lesson attempt");
+  }
+  {
+    Stmt s;
+    if (!prepare(s,
+                 "INSERT INTO lesson_progress (trainee_id, lesson, lesson_hash, steps, step, "
+                 "failed_attempts, updated_unix_ms) VALUES (?, ?, ?, ?, ?, ?, ?) "
+                 "ON CONFLICT (trainee_id, lesson, lesson_hash) DO UPDATE SET "
+                 "steps = excluded.steps, step = excluded.step, "
+                 "failed_attempts = excluded.failed_attempts, "
+                 "updated_unix_ms = excluded.updated_unix_ms",
+                 error))
+      return rollback(), std::nullopt;
+    sqlite3_stmt* p = s.get();
+    sqlite3_bind_int64(p, 1, in->trainee_id);
+    bind_text(p, 2, a.lesson);
+    bind_text(p, 3, a.lesson_hash);
+    sqlite3_bind_int(p, 4, after.steps);
+    sqlite3_bind_int(p, 5, after.step);
+    sqlite3_bind_int(p, 6, after.failed_attempts);
+    sqlite3_bind_int64(p, 7, now_unix_ms());
+    if (sqlite3_step(p) != SQLITE_DONE) return failed("cannot move the lesson's progress on");
+  }
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK)
+    return failed("cannot commit the lesson attempt");
+  return Added::added;
+}
+
+bool SqliteHistory::lesson_progress(const std::string& trainee, std::vector<LessonProgress>& out,
+                                    std::string& error) {
+  out.clear();
+  Stmt s;
+  if (!prepare(s,
+               "SELECT t.name, p.lesson, p.lesson_hash, p.steps, p.step, p.failed_attempts, "
+               "p.updated_unix_ms FROM lesson_progress p JOIN trainees t ON t.id = p.trainee_id "
+               "WHERE (?1 = '' OR t.name = ?1) ORDER BY t.name, p.lesson, p.updated_unix_ms",
+               error))
+    return false;
+  bind_text(s.get(), 1, trainee);
+  int rc;
+  while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
+    sqlite3_stmt* p = s.get();
+    LessonProgress l;
+    l.trainee = column_text(p, 0);
+    l.lesson = column_text(p, 1);
+    l.lesson_hash = column_text(p, 2);
+    l.steps = sqlite3_column_int(p, 3);
+    l.step = sqlite3_column_int(p, 4);
+    l.failed_attempts = sqlite3_column_int(p, 5);
+    l.updated_unix_ms = sqlite3_column_int64(p, 6);
+    out.push_back(std::move(l));
+  }
+  if (rc == SQLITE_DONE) return true;
+  error = fail("cannot read the lessons' progress");
+  return false;
+}
+
+bool SqliteHistory::lesson_attempts(const std::string& trainee, const std::string& lesson,
+                                    const std::string& lesson_hash,
+                                    std::vector<StoredAttempt>& out, std::string& error) {
+  out.clear();
+  Stmt s;
+  if (!prepare(s,
+               "SELECT a.id, a.flight_id, t.name, a.lesson, a.lesson_hash, a.step, a.step_title, "
+               "a.ceiling, a.passed, a.failed_criterion, a.detail, f.started_unix_ms, "
+               "f.recording_path, f.probe, m.value, "
+               "(SELECT p.steps FROM lesson_progress p WHERE p.trainee_id = a.trainee_id AND "
+               "p.lesson = a.lesson AND p.lesson_hash = a.lesson_hash) "
+               "FROM lesson_attempts a JOIN trainees t ON t.id = a.trainee_id "
+               "JOIN flights f ON f.id = a.flight_id "
+               "LEFT JOIN metrics m ON m.flight_id = a.flight_id AND m.name = 'skill' "
+               "WHERE t.name = ? AND a.lesson = ? AND a.lesson_hash = ? ORDER BY a.id",
+               error))
+    return false;
+  bind_text(s.get(), 1, trainee);
+  bind_text(s.get(), 2, lesson);
+  bind_text(s.get(), 3, lesson_hash);
+  int rc;
+  while ((rc = sqlite3_step(s.get())) == SQLITE_ROW) {
+    sqlite3_stmt* p = s.get();
+    StoredAttempt a;
+    a.id = sqlite3_column_int64(p, 0);
+    a.flight_id = sqlite3_column_int64(p, 1);
+    a.trainee = column_text(p, 2);
+    a.lesson = column_text(p, 3);
+    a.lesson_hash = column_text(p, 4);
+    a.step = sqlite3_column_int(p, 5);
+    a.step_title = column_text(p, 6);
+    a.ceiling = sqlite3_column_double(p, 7);
+    a.passed = sqlite3_column_int(p, 8) != 0;
+    a.failed_criterion = column_text(p, 9);
+    a.detail = column_text(p, 10);
+    a.started_unix_ms = sqlite3_column_int64(p, 11);
+    a.recording_path = column_text(p, 12);
+    a.probe = sqlite3_column_int(p, 13) != 0;
+    a.skill = sqlite3_column_type(p, 14) == SQLITE_NULL ? std::numeric_limits<double>::quiet_NaN()
+                                                        : sqlite3_column_double(p, 14);
+    a.steps = sqlite3_column_int(p, 15);
+    out.push_back(std::move(a));
+  }
+  if (rc == SQLITE_DONE) return true;
+  error = fail("cannot read the lesson's attempts");
+  return false;
+}
+
+bool SqliteHistory::reset_lesson(const std::string& trainee, const std::string& lesson,
+                                 const std::string& lesson_hash, std::string& error) {
+  Stmt s;
+  if (!prepare(s,
+               "DELETE FROM lesson_progress WHERE trainee_id = (SELECT id FROM trainees WHERE "
+               "name = ?) AND lesson = ? AND lesson_hash = ?",
+               error))
+    return false;
+  bind_text(s.get(), 1, trainee);
+  bind_text(s.get(), 2, lesson);
+  bind_text(s.get(), 3, lesson_hash);
+  if (sqlite3_step(s.get()) == SQLITE_DONE) return true;
+  error = fail("cannot start the lesson over");
+  return false;
 }
 
 bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
@@ -278,13 +504,14 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
   // their metrics. Readers take a snapshot (WAL): one transaction for both statements.
   static constexpr const char* kFilter =
       " FROM flights f JOIN trainees t ON t.id = f.trainee_id"
+      " LEFT JOIN lesson_attempts a ON a.flight_id = f.id"
       " WHERE (?1 = '' OR t.name = ?1) AND (?2 = '' OR f.scenario = ?2)"
       " AND f.started_unix_ms >= ?3";
   static constexpr const char* kColumns =
       "SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, f.pilot, "
       "f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, f.probe, "
       "f.recording_path, f.recording_hash, f.app_version, f.front_end, "
-      "f.parent_recording_hash, f.parent_step";
+      "f.parent_recording_hash, f.parent_step, a.lesson, a.step, a.passed, a.failed_criterion";
   // Without a limit the start-time index gives the order as it is: no sort of every row.
   const std::string flights_sql =
       q.limit > 0 ? std::string("SELECT * FROM (") + kColumns + kFilter +
@@ -325,6 +552,12 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       f.front_end = column_text(p, 16);
       f.parent_recording_hash = column_text(p, 17);
       f.parent_step = sqlite3_column_type(p, 18) == SQLITE_NULL ? -1 : sqlite3_column_int64(p, 18);
+      if (sqlite3_column_type(p, 19) != SQLITE_NULL) {
+        f.lesson = column_text(p, 19);
+        f.lesson_step = sqlite3_column_int(p, 20);
+        f.lesson_passed = sqlite3_column_int(p, 21) != 0;
+        f.lesson_failed = column_text(p, 22);
+      }
       out.push_back(std::move(f));
     }
     if (rc != SQLITE_DONE) {

@@ -475,6 +475,13 @@ bool SessionRecorder::open(const std::string& path, uint64_t control_period_ns,
     metadata.emplace("authority_floor", exact_text(info.bounds.floor));
     metadata.emplace("authority_ceiling", exact_text(info.bounds.ceiling));
   }
+  if (!info.lesson.empty()) {
+    metadata.emplace("lesson", info.lesson);
+    metadata.emplace("lesson_hash", info.lesson_hash);
+    metadata.emplace("lesson_step", std::to_string(info.lesson_step));
+    metadata.emplace("lesson_steps", std::to_string(info.lesson_steps));
+    metadata.emplace("lesson_step_title", info.lesson_step_title);
+  }
   if (info.parent_step >= 0) {
     metadata.emplace("parent_recording", info.parent_recording);
     metadata.emplace("parent_sha256", info.parent_sha256);

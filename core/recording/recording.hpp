@@ -204,6 +204,14 @@ struct SessionInfo {
   std::string parent_recording = {};
   std::string parent_sha256 = {};
   std::int64_t parent_step = -1;
+  // A lesson step's flight (SPEC §10): the lesson's name and file hash, the step's number
+  // (1-based, as the trainee sees it) of how many, and its title; written as lesson,
+  // lesson_hash, lesson_step, lesson_steps and lesson_step_title. "" / 0: not a lesson's.
+  std::string lesson = {};
+  std::string lesson_hash = {};
+  int lesson_step = 0;
+  int lesson_steps = 0;
+  std::string lesson_step_title = {};
 };
 
 // How a recording ended: its closing "mixpilot_end" Metadata record, written by
