@@ -243,6 +243,7 @@ TEST_F(InstructorWindow, TwoStationsACeilingAcceptedAndRefusalsShown) {
   cli::InstructorAppOptions o;
   o.domain = dom;
   o.issuer = "window-test";
+  o.answer_s = 60;  // a loaded or sanitized machine: the answer is waited for, never timed
   cli::InstructorApp app(o);
   ASSERT_TRUE(app.open(error)) << error;
   Driver d{*screen, [&] { app.build_frame(1.0 / 30.0); }};
