@@ -1,7 +1,7 @@
-// mixpilot instruct: the instructor's command line (SPEC §10, docs/instructor-security.md):
-// the stations announced on the DDS domain, or one command to one station, waited for until the
-// station announces what became of it. Built on net::InstructorClient, which a window can use
-// the same way.
+// mixpilot instruct: the instructor (SPEC §10, docs/instructor-security.md): its window
+// (app/instructor_app.hpp), or on the command line the stations announced on the DDS domain, or
+// one command to one station, waited for until the station announces what became of it. Both
+// are built on net::InstructorClient.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +12,9 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight.hpp"
+#include "app/instructor_app.hpp"
+#include "app/screenshot.hpp"
+#include "app/window.hpp"
 #include "core/history/history.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/instructor_client.hpp"
@@ -25,10 +28,18 @@ constexpr int kExitRefused = 4;   // the station, or DDS Security, refused the c
 constexpr int kExitNoAnswer = 5;  // the station was not heard, or did not answer in time
 
 constexpr const char* kUsage =
-    "usage: mixpilot instruct --list [--count N] [options]\n"
+    "usage: mixpilot instruct [--station NAME] [window options] [options]\n"
+    "       mixpilot instruct --list [--count N] [options]\n"
     "       mixpilot instruct --station NAME COMMAND [options]\n"
     "\n"
-    "The instructor's command line (SPEC §10). --list prints the stations announced on the DDS\n"
+    "The instructor (SPEC §10). Without --list or a command it opens a window: the stations\n"
+    "announced on the DDS domain, up to four side by side (a small arena, the λ strip, the\n"
+    "deviation and the score so far), one large with its plots (click a tile, or 1-4), and in\n"
+    "a pane on the right the commands to the selected station, each with what became of it\n"
+    "(F1 lists the keys).\n"
+    "--station NAME opens it on that station, large.\n"
+    "\n"
+    "On the command line, --list prints the stations announced on the DDS\n"
     "domain (every `fly --publish`): trainee, scenario, state, time, λ, deviation, time in B,\n"
     "whether it obeys an instructor, the commands it accepted and refused, and its telemetry\n"
     "heard here. --station sends one command to one station and waits until the station\n"
@@ -43,6 +54,15 @@ constexpr const char* kUsage =
     "  --delay S          extra round-trip delay, 0 to 0.5 s (0 removes it)\n"
     "  --marker TEXT      a marker in the debrief: 1 to 95 bytes of UTF-8\n"
     "  --pause, --resume, --end\n"
+    "\n"
+    "window options:\n"
+    "  --headless         no window: render --screenshot's frames offscreen (EGL)\n"
+    "  --screenshot T:FILE.png  the window's frame T seconds after it opened (headless: after\n"
+    "                     --count stations were heard); repeatable\n"
+    "  --count N          headless: wait (up to --wait) for N stations and their telemetry\n"
+    "  --size WxH         the window's size (default 1280x720)\n"
+    "  --scale S          the UI's display scale (default: the display's; headless 1)\n"
+    "  --force            screenshots may replace existing files\n"
     "\n"
     "options:\n"
     "  --domain N         DDS domain (0-232, default 0; 0-230 with DDS Security)\n"
@@ -62,10 +82,11 @@ constexpr const char* kUsage =
     "DDS stays on this machine unless CYCLONEDDS_URI names another configuration\n"
     "(docs/network.md).\n"
     "\n"
-    "exit status: 0 listed, or the command was accepted; 1 a failure (DDS, unreadable security\n"
-    "files); 2 usage; 4 refused (by the station, or by DDS Security: this identity may not\n"
+    "exit status: 0 listed, the command was accepted, or the window closed; 1 a failure (DDS,\n"
+    "unreadable security files, no display: use --list or --headless); 2 usage; 4 refused (by the station, or by DDS Security: this identity may not\n"
     "command, its certificate is not trusted or expired); 5 no answer (the station was not\n"
-    "heard, its command reader never matched, or it did not answer within --wait)\n";
+    "heard, its command reader never matched, or it did not answer within --wait; headless:\n"
+    "fewer than --count stations heard)\n";
 
 std::optional<double> parse_number(const std::string& text) {
   char* end = nullptr;
@@ -120,6 +141,8 @@ int instruct_command(int argc, char** argv) {
   double wait_s = 10.0;
   int count = 0;
   std::optional<std::uint64_t> sequence;
+  InstructWindowOptions window;
+  bool window_option = false;  // an option only the window takes
   std::optional<double> floor, ceiling, duration;
   InstructorCommand c;
   int commands = 0;
@@ -139,6 +162,28 @@ int instruct_command(int argc, char** argv) {
     if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return kExitOk;
+    } else if (a == "--headless") {
+      window.headless = true;
+      window_option = true;
+    } else if (a == "--screenshot") {
+      const std::string v = value();
+      const std::optional<ScreenshotRequest> r = parse_screenshot(v);
+      if (!r) usage_error(cmd, "--screenshot expects T:FILE.png with T >= 0 seconds, got '" + v + "'");
+      window.screenshots.push_back({r->t, r->path});
+      window_option = true;
+    } else if (a == "--size") {
+      const std::string v = value();
+      if (!parse_size(v, window.width, window.height))
+        usage_error(cmd, "--size expects WxH from 64 to 8192, got '" + v + "'");
+      window_option = true;
+    } else if (a == "--scale") {
+      const double s = number("a display scale from 0.5 to 4");
+      if (s < 0.5 || s > 4) usage_error(cmd, "--scale expects a display scale from 0.5 to 4");
+      window.scale = float(s);
+      window_option = true;
+    } else if (a == "--force") {
+      window.overwrite = true;
+      window_option = true;
     } else if (a == "--list") {
       list = true;
     } else if (a == "--station") {
@@ -215,13 +260,19 @@ int instruct_command(int argc, char** argv) {
     if (!c.bounds.valid())
       usage_error(cmd, "the floor must not be above the ceiling (0 <= floor <= ceiling <= 1)");
   }
-  if (list == !station.empty())
-    usage_error(cmd, "--list, or --station NAME with one command (see --help)");
+  const bool in_window = !list && commands == 0;
+  if (list && !station.empty()) usage_error(cmd, "--list or --station NAME, not both");
   if (list && commands > 0) usage_error(cmd, "--list sends no command");
-  if (!list && commands != 1)
-    usage_error(cmd, commands == 0 ? "which command? (--ceiling, --gust, --marker, --pause...)"
-                                   : "one command per run");
-  if (count > 0 && !list) usage_error(cmd, "--count goes with --list");
+  if (!list && commands > 1) usage_error(cmd, "one command per run");
+  if (!in_window && window_option)
+    usage_error(cmd, "--headless, --screenshot, --size, --scale and --force go with the window "
+                     "(no --list, no command)");
+  if (!list && commands == 1 && station.empty())
+    usage_error(cmd, "to which station? (--station NAME)");
+  if (count > 0 && !list && !(in_window && window.headless))
+    usage_error(cmd, "--count goes with --list or --headless");
+  if (in_window && window.headless && window.screenshots.empty())
+    usage_error(cmd, "--headless renders only --screenshot T:FILE.png frames (or use --list)");
   if (sequence && list) usage_error(cmd, "--sequence goes with a command");
   const bool timed = c.kind == InstructorCommandKind::gust ||
                      c.kind == InstructorCommandKind::input_loss;
@@ -238,6 +289,14 @@ int instruct_command(int argc, char** argv) {
   if (issuer.size() > net::kMaxIssuer) issuer.resize(net::kMaxIssuer);
   if (!net::printable_utf8(issuer)) issuer = "instructor";
 
+  if (in_window) {
+    // Before anything is opened: a window needs a display.
+    std::string error;
+    if (!window.headless && !window_available(error)) {
+      std::fprintf(stderr, "mixpilot %s: %s (or --list)\n", cmd, error.c_str());
+      return kExitError;
+    }
+  }
   net::use_loopback_unless_configured();
   if (!security.empty()) {
     std::string error;
@@ -247,6 +306,19 @@ int instruct_command(int argc, char** argv) {
       return kExitError;
     }
     net::use_security(*files);
+  }
+  if (in_window) {
+    window.app.domain = domain;
+    window.app.issuer = issuer;
+    window.app.security = security;
+    window.app.select = station;
+    window.count = count;
+    window.wait_s = wait_s;
+    catch_interrupts();
+    std::string error;
+    const int status = run_instruct_window(window, error);
+    if (status != kExitOk) std::fprintf(stderr, "mixpilot %s: %s\n", cmd, error.c_str());
+    return status;
   }
   net::InstructorClient client;
   std::string error;

@@ -124,6 +124,16 @@ bool window_available(std::string& error) {
 
 bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& written,
                 std::string& error) {
+  WindowContent c;
+  c.build_frame = [&app](double dt) { app.build_frame(dt); };
+  c.shown_time = [&app] { return app.shown_time(); };
+  c.start = [&app] { app.start(); };
+  c.over = [&app] { return app.over(); };
+  return run_window(c, o, written, error);
+}
+
+bool run_window(const WindowContent& app, const WindowOptions& o,
+                std::vector<std::string>& written, std::string& error) {
   if (!glfwInit()) {
     error = "cannot open a window (" + glfw_error() + "); use --headless";
     return false;
@@ -131,7 +141,7 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  GLFWwindow* window = glfwCreateWindow(o.width, o.height, "mixpilot", nullptr, nullptr);
+  GLFWwindow* window = glfwCreateWindow(o.width, o.height, o.title.c_str(), nullptr, nullptr);
   if (!window) {
     error = "cannot open an OpenGL 3.3 window (" + glfw_error() + "); use --headless";
     glfwTerminate();
@@ -152,7 +162,7 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
 
   std::vector<bool> shot(o.screenshots.size(), false);
   bool ok = true;
-  if (o.exit_at_end) app.start();
+  if (o.exit_at_end && app.start) app.start();
   auto last = std::chrono::steady_clock::now();
   std::string title;
   while (!glfwWindowShouldClose(window) && !interrupted()) {  // ^C ends the flight as headless
@@ -174,7 +184,7 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
     }
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    const double shown = app.shown_time();
+    const double shown = app.shown_time ? app.shown_time() : -1.0;
     for (std::size_t i = 0; i < shot.size(); ++i) {
       if (shot[i] || shown < o.screenshots[i].t) continue;
       shot[i] = true;
@@ -187,7 +197,7 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
       }
     }
     glfwSwapBuffers(window);
-    if (o.exit_at_end && app.over()) break;
+    if (o.exit_at_end && app.over && app.over()) break;
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();

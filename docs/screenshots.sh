@@ -2,8 +2,8 @@
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
 # why λ fell, a ghost run, and the input settings, Progress and lesson panels, fly from here and
-# the debrief at
-# 1280x720 (app tests render them). The flights
+# the debrief at 1280x720 (app tests render them), and the instructor's window with two
+# stations. The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
 set -euo pipefail
@@ -66,6 +66,24 @@ cp "$tmp/lesson_picker_100.png" $out/lesson_picker.png
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_debrief" \
   --gtest_filter='Scales/DebriefScreen.ThePanelListsTheEventsAndTheBracketsStepThroughThem/0' >/dev/null
 cp "$tmp/debrief_100.png" $out/debrief.png
+# The instructor's window (mixpilot instruct): two stations flying in real time on a domain of
+# this run's own (loopback only), the novice at station A (it obeys unauthenticated commands on
+# loopback), the experienced pilot at B (it obeys no instructor); a ceiling of 0.3 sent to A from
+# the command line first, so A's announced results show it; the window 4 s after both are heard.
+domain=$((1 + $$ % 200))
+for s in A:novice B:experienced; do
+  extra=()
+  [ "${s%%:*}" = A ] && extra=(--instructor --allow-unauthenticated-commands)
+  "$m" fly --scenario scenarios/mi_helix_endurance.toml --pilot "${s#*:}" --headless --realtime \
+    --publish --domain $domain --station "${s%%:*}" --trainee "${s#*:} pilot" --history off \
+    "${extra[@]}" >"$tmp/station-${s%%:*}.txt" 2>&1 &
+done
+"$m" instruct --domain $domain --list --count 2 --wait 60 >/dev/null
+"$m" instruct --domain $domain --station A --ceiling 0.3 --issuer docs >/dev/null
+"$m" instruct --domain $domain --headless --count 2 --wait 60 --screenshot 4:$out/instructor.png \
+  --force >/dev/null
+kill -INT $(jobs -p) 2>/dev/null || true
+wait
 # The progress report to take home (history --html) of a trainee who flew the helix three times
 # as the novice, three times as the experienced pilot (each attempt with its own position noise)
 # and once unassisted, as headless Chromium prints it (Debian's chromium package).

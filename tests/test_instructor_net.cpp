@@ -408,7 +408,9 @@ TEST_F(InstructorNet, TheCommandLineSaysWhatIsWrong) {
     EXPECT_NE(read_file(dir / "out.txt").find(expected), std::string::npos)
         << args << ": " << read_file(dir / "out.txt");
   };
-  usage("--station A", "which command?");
+  usage("--headless", "--headless renders only --screenshot");
+  usage("--list --headless", "go with the window");
+  usage("--pause", "to which station?");
   usage("--station A --gust 2,0,0", "--gust needs --duration");
   usage("--station A --gust 30,0,0 --duration 1", "at most 20 N");
   usage("--station A --floor 0.6 --ceiling 0.4", "the floor must not be above the ceiling");

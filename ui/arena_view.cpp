@@ -406,7 +406,7 @@ bool project_in_arena(const Scene& sc, const Telemetry& newest, const UiState& u
 }
 
 void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVec2 max,
-                ImVec2 frame, ImVec2 clear_min, ImVec2 clear_max) {
+                ImVec2 frame, ImVec2 clear_min, ImVec2 clear_max, bool camera_hint) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   dl->PushClipRect(min, max, true);
   dl->AddRectFilled(min, max, colour::kBackground);
@@ -519,6 +519,10 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
                                                : float(1.2 * (sc.arena_max - sc.arena_min).norm());
       ui.orbit_distance = std::clamp(base * std::pow(0.9f, io.MouseWheel), 0.5f, 100.0f);
     }
+  }
+  if (!camera_hint) {
+    dl->PopClipRect();
+    return;
   }
   // The camera and its keys at the bottom left; the keys shorter where the view is narrow.
   const float inset = ImGui::GetStyle().WindowPadding.x;

@@ -13,8 +13,10 @@ namespace mixpilot::ui {
 // 3D arena of the quadrotor modes over the pane [min, max), framed in [frame, max) (what the
 // overlays leave of it; view_rect); the mouse orbits and zooms when over it. Its labels keep
 // clear of [clear_min, clear_max) where they can (an overlay drawn over the view: the sticks).
+// `camera_hint`: the camera and its keys at the bottom left (not where 1-4 mean something else).
 void draw_arena(const Scene& scene, const History& history, UiState& ui, ImVec2 min, ImVec2 max,
-                ImVec2 frame, ImVec2 clear_min = ImVec2(0, 0), ImVec2 clear_max = ImVec2(0, 0));
+                ImVec2 frame, ImVec2 clear_min = ImVec2(0, 0), ImVec2 clear_max = ImVec2(0, 0),
+                bool camera_hint = true);
 // Where draw_arena puts the world point `p` on screen, `newest` being the newest telemetry and
 // [min, max) the frame (view_rect); false when it is behind the camera.
 bool project_in_arena(const Scene& scene, const Telemetry& newest, const UiState& ui, ImVec2 min,

@@ -3,6 +3,7 @@
 #include <dds/dds.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -207,6 +208,10 @@ void InstructorClient::read_telemetry() {
     if (name.empty() || it == stations_.end()) continue;  // not (yet) an announced station
     const auto& m = *static_cast<const geometry_msgs_msg_dds__PoseStamped_*>(samples[i]);
     it->second.position = {m.pose.position.x, m.pose.position.y, m.pose.position.z};
+    const Eigen::Quaterniond q(m.pose.orientation.w, m.pose.orientation.x, m.pose.orientation.y,
+                               m.pose.orientation.z);
+    // A peer's quaternion: kept only when it is one (finite, not far from unit length).
+    if (q.coeffs().allFinite() && std::abs(q.norm() - 1.0) < 0.1) it->second.orientation = q.normalized();
     ++it->second.poses;
   }
   if (n > 0) dds_return_loan(pose_reader_, samples, n);

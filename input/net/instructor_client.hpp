@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "core/modes/instructor.hpp"
 #include "input/net/dds.hpp"
@@ -48,6 +49,7 @@ struct StationView {
   // Its telemetry heard by this client.
   std::uint64_t poses = 0, lambdas = 0;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // the pose's attitude
   double telemetry_lambda = 0;
   std::uint64_t refused_total() const;
 };
