@@ -307,7 +307,12 @@ std::shared_ptr<const ui::InstructorView> InstructorApp::make_view(double now) {
         x.t = a.t;
         x.x = Eigen::VectorXd::Zero(13);
         x.x << a.p[0], a.p[1], a.p[2], a.q[0], a.q[1], a.q[2], a.q[3], 0, 0, 0, 0, 0, 0;
-        if (t.scene && t.scene->reference_at) x.reference = t.scene->reference_at(a.t);
+        if (t.scene && t.scene->reference_at) {
+          // Element by element: GCC 12 takes Eigen's vectorized 3 → X copy for an overread.
+          const Eigen::Vector3d ref = t.scene->reference_at(a.t);
+          x.reference.resize(3);
+          x.reference << ref(0), ref(1), ref(2);
+        }
         x.lambda = a.lambda;
         x.set_channel(0, "lambda", "", a.lambda);
         x.set_channel(1, "deviation", "m", a.deviation);
