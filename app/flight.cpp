@@ -287,6 +287,7 @@ std::optional<Flight> prepare_flight(const FlyOptions& o, std::string& error, in
     ModeRequest request;
     request.duration = o.duration;
     request.assist = o.assist.value_or(Assistance::on);
+    request.bounds = o.bounds;
     if (o.from) {  // as long and as assisted as the flight it goes on from
       request.duration = o.from->duration;
       request.assist = o.from->assist;
@@ -359,6 +360,7 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
       {o.replay ? "the recording" : "--pilot", o.pilot.ends_with(".mcap") ? o.pilot : ""},
       {"--gamepad-script", o.gamepad_script},
       {"--input-settings", o.input_settings},
+      {"--commands", o.commands},
       {"--ghost", o.ghost == "best" || o.ghost == "off" ? "" : o.ghost}};
   for (const std::string& file : history::sqlite_files(o.history))
     inputs.emplace_back("the history", file);

@@ -41,6 +41,7 @@
 #include "app/flight.hpp"
 #include "app/history_writer.hpp"
 #include "core/history/history.hpp"
+#include "core/modes/command_inbox.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/replay.hpp"
@@ -144,6 +145,12 @@ class FlightRig {
   Flight& flight() { return flight_; }
   const FlyOptions& options() const { return options_; }
   net::TelemetryPublisher* publisher() { return publisher_ ? &*publisher_ : nullptr; }
+  // The instructor's commands into this flight (SPEC §10, core/modes/command_inbox.hpp): a
+  // live flight's session takes them before each step (a replay applies its recorded ones
+  // and has none). A producer thread pushes into commands().ring(); --commands is scheduled
+  // here by assemble().
+  CommandInbox& commands() { return inbox_; }
+  const CommandInbox& commands() const { return inbox_; }
 
  private:
   FlightRig(FlyOptions o, Flight f);
@@ -154,6 +161,7 @@ class FlightRig {
   std::optional<ReplayCheck> check_;             // flying a recording's pilot commands
   std::optional<HapticSink> haptic_;             // a gamepad pilot: λ to the rumble
   std::optional<net::TelemetryPublisher> publisher_;
+  CommandInbox inbox_;
   RecordingSink recorder_;
   std::string record_path_;                      // "" when not recording
   std::unique_ptr<RealtimeRunner> runner_;

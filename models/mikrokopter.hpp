@@ -33,9 +33,12 @@ struct MikroKopter {
   using Input = Eigen::Matrix<double, nu, 1>;
 
   MikroKopterParams p{};
+  // [N] a world-frame force on the CoM besides gravity and thrust: an instructor's gust on the
+  // simulated plant (SPEC §10). The controller's model keeps it zero: it does not know the gust.
+  Eigen::Vector3d external_force = Eigen::Vector3d::Zero();
 
   // ṗ = R(γ) v_b;  γ̇ = ZYX Euler kinematics (SPEC §2);
-  // v̇_b = (0,0,F_z/m) − R(γ)ᵀ(0,0,g) − ω × v_b;  ω̇ = J⁻¹(M − ω × Jω);
+  // v̇_b = (0,0,F_z/m) − R(γ)ᵀ(0,0,g) − ω × v_b (+ Rᵀ F_ext / m);  ω̇ = J⁻¹(M − ω × Jω);
   // Ω̇ = (τ − C_D Ω⊙Ω − D Ω)/J_m  (SPEC §3.3).
   template <class T>
   void dynamics(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Matrix<T, nu, 1>& u,
@@ -73,6 +76,14 @@ struct MikroKopter {
     xdot(6) = -p.g * r20 - (wy * vz - wz * vy);
     xdot(7) = -p.g * r21 - (wz * vx - wx * vz);
     xdot(8) = fz / p.m - p.g * r22 - (wx * vy - wy * vx);
+    if (external_force.x() != 0.0 || external_force.y() != 0.0 || external_force.z() != 0.0) {
+      // v̇_b += Rᵀ F / m (skipped at F = 0, so the plant without a gust is the model exactly).
+      const double fx = external_force.x() / p.m, fy = external_force.y() / p.m,
+                   fz_ext = external_force.z() / p.m;
+      xdot(6) += r00 * fx + r10 * fy + r20 * fz_ext;
+      xdot(7) += r01 * fx + r11 * fy + r21 * fz_ext;
+      xdot(8) += r02 * fx + r12 * fy + r22 * fz_ext;
+    }
 
     const T jwx = p.Jxx * wx, jwy = p.Jyy * wy, jwz = p.Jzz * wz;
     xdot(9) = (mx - (wy * jwz - wz * jwy)) / p.Jxx;

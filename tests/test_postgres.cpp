@@ -195,7 +195,8 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
   store.reset();
   ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
   ASSERT_TRUE(server->exec("migrate",
-                           "ALTER TABLE flights DROP COLUMN parent_step, "
+                           "ALTER TABLE flights DROP COLUMN ended_by, "
+                           "DROP COLUMN parent_step, "
                            "DROP COLUMN parent_recording_hash",
                            error))
       << error;

@@ -9,6 +9,7 @@
 
 #include "ui/ghost.hpp"
 #include "ui/panels.hpp"
+#include "ui/instructor.hpp"
 #include "ui/reason.hpp"
 #include "ui/theme.hpp"
 
@@ -204,6 +205,24 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
       ImGui::PopStyleColor();
       ImGui::PopTextWrapPos();
     }
+  }
+  // The instructor (ui/instructor.hpp): each command as it takes effect, for a few seconds, and
+  // what is in force, on lines of their own.
+  if (s) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + w);
+    if (run.instructor_paused) {
+      ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+      ImGui::TextUnformatted("paused by the instructor");
+      ImGui::PopStyleColor();
+    }
+    for (const std::string& banner : instructor_banners(h)) {
+      ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+      ImGui::TextUnformatted(banner.c_str());
+      ImGui::PopStyleColor();
+    }
+    if (const std::string line = instructor_in_force(*s); !line.empty())
+      ImGui::TextUnformatted(line.c_str());
+    ImGui::PopTextWrapPos();
   }
   // The ghost (ui/ghost.hpp): a dashed swatch in its colour, as its trail is drawn, and how far
   // ahead or behind along the reference the flight is; what it is, on hover.

@@ -54,6 +54,11 @@ const std::vector<std::vector<const char*>>& migrations() {
           "ALTER TABLE flights ADD COLUMN parent_step BIGINT CHECK (parent_step >= 0)",
           "CREATE INDEX flights_by_parent ON flights (parent_recording_hash, parent_step)",
       },
+      // 4: who ended a flight stopped before its end, when it was not the trainee: 'instructor'
+      // (SPEC §10; its `ended` stays 'interrupted', which older readers understand), else NULL.
+      {
+          "ALTER TABLE flights ADD COLUMN ended_by TEXT CHECK (ended_by IN ('instructor'))",
+      },
   };
   return m;
 }
