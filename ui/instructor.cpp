@@ -4,14 +4,14 @@
 
 namespace mixpilot::ui {
 
-std::vector<std::string> instructor_banners(const History& h) {
+std::vector<std::string> instructor_banners(const History& h, std::size_t most) {
   std::vector<std::string> out;
   if (h.empty()) return out;
   const double now = h.newest().t;
-  for (std::size_t i = h.size(); i-- > 0 && out.size() < kInstructorBanners;) {
+  for (std::size_t i = h.size(); i-- > 0 && out.size() < most;) {
     const Telemetry& s = h[i];
     if (s.t < now - kInstructorBannerS) break;
-    for (int j = s.num_commands; j-- > 0 && out.size() < kInstructorBanners;) {
+    for (int j = s.num_commands; j-- > 0 && out.size() < most;) {
       const InstructorCommand& c = s.commands[std::size_t(j)];
       if (c.kind == InstructorCommandKind::pause) continue;
       out.push_back("instructor: " + describe(c));
@@ -20,13 +20,12 @@ std::vector<std::string> instructor_banners(const History& h) {
   return {out.rbegin(), out.rend()};
 }
 
-std::string instructor_in_force(const Telemetry& s) {
+std::vector<std::string> instructor_in_force(const Telemetry& s) {
   const InstructorInForce& f = s.instructor;
-  std::string out;
+  std::vector<std::string> out;
   char buf[64];
   const auto add = [&](const char* text) {
-    out += out.empty() ? "instructor: " : " · ";
-    out += text;
+    out.push_back(out.empty() ? std::string("instructor: ") + text : std::string("· ") + text);
   };
   if (f.bounds != AuthorityBounds{}) {
     InstructorCommand b;

@@ -12,16 +12,14 @@ namespace mixpilot::ui {
 
 // [s] how long a command's banner stays after the step it took effect at.
 inline constexpr double kInstructorBannerS = 3.0;
-// Banners at most (the newest).
-inline constexpr std::size_t kInstructorBanners = 3;
-
 // "instructor: gust 2.0 N for 0.50 s" for each command of the last kInstructorBannerS (the
-// newest kInstructorBanners, oldest first). Pause is left out: a paused flight says so while
+// newest `most`, oldest first). Pause is left out: a paused flight says so while
 // it is paused (RunInfo::instructor_paused), and its record reaches the step after the resume.
-std::vector<std::string> instructor_banners(const History& h);
+std::vector<std::string> instructor_banners(const History& h, std::size_t most);
 
-// "instructor: ceiling 0.30 · gust 0.3 s left · delay +0.100 s · input lost 0.8 s" for what is
-// in force during step `s` ("" when nothing is).
-std::string instructor_in_force(const Telemetry& s);
+// What is in force during step `s`, item by item (the HUD wraps between them), the first one
+// saying whose: {"instructor: ceiling 0.30", "gust 2.0 N, 0.3 s left", "delay +0.030 s",
+// "input lost, 0.6 s left"}; empty when nothing is.
+std::vector<std::string> instructor_in_force(const Telemetry& s);
 
 }  // namespace mixpilot::ui

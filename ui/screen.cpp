@@ -215,13 +215,19 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
       ImGui::TextUnformatted("paused by the instructor");
       ImGui::PopStyleColor();
     }
-    for (const std::string& banner : instructor_banners(h)) {
+    // The newest two (one on a short view): the debrief keeps them all.
+    for (const std::string& banner : instructor_banners(h, compact ? 1 : 2)) {
       ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
       ImGui::TextUnformatted(banner.c_str());
       ImGui::PopStyleColor();
     }
-    if (const std::string line = instructor_in_force(*s); !line.empty())
-      ImGui::TextUnformatted(line.c_str());
+    // What is in force, item by item, wrapping between items.
+    bool first_item = true;
+    for (const std::string& part : instructor_in_force(*s)) {
+      if (!first_item) same_line_or_wrap(ImGui::CalcTextSize(part.c_str()).x);
+      first_item = false;
+      ImGui::TextUnformatted(part.c_str());
+    }
     ImGui::PopTextWrapPos();
   }
   // The ghost (ui/ghost.hpp): a dashed swatch in its colour, as its trail is drawn, and how far
