@@ -28,11 +28,8 @@ struct Crazyflie {
   using Input = Eigen::Matrix<double, nu, 1>;
 
   CrazyflieParams p{};
-  // [N] a world-frame force on the CoM besides gravity and thrust: an instructor's gust on the
-  // simulated plant (SPEC §10). The controller's model keeps it zero: it does not know the gust.
-  Eigen::Vector3d external_force = Eigen::Vector3d::Zero();
 
-  // ṗ = R(q) v_b;  q̇ = ½ q ⊗ (0, ω);  v̇_b = (0,0,F_z/m) − R(q)ᵀ(0,0,g) − ω × v_b (+ Rᵀ F_ext / m);
+  // ṗ = R(q) v_b;  q̇ = ½ q ⊗ (0, ω);  v̇_b = (0,0,F_z/m) − R(q)ᵀ(0,0,g) − ω × v_b;
   // ω̇ = J⁻¹(M − ω × Jω)  (SPEC §3.2).
   template <class T>
   void dynamics(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Matrix<T, nu, 1>& u,
@@ -67,19 +64,30 @@ struct Crazyflie {
     xdot(7) = -p.g * r20 - (wy * vz - wz * vy);
     xdot(8) = -p.g * r21 - (wz * vx - wx * vz);
     xdot(9) = fz / p.m - p.g * r22 - (wx * vy - wy * vx);
-    if (external_force.x() != 0.0 || external_force.y() != 0.0 || external_force.z() != 0.0) {
-      // v̇_b += Rᵀ F / m (skipped at F = 0, so the plant without a gust is the model exactly).
-      const double fx = external_force.x() / p.m, fy = external_force.y() / p.m,
-                   fz_ext = external_force.z() / p.m;
-      xdot(7) += r00 * fx + r10 * fy + r20 * fz_ext;
-      xdot(8) += r01 * fx + r11 * fy + r21 * fz_ext;
-      xdot(9) += r02 * fx + r12 * fy + r22 * fz_ext;
-    }
 
     const T jwx = p.Jxx * wx, jwy = p.Jyy * wy, jwz = p.Jzz * wz;
     xdot(10) = (mx - (wy * jwz - wz * jwy)) / p.Jxx;
     xdot(11) = (my - (wz * jwx - wx * jwz)) / p.Jyy;
     xdot(12) = (mz - (wx * jwy - wy * jwx)) / p.Jzz;
+  }
+
+  // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's
+  // gust on the simulated plant, SPEC §10): v̇_b += R(q)ᵀ F / m added to xdot = f(x, u). Apart
+  // from dynamics(), so the controller's model is untouched (models::WithExternalForce).
+  template <class T>
+  void add_external_force(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Vector3d& force,
+                          Eigen::Matrix<T, nx, 1>& xdot) const {
+    const T &qw = x(3), &qx = x(4), &qy = x(5), &qz = x(6);
+    const T r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
+            r02 = 2.0 * (qx * qz + qw * qy);
+    const T r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
+            r12 = 2.0 * (qy * qz - qw * qx);
+    const T r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
+            r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    const double fx = force.x() / p.m, fy = force.y() / p.m, fz = force.z() / p.m;
+    xdot(7) += r00 * fx + r10 * fy + r20 * fz;
+    xdot(8) += r01 * fx + r11 * fy + r21 * fz;
+    xdot(9) += r02 * fx + r12 * fy + r22 * fz;
   }
 
   // Retraction onto the state manifold after each integrator step: q ← q/‖q‖. ERK4 alone keeps

@@ -33,12 +33,9 @@ struct MikroKopter {
   using Input = Eigen::Matrix<double, nu, 1>;
 
   MikroKopterParams p{};
-  // [N] a world-frame force on the CoM besides gravity and thrust: an instructor's gust on the
-  // simulated plant (SPEC §10). The controller's model keeps it zero: it does not know the gust.
-  Eigen::Vector3d external_force = Eigen::Vector3d::Zero();
 
   // ṗ = R(γ) v_b;  γ̇ = ZYX Euler kinematics (SPEC §2);
-  // v̇_b = (0,0,F_z/m) − R(γ)ᵀ(0,0,g) − ω × v_b (+ Rᵀ F_ext / m);  ω̇ = J⁻¹(M − ω × Jω);
+  // v̇_b = (0,0,F_z/m) − R(γ)ᵀ(0,0,g) − ω × v_b;  ω̇ = J⁻¹(M − ω × Jω);
   // Ω̇ = (τ − C_D Ω⊙Ω − D Ω)/J_m  (SPEC §3.3).
   template <class T>
   void dynamics(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Matrix<T, nu, 1>& u,
@@ -76,14 +73,6 @@ struct MikroKopter {
     xdot(6) = -p.g * r20 - (wy * vz - wz * vy);
     xdot(7) = -p.g * r21 - (wz * vx - wx * vz);
     xdot(8) = fz / p.m - p.g * r22 - (wx * vy - wy * vx);
-    if (external_force.x() != 0.0 || external_force.y() != 0.0 || external_force.z() != 0.0) {
-      // v̇_b += Rᵀ F / m (skipped at F = 0, so the plant without a gust is the model exactly).
-      const double fx = external_force.x() / p.m, fy = external_force.y() / p.m,
-                   fz_ext = external_force.z() / p.m;
-      xdot(6) += r00 * fx + r10 * fy + r20 * fz_ext;
-      xdot(7) += r01 * fx + r11 * fy + r21 * fz_ext;
-      xdot(8) += r02 * fx + r12 * fy + r22 * fz_ext;
-    }
 
     const T jwx = p.Jxx * wx, jwy = p.Jyy * wy, jwz = p.Jzz * wz;
     xdot(9) = (mx - (wy * jwz - wz * jwy)) / p.Jxx;
@@ -95,6 +84,25 @@ struct MikroKopter {
     xdot(13) = (u(1) - p.C_D * s2 - p.D * x(13)) * inv_jm;
     xdot(14) = (u(2) - p.C_D * s3 - p.D * x(14)) * inv_jm;
     xdot(15) = (u(3) - p.C_D * s4 - p.D * x(15)) * inv_jm;
+  }
+
+  // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's
+  // gust on the simulated plant, SPEC §10): v̇_b += R(γ)ᵀ F / m added to xdot = f(x, u). Apart
+  // from dynamics(), so the controller's model is untouched (models::WithExternalForce).
+  template <class T>
+  void add_external_force(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Vector3d& force,
+                          Eigen::Matrix<T, nx, 1>& xdot) const {
+    using std::cos;
+    using std::sin;
+    const T cph = cos(x(3)), sph = sin(x(3)), cth = cos(x(4)), sth = sin(x(4));
+    const T cps = cos(x(5)), sps = sin(x(5));
+    const T r00 = cps * cth, r01 = cps * sth * sph - sps * cph, r02 = cps * sth * cph + sps * sph;
+    const T r10 = sps * cth, r11 = sps * sth * sph + cps * cph, r12 = sps * sth * cph - cps * sph;
+    const T r20 = -sth, r21 = cth * sph, r22 = cth * cph;
+    const double fx = force.x() / p.m, fy = force.y() / p.m, fz = force.z() / p.m;
+    xdot(6) += r00 * fx + r10 * fy + r20 * fz;
+    xdot(7) += r01 * fx + r11 * fy + r21 * fz;
+    xdot(8) += r02 * fx + r12 * fy + r22 * fz;
   }
 
   // Ω = √(m g / 4 C_T) ≈ 0.0655 and the torque τ = C_D Ω² + D Ω ≈ 0.0756 that holds it.

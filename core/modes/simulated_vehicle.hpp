@@ -11,8 +11,8 @@
 // its position plus σ·N(0, 1) per axis where σ > 0. The states are kept in a ring: boundaries
 // from k·s − n_m − n_x up to those integrated ahead, (k+1)·s + n_c at most, are there.
 //
-// The instructor (SPEC §10): a gust is a world-frame force on the plant (the model's
-// external_force) over substeps [j_g, j_g + n_g) from the first one not yet integrated; the
+// The instructor (SPEC §10): a gust is a world-frame force on the plant
+// (models::WithExternalForce) over substeps [j_g, j_g + n_g) from the first one not yet integrated; the
 // extra delay n_x ≤ max_extra_delay substeps is added to the measurement's, so step k measures
 // boundary k·s − n_m − n_x. All of the round trip's extra delay is put on the measurement: the
 // loop sees the same delay as when it is split over both links, and a command line whose delay
@@ -49,11 +49,8 @@ class VehiclePlant {
   // The same with a world-frame force F on the vehicle (a gust). Allocates nothing.
   void substep(const State& x, const Input& u, double h, const Eigen::Vector3d& force,
                State& x_next) {
-    if (forced_.model().external_force != force) {
-      Model m = erk4_.model();
-      m.external_force = force;
-      forced_ = IntegratorErk4<Model>(m);
-    }
+    if (forced_.model().force != force)
+      forced_ = IntegratorErk4<models::WithExternalForce<Model>>({erk4_.model(), force});
     forced_.template step<double>(x, u, h, x_next);
   }
   // x from t to `to` [ns] with u held, in substeps of h_ns (the last one shorter), stopping at
@@ -76,7 +73,7 @@ class VehiclePlant {
 
  private:
   IntegratorErk4<Model> erk4_{};
-  IntegratorErk4<Model> forced_{};  // the model with the gust's force
+  IntegratorErk4<models::WithExternalForce<Model>> forced_{};  // the model with the gust's force
 };
 
 template <class Model>
