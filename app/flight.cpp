@@ -368,6 +368,7 @@ bool check_outputs(const FlyOptions& o, std::string& error) {
       {o.replay ? "the recording" : "--pilot", o.pilot.ends_with(".mcap") ? o.pilot : ""},
       {"--gamepad-script", o.gamepad_script},
       {"--input-settings", o.input_settings},
+      {"--commands", o.commands},
       {"--ghost", o.ghost == "best" || o.ghost == "off" ? "" : o.ghost}};
   for (const std::string& file : history::sqlite_files(o.history))
     inputs.emplace_back("the history", file);

@@ -73,6 +73,10 @@ struct FlyOptions {
   // --assist on|off (mixed initiative): off flies a probe (SPEC §10). Unset: on for a new
   // flight, as recorded for a replay (which refuses another value).
   std::optional<Assistance> assist;
+  // --floor / --ceiling (mixed initiative): the instructor's bounds on λ for the whole flight.
+  AuthorityBounds bounds = {};
+  // --commands: a script of instructor's commands at flight times (core/modes/command_script.hpp).
+  std::string commands;
   std::uint32_t domain = 0;        // --domain: the DDS domain of network peers
   bool publish = false;            // --publish: telemetry out over DDS, the station announced
   // The instructor's network (SPEC §10, docs/instructor-security.md), with --publish:

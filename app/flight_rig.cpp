@@ -1,18 +1,48 @@
 #include "app/flight_rig.hpp"
 
+#include "app/cli.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/base/content_hash.hpp"
+#include "core/modes/command_script.hpp"
 #include "core/numerics/version.hpp"
 #include "core/recording/branch_replay.hpp"
 #include "input/net/dds.hpp"
 
 namespace mixpilot::cli {
 
+namespace {
+
+// Each scripted command against the flight: one it would refuse, or one after its end, is an
+// error before the flight rather than a surprise in it.
+bool check_script(const std::vector<ScriptedCommand>& script, const Mode& mode,
+                  const std::string& path, std::string& error) {
+  const double end = double(mode.steps_total()) * mode.dt();
+  for (const ScriptedCommand& c : script) {
+    const std::string at = path + ":" + std::to_string(c.line) + ": ";
+    const InstructorStatus s = mode.accepts(c.command.kind);
+    if (s != InstructorStatus::applied) {
+      error = at + "a " + to_string(c.command.kind) + " command, which this flight (" +
+              to_string(mode.kind()) + ") refuses: " + to_string(s);
+      return false;
+    }
+    if (CommandInbox::step_of(c.at, mode.dt()) >= mode.steps_total()) {
+      error = at + "at = " + seconds_text(c.at) + " s is not before the flight's end at " +
+              seconds_text(end) + " s";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 FlightRig::FlightRig(FlyOptions o, Flight f) : options_(std::move(o)), flight_(std::move(f)) {
   session_ = std::make_unique<Session>(*flight_.mode);
+  if (!flight_.recording) session_->set_inbox(&inbox_);
   if (flight_.recording) {
     check_.emplace(*flight_.recording);
     session_->add_sink(&*check_);
@@ -34,6 +64,14 @@ std::unique_ptr<FlightRig> FlightRig::assemble(const FlyOptions& o, std::string&
   std::optional<Flight> f = prepare_flight(o, error, status, std::move(gamepad), wait);
   if (!f) return nullptr;
   std::unique_ptr<FlightRig> rig(new FlightRig(o, std::move(*f)));
+  if (!o.commands.empty()) {
+    auto script = load_command_script(o.commands, error);
+    if (!script || !check_script(*script, rig->mode(), o.commands, error)) {
+      status = kExitError;
+      return nullptr;
+    }
+    rig->inbox_.schedule(std::move(*script));
+  }
   if (rig->flight_.vehicle) {
     if (wait == VehicleWait::later) {
       rig->vehicle_ = VehicleStatus::waiting;
@@ -46,6 +84,7 @@ std::unique_ptr<FlightRig> FlightRig::assemble(const FlyOptions& o, std::string&
   }
   return rig;
 }
+
 
 FlightRig::VehicleStatus FlightRig::poll_vehicle(std::string& error) {
   if (vehicle_ != VehicleStatus::waiting) return vehicle_;
@@ -95,15 +134,18 @@ bool FlightRig::publish(std::string& error) {
   lo.station.mode = to_string(mode.kind());
   lo.station.duration = double(mode.steps_total()) * mode.dt();
   lo.station.ball_radius = mode.view().ball_radius;
+  lo.paused = [this] {
+    const RealtimeRunner* r = paced_.load();
+    return r && r->instructor_paused();
+  };
   publisher_.emplace();
   if (!publisher_->start(options_.domain, mode.telemetry(), error, lo.station.name)) {
     publisher_.reset();
     error = "--publish: " + error;
     return false;
   }
-  instructor_commands_.setup(64, InstructorCommand{});
   instructor_.emplace();
-  if (!instructor_->start(lo, &instructor_commands_, error)) {
+  if (!instructor_->start(lo, &inbox_.ring(), error)) {
     instructor_.reset();
     publisher_->stop();
     publisher_.reset();
@@ -134,6 +176,7 @@ void FlightRig::remember(HistoryWriter* writer, std::string trainee, std::string
 
 void FlightRig::pace(std::size_t ring_slots) {
   runner_ = std::make_unique<RealtimeRunner>(*session_, ring_slots);
+  paced_.store(runner_.get());
 }
 
 void FlightRig::start() {
@@ -264,9 +307,10 @@ std::optional<history::FlightRecord> FlightRig::flight_record(bool interrupted,
   r.started_unix_ms = started_unix_ms_;
   // The time flown: a branch's from its take-over on.
   r.duration_s = double(mode.steps_done() - (parent ? parent->step : 0)) * mode.dt();
-  r.ended = mode.lost()     ? history::Ended::lost
-            : interrupted ? history::Ended::interrupted
-                          : history::Ended::completed;
+  r.ended = mode.lost()                         ? history::Ended::lost
+            : session_->ended_by_instructor() ? history::Ended::instructor
+            : interrupted                     ? history::Ended::interrupted
+                                              : history::Ended::completed;
   const bool remote = flight_.recording ? meta("vehicle") == "dds" : flight_.vehicle != nullptr;
   r.front_end = remote ? "vehicle" : front_end_;
   r.app_version = version();

@@ -34,6 +34,7 @@
 //                 loads what the window shows of the history    for it at the end)
 //   vehicle       `mixpilot vehicle`'s plant loop runs on main; its DDS link's threads are
 //                 Cyclone's, under RealtimeThreadsScope
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -43,6 +44,7 @@
 #include "app/flight.hpp"
 #include "app/history_writer.hpp"
 #include "core/history/history.hpp"
+#include "core/modes/command_inbox.hpp"
 #include "core/modes/report.hpp"
 #include "core/modes/session.hpp"
 #include "core/recording/replay.hpp"
@@ -166,9 +168,12 @@ class FlightRig {
   net::TelemetryPublisher* publisher() { return publisher_ ? &*publisher_ : nullptr; }
   // --publish: the station's link to instructors (nullptr otherwise).
   net::InstructorLink* instructor_link() { return instructor_ ? &*instructor_ : nullptr; }
-  // The commands the station's link took, oldest first: the control thread is their consumer
-  // (it applies them between two steps); sized once, a full ring refuses a command as busy.
-  SpscRing<InstructorCommand>& instructor_commands() { return instructor_commands_; }
+  // The instructor's commands into this flight (SPEC §10, core/modes/command_inbox.hpp): a
+  // live flight's session takes them before each step (a replay applies its recorded ones
+  // and has none). The station's link pushes into commands().ring() (a full ring refuses a
+  // command as busy); --commands is scheduled here by assemble().
+  CommandInbox& commands() { return inbox_; }
+  const CommandInbox& commands() const { return inbox_; }
 
  private:
   FlightRig(FlyOptions o, Flight f);
@@ -179,11 +184,14 @@ class FlightRig {
   std::optional<ReplayCheck> check_;             // flying a recording's pilot commands
   std::optional<HapticSink> haptic_;             // a gamepad pilot: λ to the rumble
   std::optional<net::TelemetryPublisher> publisher_;
-  SpscRing<InstructorCommand> instructor_commands_;  // before the link: it outlives it
+  CommandInbox inbox_;                           // before the link: it outlives it
   std::optional<net::InstructorLink> instructor_;
   RecordingSink recorder_;
   std::string record_path_;                      // "" when not recording
   std::unique_ptr<RealtimeRunner> runner_;
+  // runner_ for the link's announcing thread (pace() may follow publish()); close() stops the
+  // link before runner_ goes.
+  std::atomic<const RealtimeRunner*> paced_{nullptr};
   VehicleStatus vehicle_ = VehicleStatus::none;
   std::chrono::steady_clock::time_point vehicle_deadline_;
   bool started_ = false, closed_ = false;

@@ -1,4 +1,6 @@
 // mixpilot fly / demo: one session of any mode, as fast as possible.
+#include <charconv>
+#include <system_error>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -64,6 +66,16 @@ constexpr const char* kFlyUsage =
     "                     a lost device still hands the vehicle to the planner). Marked as a\n"
     "                     probe in the report and the recording, whose replays fly it as one\n"
     "                     (mixed_initiative only)\n"
+    "  --floor X, --ceiling X  the instructor's bounds on the authority λ for the whole\n"
+    "                     flight (SPEC §10): λ = min(max(λ_PH, floor), ceiling, the input's\n"
+    "                     cap); 0 <= floor <= ceiling <= 1, default 0 and 1; recorded, and\n"
+    "                     flown again by a replay (mixed_initiative only)\n"
+    "  --commands FILE.toml  an instructor's commands at flight times (SPEC §10): bounds,\n"
+    "                     gust, extra_delay, input_loss, marker and end, one [[command]] table\n"
+    "                     each with `at` in seconds (docs/recording-format.md, \"Instructor\n"
+    "                     commands\"); each takes effect at the first step at or after its time,\n"
+    "                     is shown on the HUD, recorded with that step and applied there again by\n"
+    "                     a replay. Not for a replay, which applies its recorded commands\n"
     "  --gamepad-script FILE.csv  with --pilot gamepad: a virtual gamepad plays the script\n"
     "                     (docs/input-settings.md) through SDL from the start of the flight\n"
     "  --input-settings FILE  stick mode, shaping, input loss, haptic cue (TOML; default: the\n"
@@ -253,7 +265,11 @@ double fly_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
     if (screenshots) rig.watch(*screenshots);
     rig.start();
     Progress progress("fly " + mode.scenario_name(), mode.steps_total());
-    while (!interrupted() && rig.step()) progress.update(mode.steps_done());
+    // Paused by the instructor (a live command): nothing steps until a resume or an end.
+    while (!interrupted() && rig.step()) {
+      if (!rig.session().stepped()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      progress.update(mode.steps_done());
+    }
   }
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -305,7 +321,7 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
                     double wall, const std::optional<RealtimeStats>& realtime,
                     HistoryWriter* history, const ui::Ghost* ghost) {
   const Mode& mode = rig.mode();
-  const bool stopped = interrupted() && !mode.finished();
+  const bool stopped = (interrupted() || rig.session().ended_by_instructor()) && !mode.finished();
   int status = kExitOk;
   std::string error;
   const FlightRig::Closed closed = rig.close(stopped);
@@ -327,6 +343,16 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
                 (unsigned long long)closed.publish_dropped);
   std::fputs(station_summary(closed).c_str(), stdout);
   if (mode.lost()) std::printf("  LOST: the vehicle was lost at t = %.3f s\n", mode.lost_at());
+  const CommandInbox& inbox = rig.commands();
+  if (inbox.applied() + inbox.refused() + inbox.dropped() > 0) {
+    std::printf("  instructor: %lld commands applied, %lld refused, %lld dropped (the inbox was "
+                "full)\n",
+                (long long)inbox.applied(), (long long)inbox.refused(), (long long)inbox.dropped());
+    if (inbox.refused() > 0)
+      std::printf("  the last refused: %s\n", to_string(inbox.last_refusal()));
+  }
+  if (rig.session().ended_by_instructor())
+    std::printf("  ended by the instructor at t = %.3f s\n", flown);
   if (ghost) print_ghost(*ghost, mode);
   if (!o.report.empty()) {
     const std::string json = to_json(rig.labels(stopped), rig.metrics()) + "\n";
@@ -357,7 +383,7 @@ int finish_headless(FlightRig& rig, const FlyOptions& o, ScreenshotSink* screens
                      o.command, r.error.c_str());
   }
   if (!o.report.empty() && status == kExitOk) std::printf("  report %s\n", o.report.c_str());
-  if (stopped) {
+  if (stopped && !rig.session().ended_by_instructor()) {
     std::printf("  interrupted at t = %.3f s\n", flown);
     return kExitInterrupted;
   }
@@ -508,6 +534,16 @@ int fly_command(int argc, char** argv) {
       if (v == "on") o.assist = Assistance::on;
       else if (v == "off") o.assist = Assistance::off;
       else usage_error(o.command, "--assist expects on or off, got '" + v + "'");
+    } else if (a == "--floor" || a == "--ceiling") {
+      const std::string v = value();
+      double x = 0.0;
+      const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
+      if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !(x >= 0.0) ||
+          !(x <= 1.0))
+        usage_error(o.command, std::string(a) + " expects a number from 0 to 1, got '" + v + "'");
+      (a == "--floor" ? o.bounds.floor : o.bounds.ceiling) = x;
+    } else if (a == "--commands") {
+      o.commands = value();
     } else if (a == "--headless") {
       o.headless = true;
     } else if (a == "--duration") {
@@ -596,6 +632,15 @@ int fly_command(int argc, char** argv) {
   // The window without a scenario (the desktop entry): the shipped mi_helix, changeable there.
   if (o.scenario_path.empty() && !o.headless && !o.pilot.ends_with(".mcap"))
     o.scenario_path = data_file("scenarios/mi_helix.toml");
+  if (!o.bounds.valid())
+    usage_error(o.command, "--floor " + seconds_text(o.bounds.floor) + " is above --ceiling " +
+                               seconds_text(o.bounds.ceiling) + ": expected floor <= ceiling");
+  if (o.bounds != AuthorityBounds{} && o.pilot.ends_with(".mcap"))
+    usage_error(o.command, "--floor and --ceiling are for a new flight: a replay flies with the "
+                           "bounds it was recorded with");
+  if (!o.commands.empty() && o.pilot.ends_with(".mcap"))
+    usage_error(o.command, "--commands is for a new flight: a replay applies the instructor's "
+                           "commands it recorded");
   if (o.realtime && !o.headless) usage_error(o.command, "--realtime is for --headless runs (a window is always real time)");
   if (o.exit_at_end && o.headless) usage_error(o.command, "--exit-at-end is for the window");
   if (!o.gamepad_script.empty() && o.pilot != "gamepad")

@@ -157,6 +157,8 @@ void LiveController::close_live(LiveFlight& f) {
   while (f.runner().telemetry().pop(f.sample)) f.history.push(f.sample);
   const bool flown = f.started();
   const FlightRig::Closed& c = f.closing = f.rig->close(!f.mode().finished());
+  if (flown && f.rig->session().ended_by_instructor())
+    status_line_.say("the instructor ended the flight", false);
   if (c.verdict && c.attempt) {
     // The lesson's verdict: said, shown in the panel, and the progress moved on at once (the
     // history's snapshot, reloaded once the attempt is written, says the same).
@@ -895,6 +897,7 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
               : f.runner().paused() ? ui::RunState::paused
                                    : ui::RunState::flying;
   run.speed = f.runner().speed();
+  run.instructor_paused = f.started() && !over && f.runner().instructor_paused();
   run.deadline_misses = f.counts.deadline_misses;
   run.fallbacks = f.counts.fallbacks;
   run.recording = !f.rig->recording_path().empty() && !f.closed();

@@ -15,14 +15,15 @@ DevicePilot::DevicePilot(StickSource& source, const InputSettings& settings, dou
                          double hover_speed)
     : source_(source), settings_(settings), dt_(dt), hover_speed_(hover_speed) {}
 
-bool DevicePilot::command(std::int64_t, double, const Eigen::VectorXd&, PilotCommand& out) {
+bool DevicePilot::command(std::int64_t step, double, const Eigen::VectorXd&, PilotCommand& out) {
   source_.advance(dt_);
   read_ns_ = steady_ns();
   reading_ = source_.latest();
   source_.next_read_at(read_ns_ + std::int64_t(dt_ * 1e9));
   joy_ = reading_.joy;
   const std::int64_t timeout_ns = std::int64_t(settings_.input_timeout_s * 1e9);
-  const bool present = reading_.connected && steady_ns() - reading_.alive_ns <= timeout_ns;
+  const bool present = reading_.connected && steady_ns() - reading_.alive_ns <= timeout_ns &&
+                       step >= lost_until_;
   const Controls c = controls(reading_.sticks, settings_);
 
   if (!present) {

@@ -27,6 +27,11 @@ class DevicePilot final : public PilotSource {
   std::string name() const override { return source_.name(); }
   bool command(std::int64_t step, double t, const Eigen::VectorXd& x, PilotCommand& out) override;
   const JoyInput* joy() const override { return &joy_; }
+  // The instructor's input loss: the device counts as absent before `until_step`.
+  [[nodiscard]] bool lose_input(std::int64_t until_step) override {
+    lost_until_ = until_step;
+    return true;
+  }
 
   InputState state() const { return state_; }
   // The reading behind the last command (what the test of latency correlates).
@@ -46,6 +51,7 @@ class DevicePilot final : public PilotSource {
   std::int64_t returning_steps_ = 0;  // steps since the sticks were re-centred
   std::int64_t centred_steps_ = 0;    // consecutive steps the sticks have read centred
   std::int64_t read_ns_ = 0;
+  std::int64_t lost_until_ = -1;  // the instructor's input loss: absent before this step
 };
 
 }  // namespace mixpilot::input

@@ -71,6 +71,25 @@ struct Crazyflie {
     xdot(12) = (mz - (wx * jwy - wy * jwx)) / p.Jzz;
   }
 
+  // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's
+  // gust on the simulated plant, SPEC §10): v̇_b += R(q)ᵀ F / m added to xdot = f(x, u). Apart
+  // from dynamics(), so the controller's model is untouched (models::WithExternalForce).
+  template <class T>
+  void add_external_force(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Vector3d& force,
+                          Eigen::Matrix<T, nx, 1>& xdot) const {
+    const T &qw = x(3), &qx = x(4), &qy = x(5), &qz = x(6);
+    const T r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
+            r02 = 2.0 * (qx * qz + qw * qy);
+    const T r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
+            r12 = 2.0 * (qy * qz - qw * qx);
+    const T r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
+            r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    const double fx = force.x() / p.m, fy = force.y() / p.m, fz = force.z() / p.m;
+    xdot(7) += r00 * fx + r10 * fy + r20 * fz;
+    xdot(8) += r01 * fx + r11 * fy + r21 * fz;
+    xdot(9) += r02 * fx + r12 * fy + r22 * fz;
+  }
+
   // Retraction onto the state manifold after each integrator step: q ← q/‖q‖. ERK4 alone keeps
   // ‖q‖ to ~1e-8 per 15 ms step under flight-like angular accelerations; the projection makes
   // it exact to rounding without lowering the order (SPEC §2: q is a unit quaternion).

@@ -86,6 +86,25 @@ struct MikroKopter {
     xdot(15) = (u(3) - p.C_D * s4 - p.D * x(15)) * inv_jm;
   }
 
+  // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's
+  // gust on the simulated plant, SPEC §10): v̇_b += R(γ)ᵀ F / m added to xdot = f(x, u). Apart
+  // from dynamics(), so the controller's model is untouched (models::WithExternalForce).
+  template <class T>
+  void add_external_force(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Vector3d& force,
+                          Eigen::Matrix<T, nx, 1>& xdot) const {
+    using std::cos;
+    using std::sin;
+    const T cph = cos(x(3)), sph = sin(x(3)), cth = cos(x(4)), sth = sin(x(4));
+    const T cps = cos(x(5)), sps = sin(x(5));
+    const T r00 = cps * cth, r01 = cps * sth * sph - sps * cph, r02 = cps * sth * cph + sps * sph;
+    const T r10 = sps * cth, r11 = sps * sth * sph + cps * cph, r12 = sps * sth * cph - cps * sph;
+    const T r20 = -sth, r21 = cth * sph, r22 = cth * cph;
+    const double fx = force.x() / p.m, fy = force.y() / p.m, fz = force.z() / p.m;
+    xdot(6) += r00 * fx + r10 * fy + r20 * fz;
+    xdot(7) += r01 * fx + r11 * fy + r21 * fz;
+    xdot(8) += r02 * fx + r12 * fy + r22 * fz;
+  }
+
   // Ω = √(m g / 4 C_T) ≈ 0.0655 and the torque τ = C_D Ω² + D Ω ≈ 0.0756 that holds it.
   double hover_speed() const { return std::sqrt(p.m * p.g / (4.0 * p.C_T)); }
   double hover_torque() const {

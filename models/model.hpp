@@ -37,6 +37,33 @@ void project(const M& model, Eigen::Matrix<T, M::nx, 1>& x) {
 template <int n>
 using AutoDiff = Dual<n>;
 
+// A model with a world-frame force on its centre of mass (an instructor's gust on a simulated
+// plant, SPEC §10): f(x, u) + the model's add_external_force(x, force). The plain model's
+// dynamics() are left as they are, so the controller's model, which does not know the force,
+// computes exactly what it did.
+template <class M>
+struct WithExternalForce {
+  static constexpr int nx = M::nx;
+  static constexpr int nu = M::nu;
+  static constexpr const char* name = M::name;
+  using State = Eigen::Matrix<double, nx, 1>;
+  using Input = Eigen::Matrix<double, nu, 1>;
+
+  M model{};
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // [N] world frame
+
+  template <class T>
+  void dynamics(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Matrix<T, nu, 1>& u,
+                Eigen::Matrix<T, nx, 1>& xdot) const {
+    model.dynamics(x, u, xdot);
+    model.add_external_force(x, force, xdot);
+  }
+  template <class T>
+  void project(Eigen::Matrix<T, nx, 1>& x) const {
+    models::project(model, x);
+  }
+};
+
 // f(x, u) with ∂f/∂x (nx x nx) and ∂f/∂u (nx x nu).
 template <DynamicModel M>
 void dynamics_jacobians(const M& model, const Eigen::Matrix<double, M::nx, 1>& x,

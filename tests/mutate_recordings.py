@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Mutation run over recordings (docs/recording-format.md).
 
-It records a short headless flight of each shipped scenario (`mixpilot fly --record`), makes a
+It records a short headless flight of each shipped scenario (`mixpilot fly --record`), and one of
+mi_helix with an instructor's commands of each recorded kind (`--commands`), makes a
 second copy of each with its CRCs zeroed ("not computed" in the MCAP spec, so mutations reach
 the structure checks and the CDR decoders instead of stopping at a CRC), and writes variants of
 every record, top-level and inside chunks: cut at its start, after its opcode, after its header
@@ -38,6 +39,35 @@ CHUNK, DATA_END, FOOTER = 0x06, 0x0F, 0x02
 OPCODES = [0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x0E,
            0x0F]
 BOUNDARY_U64 = [0, 1, 0x7FFFFFFF, 0xFFFFFFFF, 1 << 32, (1 << 63) - 1, (1 << 64) - 1]
+# Commands within the base recordings' first three steps (15 ms each).
+COMMANDS = """
+[[command]]
+at = 0.0
+kind = "bounds"
+floor = 0.1
+ceiling = 0.3
+
+[[command]]
+at = 0.015
+kind = "gust"
+force = [2.0, -1.0, 0.5]
+duration = 0.5
+
+[[command]]
+at = 0.015
+kind = "marker"
+text = "mutate me"
+
+[[command]]
+at = 0.03
+kind = "extra_delay"
+delay = 0.03
+
+[[command]]
+at = 0.03
+kind = "input_loss"
+duration = 0.2
+"""
 
 
 def records(data, start, end):
@@ -186,6 +216,21 @@ def main():
         data = rec.read_bytes()
         cases += variants(data, f.stem, rng, args.flips)
         cases += variants(zero_crcs(data), f"{f.stem}_nocrc", rng, args.flips)
+    # A flight with an instructor's commands of every recorded kind (/instructor/command,
+    # docs/recording-format.md), so mutations reach that topic's decoder and checks too.
+    script = work / "commands.toml"
+    script.write_text(COMMANDS)
+    helix = Path(args.scenarios).resolve() / "mi_helix.toml"
+    rec = work / "mi_helix_commands.mcap"
+    p = subprocess.run([str(binary), "fly", "--scenario", str(helix), "--headless", "--duration",
+                        str(args.duration), "--commands", str(script), "--record", str(rec)],
+                       capture_output=True, text=True, timeout=120)
+    if p.returncode != 0:
+        print(f"mi_helix.toml with --commands does not record: {p.stderr.strip()}")
+        return 1
+    data = rec.read_bytes()
+    cases += variants(data, "mi_helix_commands", rng, args.flips)
+    cases += variants(zero_crcs(data), "mi_helix_commands_nocrc", rng, args.flips)
     if args.sample and args.sample < len(cases):
         cases = random.Random(args.seed).sample(cases, args.sample)
 

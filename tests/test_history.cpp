@@ -304,6 +304,7 @@ TEST(HistoryStore, AnOlderSchemaIsMigratedForward) {
   ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
   EXPECT_EQ(sqlite3_exec(db, "DROP TABLE lesson_attempts; DROP TABLE lesson_progress; "
                              "DROP INDEX metrics_by_name; DROP INDEX flights_by_parent; "
+                             "ALTER TABLE flights DROP COLUMN ended_by; "
                              "ALTER TABLE flights DROP COLUMN parent_step; "
                              "ALTER TABLE flights DROP COLUMN parent_recording_hash; "
                              "DELETE FROM schema_version WHERE version > 1",

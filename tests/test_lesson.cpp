@@ -284,6 +284,7 @@ TEST(Lesson, TheSchemaMigratesForwardFromVersion3) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open_v2(p.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "DROP TABLE lesson_attempts; DROP TABLE lesson_progress; "
+                             "ALTER TABLE flights DROP COLUMN ended_by; "
                              "DELETE FROM schema_version WHERE version > 3",
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
@@ -291,8 +292,8 @@ TEST(Lesson, TheSchemaMigratesForwardFromVersion3) {
   ASSERT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), 3);
   store = history::open_sqlite(p.string(), error);
   ASSERT_TRUE(store) << error;
-  EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), 4);
-  EXPECT_EQ(history::kSchemaVersion, 4);
+  EXPECT_EQ(sql_int(p, "SELECT max(version) FROM schema_version"), history::kSchemaVersion);
+  EXPECT_EQ(history::kSchemaVersion, 5);
   EXPECT_EQ(sql_int(p, "SELECT count(*) FROM sqlite_master WHERE name = 'lesson_attempts_by_lesson'"),
             1);
   std::vector<history::StoredFlight> rows;

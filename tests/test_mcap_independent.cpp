@@ -145,6 +145,7 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   ModeChannelsMsg channels;
   LambdaReasonMsg reason;
   LogMsg log;
+  InstructorCommandMsg command;
   double lambda = 0;
   for (uint64_t k = 0; k < kSteps; ++k) {
     const double s = static_cast<double>(k);
@@ -177,6 +178,9 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
            kDebriefLogger, "planner took over for 1.8 s (lowest λ 0.21) at step " + std::to_string(k),
            "", k % 2 ? "takeover" : "near miss", static_cast<uint32_t>(k)};
     ASSERT_TRUE(rec.record_log(k, log));
+    command = {{}, k, static_cast<uint8_t>(k % 8), 0.125, 0.875, {2.0, -0.5 * s, 0.25},
+               0.5, 0.0625, k % 8 == 4 ? "watch the column" : ""};
+    ASSERT_TRUE(rec.record_command(command));
   }
   ASSERT_TRUE(rec.close(err)) << err;
 
@@ -234,6 +238,11 @@ TEST(McapIndependentReader, NodeMcapCoreReadsWhatWeWrite) {
   j.key("linearization_us").num(solver.linearization_us).key("qp_us").num(solver.qp_us);
   j.key("total_us").num(solver.total_us).key("fallback").raw(solver.fallback ? "true" : "false");
   j.end('}');
+  j.key("/instructor/command").begin('{').stamp(t).key("step").num(command.step);
+  j.key("kind").num(command.kind).key("floor").num(command.floor);
+  j.key("ceiling").num(command.ceiling).key("force").nums(command.force);
+  j.key("duration").num(command.duration).key("delay").num(command.delay);
+  j.key("text").str(command.text).end('}');
   j.key("/joy").begin('{').key("header").begin('{').stamp(t).key("frame_id").str(joy.frame_id);
   j.end('}').key("axes").nums(joy.axes).key("buttons").nums(joy.buttons).end('}');
   j.key("/mode/channels").begin('{').stamp(t).key("step").num(channels.step);

@@ -197,7 +197,8 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
       << error;
   ASSERT_TRUE(server->exec("migrate", "DROP INDEX metrics_by_name", error)) << error;
   ASSERT_TRUE(server->exec("migrate",
-                           "ALTER TABLE flights DROP COLUMN parent_step, "
+                           "ALTER TABLE flights DROP COLUMN ended_by, "
+                           "DROP COLUMN parent_step, "
                            "DROP COLUMN parent_recording_hash",
                            error))
       << error;
@@ -220,7 +221,7 @@ TEST(Postgres, AnOlderSchemaIsMigratedForward) {
 }
 
 // Lessons (SPEC §10): the attempts and the progress as in SQLite (tests/history_test.hpp), and
-// the lesson tables made by the migration to schema 4 from a database of schema 3.
+// the lesson tables made by the migration from a database of schema 3.
 TEST(Postgres, LessonAttemptsAndProgressAsInSqlite) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "lessons");
@@ -231,11 +232,13 @@ TEST(Postgres, LessonAttemptsAndProgressAsInSqlite) {
   store.reset();
   ASSERT_TRUE(server->exec("lessons", "DROP TABLE lesson_attempts, lesson_progress", error))
       << error;
+  ASSERT_TRUE(server->exec("lessons", "ALTER TABLE flights DROP COLUMN ended_by", error)) << error;
   ASSERT_TRUE(server->exec("lessons", "DELETE FROM schema_version WHERE version > 3", error))
       << error;
   store = open_store(url);
   ASSERT_TRUE(store);
-  EXPECT_EQ(sql(*server, "lessons", "SELECT max(version) FROM schema_version"), "4");
+  EXPECT_EQ(sql(*server, "lessons", "SELECT max(version) FROM schema_version"),
+            std::to_string(history::kSchemaVersion));
   EXPECT_EQ(sql(*server, "lessons",
                 "SELECT count(*) FROM pg_indexes WHERE indexname = 'lesson_attempts_by_lesson'"),
             "1");

@@ -155,7 +155,7 @@ TEST(RecordingMessages, DecodeRejectsTrailingBytes) {
 
 TEST(RecordingMessages, SchemasAreRos2msgWithDependencies) {
   const auto types = recorded_types();
-  ASSERT_EQ(types.size(), 10u);
+  ASSERT_EQ(types.size(), 11u);
   const std::string sep(80, '=');
   for (const auto& t : types) {
     const std::string text = t.schema_text;
@@ -205,6 +205,8 @@ void record_session(SessionRecorder& rec, uint64_t steps) {
     ASSERT_TRUE(rec.record_log(k, {ros_time_from_ns(k / 2 * kPeriodNs), 30, "mixpilot.debrief",
                                    "near miss for " + std::to_string(k) + " s", "", "near miss",
                                    0}));
+    ASSERT_TRUE(rec.record_command({{}, k, uint8_t(k % 8), 0.0, 1.0, {s, 0.0, -s}, 0.5, 0.0,
+                                    k % 8 == 4 ? "marker " + std::to_string(k) : ""}));
   }
 }
 
@@ -264,6 +266,12 @@ TEST(SessionRecorder, RecordsAndReadsBack) {
     EXPECT_EQ(log.name, "mixpilot.debrief");
     EXPECT_EQ(log.msg, "near miss for " + std::to_string(k) + " s");
     EXPECT_EQ(log.function, "near miss");
+    const InstructorCommandMsg& c = r->commands[k];
+    EXPECT_EQ(ros_time_to_ns(c.stamp), k * kPeriodNs);
+    EXPECT_EQ(c.step, k);
+    EXPECT_EQ(c.kind, k % 8);
+    EXPECT_EQ(c.force, (std::array<double, 3>{double(k), 0.0, -double(k)}));
+    EXPECT_EQ(c.text, k % 8 == 4 ? "marker " + std::to_string(k) : "");
   }
   // Log times in the container are k·Δt too.
   std::string e2;

@@ -261,8 +261,13 @@ void draw_input_banner(const History& h, const RunInfo& run, ImVec2 min, ImVec2 
   ImU32 c = colour::kCritical;
   switch (state) {
     case InputState::lost:
-      std::snprintf(text, sizeof text, "INPUT LOST: the planner flies. Reconnect the %s.",
-                    run.input && !run.input->pilot.empty() ? run.input->pilot.c_str() : "device");
+      // The instructor's simulated loss (SPEC §10) needs no reconnecting: it ends by itself.
+      if (h.newest().instructor.input_loss_left > 0.0)
+        std::snprintf(text, sizeof text, "INPUT LOST (the instructor's, %.1f s left): the planner "
+                      "flies.", h.newest().instructor.input_loss_left);
+      else
+        std::snprintf(text, sizeof text, "INPUT LOST: the planner flies. Reconnect the %s.",
+                      run.input && !run.input->pilot.empty() ? run.input->pilot.c_str() : "device");
       break;
     case InputState::recentre:
       std::snprintf(text, sizeof text, "The %s is back: centre the sticks to take control.",

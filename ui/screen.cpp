@@ -9,6 +9,7 @@
 
 #include "ui/ghost.hpp"
 #include "ui/panels.hpp"
+#include "ui/instructor_hud.hpp"
 #include "ui/reason.hpp"
 #include "ui/theme.hpp"
 
@@ -204,6 +205,30 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
       ImGui::PopStyleColor();
       ImGui::PopTextWrapPos();
     }
+  }
+  // The instructor (ui/instructor_hud.hpp): each command as it takes effect, for a few seconds, and
+  // what is in force, on lines of their own.
+  if (s) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + w);
+    if (run.instructor_paused) {
+      ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+      ImGui::TextUnformatted("paused by the instructor");
+      ImGui::PopStyleColor();
+    }
+    // The newest two (one on a short view): the debrief keeps them all.
+    for (const std::string& banner : instructor_banners(h, compact ? 1 : 2)) {
+      ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+      ImGui::TextUnformatted(banner.c_str());
+      ImGui::PopStyleColor();
+    }
+    // What is in force, item by item, wrapping between items.
+    bool first_item = true;
+    for (const std::string& part : instructor_in_force(*s)) {
+      if (!first_item) same_line_or_wrap(ImGui::CalcTextSize(part.c_str()).x);
+      first_item = false;
+      ImGui::TextUnformatted(part.c_str());
+    }
+    ImGui::PopTextWrapPos();
   }
   // The ghost (ui/ghost.hpp): a dashed swatch in its colour, as its trail is drawn, and how far
   // ahead or behind along the reference the flight is; what it is, on hover.

@@ -165,6 +165,7 @@ struct RunInfo {
   const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
   const HistoryView* history = nullptr;     // trainees and progress (nullptr: no history)
+  bool instructor_paused = false;  // the instructor paused the flight (SPEC §10)
 };
 
 // What a field of a mode's report means, with its unit ("" for a field it does not know).

@@ -49,13 +49,14 @@ ImU32 event_colour(DebriefKind k) {
     case DebriefKind::input_lost: return colour::kPilot;
     case DebriefKind::lost: return colour::kCritical;
     case DebriefKind::safe_hold: return colour::kCritical;
-    case DebriefKind::marker: return colour::kText;
+    case DebriefKind::marker:
+    case DebriefKind::instructor: return colour::kText;
   }
   return colour::kText;
 }
 
 // A mark's shape tells its kind without colour: takeover ▼, near miss ◆, collision ▲,
-// fallback ■, input lost ○, vehicle lost ✕, safe hold ●, marker ⚑.
+// fallback ■, input lost ○, vehicle lost ✕, safe hold ●, marker ⚑, instructor ◇.
 void draw_event_mark(ImDrawList* dl, ImVec2 c, float s, DebriefKind k) {
   const ImU32 col = event_colour(k);
   const float x = c.x, y = c.y;
@@ -82,6 +83,10 @@ void draw_event_mark(ImDrawList* dl, ImVec2 c, float s, DebriefKind k) {
       dl->AddLine(ImVec2(x - 0.6f * s, y - s), ImVec2(x - 0.6f * s, y + s), col, scaled(1.5f));
       dl->AddTriangleFilled(ImVec2(x - 0.6f * s, y - s), ImVec2(x + s, y - 0.5f * s),
                             ImVec2(x - 0.6f * s, y), col);
+      break;
+    case DebriefKind::instructor:
+      dl->AddQuad(ImVec2(x, y - s), ImVec2(x + s, y), ImVec2(x, y + s), ImVec2(x - s, y), col,
+                  scaled(1.5f));
       break;
   }
 }

@@ -77,6 +77,15 @@ class PilotSource {
   // device reads from now on and a recording gives its commands of the steps to come, so they
   // have nothing to do (the default). Allocates nothing.
   virtual void take_over() {}
+  // The instructor's input loss (SPEC §10): the source's input counts as lost for the steps
+  // before `until_step`, then comes back as it does after a lost device (SPEC §6). true: the
+  // source does it itself (a device: lost, then re-centre and the ramp; a recording: its
+  // commands hold the loss as it was flown); false (the default): the source has no device,
+  // and the mode applies SPEC §6's rule to its commands. Allocates nothing.
+  [[nodiscard]] virtual bool lose_input(std::int64_t until_step) {
+    (void)until_step;
+    return false;
+  }
 };
 
 }  // namespace mixpilot

@@ -17,12 +17,13 @@ const char* to_string(Ended e) {
     case Ended::completed: return "completed";
     case Ended::interrupted: return "interrupted";
     case Ended::lost: return "lost";
+    case Ended::instructor: return "instructor";
   }
   return "completed";
 }
 
 std::optional<Ended> ended_from(std::string_view text) {
-  for (Ended e : {Ended::completed, Ended::interrupted, Ended::lost})
+  for (Ended e : {Ended::completed, Ended::interrupted, Ended::lost, Ended::instructor})
     if (text == to_string(e)) return e;
   return std::nullopt;
 }

@@ -12,7 +12,9 @@
 
 namespace mixpilot::history {
 
-enum class Ended { completed, interrupted, lost };
+// How a flight ended; `instructor`: the instructor ended it (SPEC §10), stored as interrupted
+// with ended_by 'instructor' (core/history/schema.cpp, migration 5).
+enum class Ended { completed, interrupted, lost, instructor };
 const char* to_string(Ended e);
 std::optional<Ended> ended_from(std::string_view text);
 

@@ -398,7 +398,8 @@ std::optional<PostgresHistory::Inserted> PostgresHistory::insert_flight(const Fl
       .text(f.input_settings_hash)
       .integer(f.started_unix_ms)
       .text(number(f.duration_s))
-      .text(to_string(f.ended))
+      // The instructor's end is stored as interrupted, with who ended it (schema migration 5).
+      .text(to_string(f.ended == Ended::instructor ? Ended::interrupted : f.ended))
       .integer(f.probe ? 1 : 0)
       .text_or_null(f.recording_path)
       .text_or_null(f.recording_hash)
@@ -409,14 +410,15 @@ std::optional<PostgresHistory::Inserted> PostgresHistory::insert_flight(const Fl
     p.integer(f.parent_step);
   else
     p.null();
+  p.text_or_null(f.ended == Ended::instructor ? std::string("instructor") : std::string());
   // The same recording added at this moment by another station: theirs counts, ours is known.
   const auto flight =
       run("INSERT INTO flights (trainee_id, station, scenario, scenario_hash, mode, pilot, "
           "input_device, input_settings_hash, started_unix_ms, duration_s, ended, probe, "
           "recording_path, recording_hash, app_version, front_end, parent_recording_hash, "
-          "parent_step) "
+          "parent_step, ended_by) "
           "VALUES ($1::bigint, $2, $3, $4, $5, $6, $7, $8, $9::bigint, $10::double precision, $11, "
-          "$12::integer, $13, $14, $15, $16, $17, $18::bigint) "
+          "$12::integer, $13, $14, $15, $16, $17, $18::bigint, $19) "
           "ON CONFLICT (recording_hash) DO NOTHING RETURNING id",
           p, PGRES_TUPLES_OK, "cannot add the flight", error);
   if (!flight) return std::nullopt;
@@ -642,7 +644,8 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
       "SELECT * FROM (SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, "
       "f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, "
       "f.probe, f.recording_path, f.recording_hash, f.app_version, f.front_end, "
-      "f.parent_recording_hash, f.parent_step, a.lesson, a.step, a.passed, a.failed_criterion "
+      "f.parent_recording_hash, f.parent_step, f.ended_by, a.lesson, a.step, a.passed, "
+      "a.failed_criterion "
       "FROM flights f JOIN trainees t ON t.id = f.trainee_id "
       "LEFT JOIN lesson_attempts a ON a.flight_id = f.id "
       "WHERE ($1::text = '' OR t.name = $1::text) AND ($2::text = '' OR f.scenario = $2::text) "
@@ -678,11 +681,12 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
     f.front_end = s.text(r, 16);
     f.parent_recording_hash = s.text(r, 17);
     f.parent_step = s.at(r, 18) ? read_int(s.at(r, 18)) : -1;
-    if (s.at(r, 19)) {
-      f.lesson = s.text(r, 19);
-      f.lesson_step = int(read_int(s.at(r, 20)));
-      f.lesson_passed = read_int(s.at(r, 21)) != 0;
-      f.lesson_failed = s.text(r, 22);
+    if (s.text(r, 19) == "instructor") f.ended = Ended::instructor;
+    if (s.at(r, 20)) {
+      f.lesson = s.text(r, 20);
+      f.lesson_step = int(read_int(s.at(r, 21)));
+      f.lesson_passed = read_int(s.at(r, 22)) != 0;
+      f.lesson_failed = s.text(r, 23);
     }
     if (r > 0) ids += ',';
     ids += std::to_string(f.id);

@@ -85,6 +85,11 @@ const std::vector<std::vector<const char*>>& migrations() {
           "CREATE INDEX lesson_attempts_by_lesson ON lesson_attempts (trainee_id, lesson, "
           "lesson_hash, step, id)",
       },
+      // 5: who ended a flight stopped before its end, when it was not the trainee: 'instructor'
+      // (SPEC §10; its `ended` stays 'interrupted', which older readers understand), else NULL.
+      {
+          "ALTER TABLE flights ADD COLUMN ended_by TEXT CHECK (ended_by IN ('instructor'))",
+      },
   };
   return m;
 }

@@ -22,7 +22,7 @@ namespace mixpilot::history {
 enum class Dialect { sqlite, postgresql };
 
 // The schema this build writes and reads.
-inline constexpr int kSchemaVersion = 4;
+inline constexpr int kSchemaVersion = 5;
 
 inline constexpr const char* kCreateVersionTable =
     "CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL PRIMARY KEY, "

@@ -229,8 +229,8 @@ std::optional<SqliteHistory::Inserted> SqliteHistory::insert_flight(const Flight
                  "INSERT INTO flights (trainee_id, station, scenario, scenario_hash, mode, pilot, "
                  "input_device, input_settings_hash, started_unix_ms, duration_s, ended, probe, "
                  "recording_path, recording_hash, app_version, front_end, parent_recording_hash, "
-                 "parent_step) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
+                 "parent_step, ended_by) "
+                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
                  error))
       return std::nullopt;
     sqlite3_stmt* p = s.get();
@@ -244,7 +244,9 @@ std::optional<SqliteHistory::Inserted> SqliteHistory::insert_flight(const Flight
     bind_text(p, 8, f.input_settings_hash);
     sqlite3_bind_int64(p, 9, f.started_unix_ms);
     sqlite3_bind_double(p, 10, f.duration_s);
-    bind_text(p, 11, to_string(f.ended));
+    // The instructor's end is stored as interrupted, with who ended it (schema migration 5).
+    const bool by_instructor = f.ended == Ended::instructor;
+    bind_text(p, 11, to_string(by_instructor ? Ended::interrupted : f.ended));
     sqlite3_bind_int(p, 12, f.probe ? 1 : 0);
     bind_text(p, 13, f.recording_path, true);
     bind_text(p, 14, f.recording_hash, true);
@@ -255,6 +257,7 @@ std::optional<SqliteHistory::Inserted> SqliteHistory::insert_flight(const Flight
       sqlite3_bind_int64(p, 18, f.parent_step);
     else
       sqlite3_bind_null(p, 18);
+    bind_text(p, 19, by_instructor ? "instructor" : "", true);
     if (sqlite3_step(p) != SQLITE_ROW) {
       error = fail("cannot add the flight");
       return std::nullopt;
@@ -511,7 +514,8 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       "SELECT f.id, t.name, f.station, f.scenario, f.scenario_hash, f.mode, f.pilot, "
       "f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, f.probe, "
       "f.recording_path, f.recording_hash, f.app_version, f.front_end, "
-      "f.parent_recording_hash, f.parent_step, a.lesson, a.step, a.passed, a.failed_criterion";
+      "f.parent_recording_hash, f.parent_step, f.ended_by, a.lesson, a.step, a.passed, "
+      "a.failed_criterion";
   // Without a limit the start-time index gives the order as it is: no sort of every row.
   const std::string flights_sql =
       q.limit > 0 ? std::string("SELECT * FROM (") + kColumns + kFilter +
@@ -552,11 +556,12 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       f.front_end = column_text(p, 16);
       f.parent_recording_hash = column_text(p, 17);
       f.parent_step = sqlite3_column_type(p, 18) == SQLITE_NULL ? -1 : sqlite3_column_int64(p, 18);
-      if (sqlite3_column_type(p, 19) != SQLITE_NULL) {
-        f.lesson = column_text(p, 19);
-        f.lesson_step = sqlite3_column_int(p, 20);
-        f.lesson_passed = sqlite3_column_int(p, 21) != 0;
-        f.lesson_failed = column_text(p, 22);
+      if (column_text(p, 19) == "instructor") f.ended = Ended::instructor;
+      if (sqlite3_column_type(p, 20) != SQLITE_NULL) {
+        f.lesson = column_text(p, 20);
+        f.lesson_step = sqlite3_column_int(p, 21);
+        f.lesson_passed = sqlite3_column_int(p, 22) != 0;
+        f.lesson_failed = column_text(p, 23);
       }
       out.push_back(std::move(f));
     }

@@ -19,6 +19,7 @@ const char* to_string(DebriefKind kind) {
     case DebriefKind::lost: return "vehicle lost";
     case DebriefKind::safe_hold: return "safe hold";
     case DebriefKind::marker: return "marker";
+    case DebriefKind::instructor: return "instructor";
   }
   return "?";
 }
@@ -32,7 +33,8 @@ LogLevel log_level(DebriefKind kind) {
     case DebriefKind::collision:
     case DebriefKind::lost:
     case DebriefKind::safe_hold: return LogLevel::error;
-    case DebriefKind::marker: return LogLevel::info;
+    case DebriefKind::marker:
+    case DebriefKind::instructor: return LogLevel::info;
   }
   return LogLevel::info;
 }
@@ -179,6 +181,24 @@ void DebriefBuilder::add(const Telemetry& s) {
     ++safe_hold_.e.steps;
   run(input_lost_, DebriefKind::input_lost, mi && s.pilot.input == InputState::lost, 1);
 
+  // The instructor's commands of the step: markers with their text, the others in words.
+  for (int i = 0; i < s.num_commands; ++i) {
+    const InstructorCommand& c = s.commands[std::size_t(i)];
+    DebriefEvent e;
+    e.start_step = e.end_step = e.closed_step = k;
+    e.start = e.end = e.extreme_t = s.t;
+    e.steps = 1;
+    if (c.kind == InstructorCommandKind::marker) {
+      e.kind = DebriefKind::marker;
+      e.note = c.text;
+    } else {
+      e.kind = DebriefKind::instructor;
+      char words[DebriefNote::kCapacity + 1];
+      e.note.assign(std::string_view(words, describe(c, words, sizeof words)));
+    }
+    keep(e);
+  }
+
   if (s.events & kEventLost) {
     DebriefEvent e;
     e.kind = DebriefKind::lost;
@@ -297,6 +317,11 @@ std::size_t describe(const DebriefEvent& e, double ball_radius, char* out, std::
     case DebriefKind::marker: {
       const std::string_view note = e.note.view();
       n = std::snprintf(out, size, "marker: %.*s", int(note.size()), note.data());
+      break;
+    }
+    case DebriefKind::instructor: {
+      const std::string_view note = e.note.view();
+      n = std::snprintf(out, size, "instructor: %.*s", int(note.size()), note.data());
       break;
     }
   }

@@ -25,7 +25,10 @@
 //   input lost  the pilot's input lost (InputState::lost), until it is back.
 //   lost        the vehicle was lost (kEventLost): the flight ended there.
 //   safe hold   steps the safe controller flew (kEventSafeHold), a run as one.
-//   marker      an instructor's marker with its text, at a step (mark()).
+//   marker      an instructor's marker with its text, at a step (mark(), or a marker command
+//               in the step's telemetry, Telemetry::commands).
+//   instructor  any other instructor's command at the step it took effect at, in words
+//               (describe(InstructorCommand)): "instructor: ceiling 0.30".
 // An event still open when the flight ends is closed at its end (until_end).
 #include <array>
 #include <cstddef>
@@ -34,6 +37,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/modes/debrief_note.hpp"
 #include "core/modes/mode.hpp"
 
 namespace mixpilot {
@@ -47,30 +51,18 @@ enum class DebriefKind : std::uint8_t {
   lost,
   safe_hold,
   marker,
+  instructor,  // an instructor's command other than a marker (SPEC §10)
 };
-inline constexpr int kDebriefKindCount = 8;
+inline constexpr int kDebriefKindCount = 9;
 // "takeover", "near miss", "collision", "fallback", "input lost", "vehicle lost", "safe hold",
-// "marker".
+// "marker", "instructor".
 const char* to_string(DebriefKind kind);
 
 // The severity of an event as ROS 2 logs it (rcl_interfaces/msg/Log's levels).
 enum class LogLevel : std::uint8_t { debug = 10, info = 20, warn = 30, error = 40, fatal = 50 };
 // takeover, near miss, fallback, input lost: warn; collision, vehicle lost, safe hold: error;
-// marker: info.
+// marker, instructor: info.
 LogLevel log_level(DebriefKind kind);
-
-// A marker's text, of fixed capacity: an event holds it without allocating.
-class DebriefNote {
- public:
-  static constexpr std::size_t kCapacity = 95;  // bytes; a longer text is cut at a character
-  void assign(std::string_view text);
-  std::string_view view() const { return {text_.data(), size_}; }
-  bool operator==(const DebriefNote& o) const { return view() == o.view(); }
-
- private:
-  std::array<char, kCapacity + 1> text_{};
-  std::size_t size_ = 0;
-};
 
 struct DebriefEvent {
   DebriefKind kind = DebriefKind::marker;
@@ -87,7 +79,7 @@ struct DebriefEvent {
   // takeover: what decided λ at its lowest, and the pilot's input there.
   LambdaReason reason;
   InputState input = InputState::ok;
-  DebriefNote note;  // marker: its text
+  DebriefNote note;  // marker: its text; instructor: the command in words
 
   double duration() const { return end - start; }
   bool operator==(const DebriefEvent&) const = default;
@@ -163,6 +155,7 @@ std::vector<DebriefEvent> debrief_of(const std::vector<Telemetry>& steps, std::s
 //   "vehicle lost: the flight ended"
 //   "safe hold for 1.2 s: the MPC fell behind, the safe controller flew"
 //   "marker: <its text>"
+//   "instructor: gust 2.0 N for 0.50 s"
 // ("... for the last 1.8 s ..." when it lasted to the end). Writes a NUL-terminated text into
 // out[0 .. size) (cut at a character if need be); returns its length. Allocates nothing.
 std::size_t describe(const DebriefEvent& e, double ball_radius, char* out, std::size_t size);

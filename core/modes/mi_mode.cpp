@@ -63,6 +63,7 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   plant.idle = Simulated::Idle::hovers;
   plant.position_noise = scenario_.plant.position_noise;
   plant.seed = scenario_.plant.seed;
+  plant.max_extra_delay = std::lround(kMaxExtraDelay / plant.h);
   simulated_.setup(model_, plant, models::MikroKopter::State(run_.x));
   scorer_.setup(scenario_);
   run_.step = 0;
@@ -76,6 +77,8 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   run_.finished = steps_total_ <= 0;
   run_.lost = false;
   run_.lost_at = -1.0;
+  run_.loss_until = -1;
+  run_.loss_rule = false;
 
   Telemetry& s = run_.telemetry;
   s = Telemetry{};
@@ -174,6 +177,7 @@ void MiMode::set_channels() {
 bool MiMode::step() {
   if (run_.finished || stopped_at(run_.step)) return false;
   const auto started = std::chrono::steady_clock::now();
+  begin_commands(run_.step);
   const double t = double(run_.step) * dt_;
   Telemetry& s = run_.telemetry;
   if (remote_.attached()) {
@@ -182,6 +186,7 @@ bool MiMode::step() {
       run_.lost = run_.finished = true;
       run_.lost_at = t;
       s.events = kEventLost;
+      end_commands(s);
       remote_.finish();
       ++run_.step;
       return true;
@@ -196,6 +201,7 @@ bool MiMode::step() {
     run_.finished = true;
     return false;
   }
+  if (run_.loss_rule) lose_input(s.pilot);
   const JoyInput* joy = pilot_->joy();
   s.has_joy = joy != nullptr;
   if (joy) s.joy = *joy;
@@ -242,6 +248,7 @@ bool MiMode::step() {
   if (scorer_.add(s)) s.events |= kEventCollision;
   s.clearance = scorer_.clearance();
   set_channels();
+  end_commands(s);
 
   if (remote_.attached()) {
     ++run_.step;
@@ -324,7 +331,60 @@ RestoreStatus MiMode::take_over_state(const ModeSnapshot::State& state) {
   // SPEC §10: the new flight is scored on its own steps, from the snapshot's step on.
   scorer_.restart(run_.step);
   pilot_->take_over();
+  // An instructor's input loss in force goes on with the new source, as that source does it.
+  if (run_.loss_until >= 0) run_.loss_rule = !pilot_->lose_input(run_.loss_until);
   return RestoreStatus::ok;
+}
+
+InstructorStatus MiMode::apply_gust(const Eigen::Vector3d& force, double duration) {
+  if (remote_.attached()) return InstructorStatus::remote_vehicle;
+  simulated_.gust(force, std::lround(duration / simulated_.settings().h));
+  return InstructorStatus::applied;
+}
+
+InstructorStatus MiMode::apply_extra_delay(double delay) {
+  if (remote_.attached()) return InstructorStatus::remote_vehicle;
+  simulated_.set_extra_delay(std::lround(delay / simulated_.settings().h));
+  return InstructorStatus::applied;
+}
+
+InstructorStatus MiMode::apply_input_loss(double duration) {
+  run_.loss_until = run_.step + std::max(1L, std::lround(duration / dt_));
+  run_.loss_rule = !pilot_->lose_input(run_.loss_until);
+  return InstructorStatus::applied;
+}
+
+InstructorInForce MiMode::in_force(std::int64_t k) const {
+  InstructorInForce f;
+  if (!remote_.attached()) {
+    const double h = simulated_.settings().h;
+    const long left = simulated_.gust_left(long(k) * substeps_);
+    if (left > 0) {
+      f.gust = simulated_.data().gust;
+      f.gust_left = double(left) * h;
+    }
+    f.extra_delay = double(simulated_.extra_delay()) * h;
+  }
+  f.input_loss_left = double(std::max<std::int64_t>(0, run_.loss_until - k)) * dt_;
+  return f;
+}
+
+// SPEC §6's rule for a source without a device: lost before loss_until (a neutral command of no
+// weight), then the authority ramps back linearly over kInputReturnS, counted in steps so it
+// ends exactly then. A function of the step alone: a snapshot or a take-over continues it.
+void MiMode::lose_input(PilotCommand& pilot) const {
+  const std::int64_t k = run_.step;
+  if (k < run_.loss_until) {
+    pilot.roll = pilot.pitch = 0.0;
+    pilot.rotor_speed.setConstant(model_.hover_speed());
+    pilot.authority = 0.0;
+    pilot.input = InputState::lost;
+    return;
+  }
+  const double ramp = double(k - run_.loss_until + 1) * dt_;
+  if (ramp >= kInputReturnS - 1e-9 * dt_) return;
+  pilot.authority = std::min(pilot.authority, ramp / kInputReturnS);
+  pilot.input = InputState::returning;
 }
 
 Metrics MiMode::metrics() const {

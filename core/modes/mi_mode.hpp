@@ -60,6 +60,10 @@ class MiMode final : public Mode {
   AuthorityBounds authority_bounds() const override { return controller_.bounds(); }
   // The score; with a remote vehicle also rtt_s (the median round-trip sample) and
   // rtt_estimated_s (the final estimate).
+  InstructorStatus accepts(InstructorCommandKind kind) const override {
+    const bool plant = kind == InstructorCommandKind::gust || kind == InstructorCommandKind::extra_delay;
+    return plant && remote_.attached() ? InstructorStatus::remote_vehicle : InstructorStatus::applied;
+  }
   Metrics metrics() const override;
   std::string summary() const override;
   ModeView view() const override;
@@ -90,6 +94,18 @@ class MiMode final : public Mode {
   // (PilotSource::take_over) and the score restarts at the snapshot's step.
   [[nodiscard]] RestoreStatus take_over_state(const ModeSnapshot::State& state) override;
 
+  // The instructor (Mode::instruct, SPEC §10): a gust on the simulated plant; an extra delay
+  // on the measurement the controller starts from (core/modes/simulated_vehicle.hpp; the
+  // pilot sees the vehicle as it is); an input loss that the pilot source handles when it is a
+  // device or a recording (PilotSource::lose_input), else the mode: lost (neutral command,
+  // authority 0) for the duration, then the authority ramps back over kInputReturnS, as a
+  // device's does once its sticks are centred (an emulated pilot has no sticks to centre).
+  // With a remote vehicle the gust and the delay are refused.
+  [[nodiscard]] InstructorStatus apply_gust(const Eigen::Vector3d& force, double duration) override;
+  [[nodiscard]] InstructorStatus apply_extra_delay(double delay) override;
+  [[nodiscard]] InstructorStatus apply_input_loss(double duration) override;
+  InstructorInForce in_force(std::int64_t k) const override;
+
  private:
   struct Saved;
   // Whether a saved state can be put back into this mode (ok), or why not, its pilot's state
@@ -101,6 +117,7 @@ class MiMode final : public Mode {
   void measure_remote(double t);
   void set_reference(double t);
   void set_channels();
+  void lose_input(PilotCommand& pilot) const;
 
   Scenario scenario_;
   std::unique_ptr<PilotSource> pilot_;
@@ -127,12 +144,20 @@ class MiMode final : public Mode {
     bool lost = false;
     double lost_at = -1.0;
     const char* lost_reason = "";
+    // The instructor's input loss: lost before step loss_until (−1: none); loss_rule: the mode
+    // applies SPEC §6's rule itself (the pilot source has no device).
+    std::int64_t loss_until = -1;
+    bool loss_rule = false;
   };
   Run run_;
 
   SimulatedVehicle<models::MikroKopter> simulated_;  // flown unless a remote one is attached
   LinkedVehicle<models::MikroKopter> remote_;        // flown when attached (set_vehicle())
 };
+
+// [s] how long the authority takes to come back after an instructor's input loss, for a pilot
+// without a device (the input settings' default return time, docs/input-settings.md).
+inline constexpr double kInputReturnS = 1.0;
 
 // The scenario's emulated pilot of that name: a profile of the scenario's [pilots], or
 // "reckless". Fails with the known names.

@@ -49,6 +49,7 @@ void Mode::save(ModeSnapshot& snapshot) const {
   s.step_ = steps_done();
   s.next_forced_ = next_forced_;
   s.next_miss_ = next_miss_;
+  s.next_command_ = next_command_;
   save_state(s.state_);
 }
 
@@ -58,6 +59,8 @@ RestoreStatus Mode::restore(const ModeSnapshot& snapshot) {
   if (const RestoreStatus r = restore_state(*s.state_); r != RestoreStatus::ok) return r;
   next_forced_ = s.next_forced_;
   next_miss_ = s.next_miss_;
+  next_command_ = s.next_command_;
+  pending_count_ = 0;
   return RestoreStatus::ok;
 }
 
@@ -67,6 +70,8 @@ RestoreStatus Mode::take_over(const ModeSnapshot& snapshot) {
   if (const RestoreStatus r = take_over_state(*s.state_); r != RestoreStatus::ok) return r;
   next_forced_ = s.next_forced_;
   next_miss_ = s.next_miss_;
+  next_command_ = s.next_command_;
+  pending_count_ = 0;
   return RestoreStatus::ok;
 }
 
@@ -76,6 +81,46 @@ RestoreStatus Mode::fits(const ModeSnapshot& s) const {
   if (s.scenario_name_ != scenario_name() || s.steps_total_ != steps_total())
     return RestoreStatus::other_scenario;
   return RestoreStatus::ok;
+}
+
+InstructorStatus Mode::instruct(const InstructorCommand& c) {
+  if (invalid_reason(c)) return InstructorStatus::bad_value;
+  if (finished()) return InstructorStatus::over;
+  if (pending_count_ >= kMaxCommandsPerStep) return InstructorStatus::busy;
+  InstructorStatus status = InstructorStatus::applied;
+  switch (c.kind) {
+    case InstructorCommandKind::bounds:
+      status = set_authority_bounds(c.bounds) ? InstructorStatus::applied
+                                              : InstructorStatus::no_authority;
+      break;
+    case InstructorCommandKind::gust: status = apply_gust(c.force, c.duration); break;
+    case InstructorCommandKind::extra_delay: status = apply_extra_delay(c.delay); break;
+    case InstructorCommandKind::input_loss: status = apply_input_loss(c.duration); break;
+    case InstructorCommandKind::marker:
+    case InstructorCommandKind::pause:
+    case InstructorCommandKind::resume:
+    case InstructorCommandKind::end: break;
+  }
+  if (status == InstructorStatus::applied) pending_[std::size_t(pending_count_++)] = c;
+  return status;
+}
+
+void Mode::begin_commands(std::int64_t k) {
+  std::size_t& n = next_command_;
+  // Forward as the steps go; back after a snapshot of an earlier step was restored.
+  while (n > 0 && scheduled_[n - 1].step >= k) --n;
+  while (n < scheduled_.size() && scheduled_[n].step < k) ++n;
+  for (; n < scheduled_.size() && scheduled_[n].step == k; ++n)
+    (void)instruct(scheduled_[n].command);  // applied when recorded: the check finds any other
+}
+
+void Mode::end_commands(Telemetry& s) {
+  s.num_commands = pending_count_;
+  for (int i = 0; i < pending_count_; ++i)
+    s.commands[std::size_t(i)] = pending_[std::size_t(i)];
+  pending_count_ = 0;
+  s.instructor = in_force(s.step);
+  s.instructor.bounds = authority_bounds();
 }
 
 std::string mode_kind_names() {

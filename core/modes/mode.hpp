@@ -19,6 +19,7 @@
 
 #include "core/control/ph_index.hpp"
 #include "core/control/pilot.hpp"
+#include "core/modes/instructor.hpp"
 #include "core/modes/mode_view.hpp"
 #include "core/modes/vehicle_link.hpp"
 #include "core/nlp/rti.hpp"
@@ -91,6 +92,12 @@ struct Telemetry {
   std::array<Channel, kMaxChannels> channels{};
   int num_channels = 0;
 
+  // The instructor's commands (SPEC §10) that took effect at this step, in the order applied
+  // (Mode::instruct), and what the commands keep in force during it.
+  std::array<InstructorCommand, kMaxCommandsPerStep> commands{};
+  int num_commands = 0;
+  InstructorInForce instructor;
+
   // Sets channel i (i < kMaxChannels) and extends num_channels to cover it.
   void set_channel(int i, const char* name, const char* unit, double value) {
     channels[std::size_t(i)] = Channel{name, unit, value};
@@ -137,6 +144,7 @@ class ModeSnapshot {
   std::int64_t steps_total_ = 0;
   std::int64_t step_ = 0;
   std::size_t next_forced_ = 0, next_miss_ = 0;  // replay_timing()'s cursors
+  std::size_t next_command_ = 0;                 // replay_commands()' cursor
   std::unique_ptr<State> state_;
 };
 
@@ -198,6 +206,42 @@ class Mode {
     return false;
   }
   virtual AuthorityBounds authority_bounds() const { return {}; }
+
+  // The instructor (SPEC §10, core/modes/instructor.hpp): `c` takes effect from the next step
+  // on, which carries it in its telemetry (Telemetry::commands), so a recording holds it at
+  // that step. Called between steps, on the thread that steps the mode (the session drains its
+  // command inbox there); allocates nothing. Per kind:
+  //   bounds       set_authority_bounds() (mixed initiative)
+  //   gust         the simulated plant gets the world-frame force for `duration` from the next
+  //                substep on; the controller's model knows nothing of it (quadrotor modes)
+  //   extra delay  `delay` more between vehicle and controller (each mode says what it delays),
+  //                until another extra delay replaces it (0 removes it)
+  //   input loss   the pilot's input lost for `duration`, then recovered as SPEC §6 recovers a
+  //                lost device (mixed initiative)
+  //   marker, pause, resume, end   recorded only: the session pauses, resumes and ends
+  // A command that cannot be applied changes nothing and says why; `busy` when the step holds
+  // kMaxCommandsPerStep commands already (try again after the step).
+  [[nodiscard]] InstructorStatus instruct(const InstructorCommand& c);
+  // Whether this flight takes commands of `kind` (applied) or why not, without applying one:
+  // what a script is checked against before the flight.
+  virtual InstructorStatus accepts(InstructorCommandKind kind) const {
+    switch (kind) {
+      case InstructorCommandKind::bounds: return InstructorStatus::no_authority;
+      case InstructorCommandKind::gust: return InstructorStatus::fixed_base;
+      case InstructorCommandKind::extra_delay: return InstructorStatus::no_link;
+      case InstructorCommandKind::input_loss: return InstructorStatus::no_pilot;
+      default: return InstructorStatus::applied;
+    }
+  }
+  // Commands taken for the next step so far.
+  int commands_pending() const { return pending_count_; }
+  // A replay: the recorded commands (ascending steps), each applied by instruct() as its step
+  // starts, so the replayed steps carry and obey them as the recorded ones did.
+  void replay_commands(std::vector<StepCommand> commands) {
+    scheduled_ = std::move(commands);
+    next_command_ = 0;
+  }
+
   // The states its remote vehicle sends, for the link to check ({}: it has none).
   virtual VehicleStateSpec remote_state() const { return {}; }
 
@@ -271,6 +315,32 @@ class Mode {
   }
   void pace_like_this(Mode& mode) const { mode.set_pacing(late_us_, period_us_); }
 
+  // The instructor's commands in step(): begin_commands(k) first thing in step k (the replayed
+  // commands of step k are applied), end_commands(telemetry) once the step's telemetry is set
+  // (its commands and what is in force). Allocate nothing.
+  void begin_commands(std::int64_t k);
+  void end_commands(Telemetry& s);
+  // The effects of instruct() that a mode kind provides (the defaults refuse: a mode without a
+  // free-flying simulated plant, a link or a pilot — the Pendubot). Called with values in range.
+  [[nodiscard]] virtual InstructorStatus apply_gust(const Eigen::Vector3d& force, double duration) {
+    (void)force;
+    (void)duration;
+    return InstructorStatus::fixed_base;
+  }
+  [[nodiscard]] virtual InstructorStatus apply_extra_delay(double delay) {
+    (void)delay;
+    return InstructorStatus::no_link;
+  }
+  [[nodiscard]] virtual InstructorStatus apply_input_loss(double duration) {
+    (void)duration;
+    return InstructorStatus::no_pilot;
+  }
+  // What the commands keep in force during step k (the bounds are the base's to fill in).
+  virtual InstructorInForce in_force(std::int64_t k) const {
+    (void)k;
+    return {};
+  }
+
   // Whether restore() and take_over() can take `s` at all: saved, of this kind, scenario and
   // length (ok), or why not.
   RestoreStatus fits(const ModeSnapshot& s) const;
@@ -297,6 +367,10 @@ class Mode {
 
   std::vector<std::int64_t> forced_overruns_, forced_misses_;
   std::size_t next_forced_ = 0, next_miss_ = 0;
+  std::vector<StepCommand> scheduled_;  // replay_commands()
+  std::size_t next_command_ = 0;
+  std::array<InstructorCommand, kMaxCommandsPerStep> pending_{};  // for the next step
+  int pending_count_ = 0;
   double late_us_ = 0.0, period_us_ = 0.0;
   std::int64_t stop_after_ = -1;
 };

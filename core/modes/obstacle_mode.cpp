@@ -54,6 +54,7 @@ SetupResult ObstacleMode::setup(ObstacleScenario scenario, std::optional<Obstacl
   SimulatedVehicle<models::Crazyflie>::Settings plant;
   plant.substeps = substeps_;
   plant.h = settings_.dt / substeps_;
+  plant.max_extra_delay = std::lround(kMaxExtraDelay / plant.h);
   simulated_.setup(model_, plant, run_.x);
   warm_start();
   run_.rti_us.clear();
@@ -130,15 +131,19 @@ void ObstacleMode::reset_telemetry() {
 
 bool ObstacleMode::step() {
   if (run_.finished || stopped_at(run_.step)) return false;
+  begin_commands(run_.step);
   const auto started = std::chrono::steady_clock::now();
   const int k = int(run_.step);
   const double t = k * settings_.dt;
+  // The state the NMPC starts from: the true one, or the one the extra delay lets through.
+  if (simulated_.extra_delay() > 0) simulated_.measure(run_.step, run_.y);
+  else run_.y = run_.x;
   const OcpTrajectory& ref = scenario_.reference.trajectory;
   problem_->set_reference(rti_.data(), ref, k);
   problem_->set_obstacles(rti_.data(), scenario_.world, t);
   rti_.prepare();
   if (forced_overrun(run_.step)) rti_.force_overrun_next();
-  rti_.feedback(run_.x);
+  rti_.feedback(run_.y);
   const RtiStats& st = rti_.stats();
   run_.rti_us.push_back(st.total_us);
   run_.qp_iterations_max = std::max(run_.qp_iterations_max, st.qp_iterations);
@@ -146,8 +151,8 @@ bool ObstacleMode::step() {
   // The plan spent after fallbacks in a row: hover-hold where the safe controller took over.
   const bool safe = run_.safety.update(st.status != RtiStatus::success);
   if (safe) {
-    if (run_.safety.switched()) run_.hold = model_.hover_state(run_.x.head<3>());
-    safe_lqr_.control(run_.x, run_.hold, model_.hover_input(), u);
+    if (run_.safety.switched()) run_.hold = model_.hover_state(run_.y.head<3>());
+    safe_lqr_.control(run_.y, run_.hold, model_.hover_input(), u);
   }
   const double compute_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - started).count();
@@ -156,7 +161,7 @@ bool ObstacleMode::step() {
   s.step = run_.step;
   s.t = t;
   s.x = run_.x;
-  s.x_measured = run_.x;
+  s.x_measured = run_.y;
   s.u = u;
   s.solved = true;
   s.stats = st;
@@ -177,6 +182,7 @@ bool ObstacleMode::step() {
   s.events |= deadline_event(s.step, compute_us, st.overrun);
   if (violated) s.events |= kEventViolation;
   set_channels(distance, std::sqrt(sq_error));
+  end_commands(s);
   if (!run_.x.allFinite()) {  // never hand a non-finite state to anyone
     run_.x = s.x;
     run_.lost = run_.finished = true;
@@ -187,6 +193,28 @@ bool ObstacleMode::step() {
   rti_.shift();
   if (run_.step >= steps_total_) run_.finished = true;
   return true;
+}
+
+InstructorStatus ObstacleMode::apply_gust(const Eigen::Vector3d& force, double duration) {
+  simulated_.gust(force, std::lround(duration / simulated_.settings().h));
+  return InstructorStatus::applied;
+}
+
+InstructorStatus ObstacleMode::apply_extra_delay(double delay) {
+  simulated_.set_extra_delay(std::lround(delay / simulated_.settings().h));
+  return InstructorStatus::applied;
+}
+
+InstructorInForce ObstacleMode::in_force(std::int64_t k) const {
+  InstructorInForce f;
+  const double h = simulated_.settings().h;
+  const long left = simulated_.gust_left(long(k) * substeps_);
+  if (left > 0) {
+    f.gust = simulated_.data().gust;
+    f.gust_left = double(left) * h;
+  }
+  f.extra_delay = double(simulated_.extra_delay()) * h;
+  return f;
 }
 
 // RK4 at the plant rate with u held over [t, t + Δt], the distances checked after every

@@ -86,6 +86,11 @@ class ObstacleMode final : public Mode {
   // min_distance_m, min_margin_m, min_distance_control_m, clearance_m, violations,
   // tracking_rms_m, final_error_m, rti_median_us, rti_p99_us, fallbacks, form (0 lcl,
   // 1 squared), steps.
+  InstructorStatus accepts(InstructorCommandKind kind) const override {
+    if (kind == InstructorCommandKind::gust || kind == InstructorCommandKind::extra_delay)
+      return InstructorStatus::applied;
+    return Mode::accepts(kind);
+  }
   Metrics metrics() const override;
   std::string summary() const override;
   ModeView view() const override;
@@ -105,6 +110,12 @@ class ObstacleMode final : public Mode {
   // Snapshots (Mode::save, Mode::restore): the NMPC's RTI state, the simulated vehicle and Run.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+  // The instructor (Mode::instruct, SPEC §10): a gust on the simulated plant; an extra delay
+  // between the vehicle and the NMPC, which then starts from the state that old (without one
+  // it starts from the true state, as SPEC §5.3 does).
+  [[nodiscard]] InstructorStatus apply_gust(const Eigen::Vector3d& force, double duration) override;
+  [[nodiscard]] InstructorStatus apply_extra_delay(double delay) override;
+  InstructorInForce in_force(std::int64_t k) const override;
 
  private:
   struct Saved;
@@ -136,6 +147,7 @@ class ObstacleMode final : public Mode {
   struct Run {
     Telemetry telemetry;
     models::Crazyflie::State x;  // 13: true plant state (the simulated vehicle's, at t_k)
+    models::Crazyflie::State y;  // 13: what the NMPC starts from (x, or x delayed)
     SafetyNet safety;
     models::Crazyflie::State hold = models::Crazyflie::State::Zero();  // 13
     ReservedVector<double> rti_us;  // per step, RTI prepare + feedback [us]

@@ -282,6 +282,7 @@ void PendubotMode::record_angle_norm() {
 
 bool PendubotMode::step() {
   if (run_.finished || stopped_at(run_.step)) return false;
+  begin_commands(run_.step);
   const auto started = std::chrono::steady_clock::now();
   measure();
   const bool switched = switch_controller();
@@ -294,6 +295,7 @@ bool PendubotMode::step() {
   s.x = x_k;
   set_telemetry(u, switched, worst);
   s.events |= deadline_event(run_.step, compute_us, s.solved && s.stats.overrun);
+  end_commands(s);
   ++run_.step;
   record_angle_norm();
   run_.finished = run_.step >= steps_total_;

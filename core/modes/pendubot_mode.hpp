@@ -22,6 +22,10 @@
 // kEventFallback (the RTI fell back); channels (PendubotChannel) with the wrapped state, its
 // reference, u, the active controller and the bounds. Before the first step: x_0, u = 0.
 //
+// The instructor (Mode::instruct, SPEC §10): markers, pause, resume and end; a gust is refused
+// (an arm on a fixed shoulder has no free body to push), as are an extra delay (its controller
+// is wired to its encoders, no link) and bounds or an input loss (no pilot).
+//
 // setup() sizes everything; step() allocates nothing.
 #include <cstdint>
 #include <memory>

@@ -9,7 +9,14 @@
 // before command 0 acts the vehicle rests, or hovers on the model's hover input. Step k
 // measures boundary k·s − n_m (the measurement delay line; the start state before boundary 0),
 // its position plus σ·N(0, 1) per axis where σ > 0. The states are kept in a ring: boundaries
-// from k·s − n_m up to those integrated ahead, (k+1)·s + n_c at most, are there.
+// from k·s − n_m − n_x up to those integrated ahead, (k+1)·s + n_c at most, are there.
+//
+// The instructor (SPEC §10): a gust is a world-frame force on the plant
+// (models::WithExternalForce) over substeps [j_g, j_g + n_g) from the first one not yet integrated; the
+// extra delay n_x ≤ max_extra_delay substeps is added to the measurement's, so step k measures
+// boundary k·s − n_m − n_x. All of the round trip's extra delay is put on the measurement: the
+// loop sees the same delay as when it is split over both links, and a command line whose delay
+// changed in flight would drop or repeat commands, which no link does. Both are in Data.
 //
 // Model/Data: setup() sizes Data, the rest allocates nothing; a snapshot copies Data.
 #include <algorithm>
@@ -39,6 +46,13 @@ class VehiclePlant {
   void substep(const State& x, const Input& u, double h, State& x_next) const {
     erk4_.template step<double>(x, u, h, x_next);
   }
+  // The same with a world-frame force F on the vehicle (a gust). Allocates nothing.
+  void substep(const State& x, const Input& u, double h, const Eigen::Vector3d& force,
+               State& x_next) {
+    if (forced_.model().force != force)
+      forced_ = IntegratorErk4<models::WithExternalForce<Model>>({erk4_.model(), force});
+    forced_.template step<double>(x, u, h, x_next);
+  }
   // x from t to `to` [ns] with u held, in substeps of h_ns (the last one shorter), stopping at
   // the first state outside `world` or not finite: then x keeps the last state inside, t is
   // the end of the substep that left, and how it left is returned (nullptr: t = to).
@@ -59,6 +73,7 @@ class VehiclePlant {
 
  private:
   IntegratorErk4<Model> erk4_{};
+  IntegratorErk4<models::WithExternalForce<Model>> forced_{};  // the model with the gust's force
 };
 
 template <class Model>
@@ -78,6 +93,7 @@ class SimulatedVehicle {
     Idle idle = Idle::rests;
     double position_noise = 0.0;  // σ [m]
     std::uint64_t seed = 0;       // of the noise
+    long max_extra_delay = 0;     // [substeps] the instructor's extra delay at most (the ring)
   };
 
   // What a flight changes: a snapshot copies it.
@@ -87,6 +103,10 @@ class SimulatedVehicle {
     long integrated = 0;          // boundaries integrated: states up to here are known
     std::mt19937_64 rng;          // position noise
     std::normal_distribution<double> noise{0.0, 1.0};
+    // The instructor's gust: `gust` [N, world frame] over substeps [gust_from, gust_until).
+    Eigen::Vector3d gust = Eigen::Vector3d::Zero();
+    long gust_from = 0, gust_until = 0;
+    long extra_delay = 0;  // n_x [substeps] added to the measurement's delay
   };
 
   // Sizes the rings; the vehicle starts at x0, no command sent.
@@ -99,12 +119,34 @@ class SimulatedVehicle {
     const long s = settings_.substeps, n_c = settings_.command_delay;
     // Integrating to (k+1)·s + n_c while k·s − n_m is still read; the substeps integrated in
     // step k act on commands k − ⌈n_c/s⌉ .. k.
-    data_.states.assign(std::size_t(settings_.measurement_delay + n_c + s + 1), x0);
+    settings_.max_extra_delay = std::max(0L, settings.max_extra_delay);
+    data_.states.assign(
+        std::size_t(settings_.measurement_delay + settings_.max_extra_delay + n_c + s + 1), x0);
     data_.commands.assign(std::size_t((n_c + s - 1) / s + 2), idle_input_);
     data_.integrated = 0;
     data_.rng.seed(settings_.seed);
     data_.noise.reset();
+    data_.gust.setZero();
+    data_.gust_from = data_.gust_until = 0;
+    data_.extra_delay = 0;
   }
+
+  // A gust of `force` [N, world frame] for `substeps` substeps from the first substep not yet
+  // integrated on (replacing one still blowing).
+  void gust(const Eigen::Vector3d& force, long substeps) {
+    data_.gust = force;
+    data_.gust_from = data_.integrated;
+    data_.gust_until = data_.integrated + std::max(1L, substeps);
+  }
+  // The gust's substeps left from boundary j on.
+  long gust_left(long j) const {
+    return std::max(0L, data_.gust_until - std::max(j, data_.gust_from));
+  }
+  // The extra measurement delay [substeps], clamped to 0 .. max_extra_delay.
+  void set_extra_delay(long substeps) {
+    data_.extra_delay = std::clamp(substeps, 0L, settings_.max_extra_delay);
+  }
+  long extra_delay() const { return data_.extra_delay; }
 
   // Command k goes out (the step's; once per step, in order).
   void send(std::int64_t k, const Input& u) {
@@ -117,16 +159,19 @@ class SimulatedVehicle {
       const State& x = at(j);
       State& xn = data_.states[ring(j + 1)];
       if (j >= settings_.command_delay || settings_.idle == Idle::hovers) {
-        plant_.substep(x, acting(j), settings_.h, xn);
+        if (j >= data_.gust_from && j < data_.gust_until)
+          plant_.substep(x, acting(j), settings_.h, data_.gust, xn);
+        else
+          plant_.substep(x, acting(j), settings_.h, xn);
       } else {
         xn = x;  // at rest until command 0 acts
       }
       ++data_.integrated;
     }
   }
-  // Step k's measurement y: boundary k·s − n_m, its position with noise.
+  // Step k's measurement y: boundary k·s − n_m − n_x, its position with noise.
   void measure(std::int64_t k, State& y) {
-    const long b = long(k) * settings_.substeps - settings_.measurement_delay;
+    const long b = long(k) * settings_.substeps - settings_.measurement_delay - data_.extra_delay;
     y = b <= 0 ? x0_ : at(b);
     if (settings_.position_noise > 0.0) {
       for (int i = 0; i < 3; ++i) y(i) += settings_.position_noise * data_.noise(data_.rng);

@@ -92,6 +92,7 @@ SetupResult TrackingMode::setup(TrackingScenario scenario) {
   plant.h = h_;
   plant.command_delay = n_c_;
   plant.measurement_delay = n_m_;
+  plant.max_extra_delay = std::lround(kMaxExtraDelay / h_);
   plant.idle = Simulated::Idle::rests;
   simulated_.setup(model_, plant, x_init_);
   run_.j = 0;
@@ -274,6 +275,7 @@ void TrackingMode::lose(double at, const char* reason) {
 
 bool TrackingMode::step() {
   if (run_.finished || stopped_at(run_.step)) return false;
+  begin_commands(run_.step);
   if (remote_.attached()) return step_remote();
   const long k = long(run_.step);
   const auto started = std::chrono::steady_clock::now();
@@ -290,9 +292,35 @@ bool TrackingMode::step() {
   Telemetry& s = run_.telemetry;
   s.events |= deadline_event(run_.step, run_.compute_us, s.solved && s.stats.overrun);
   set_channels(run_.predict_us.back(), run_.solve_us.back());
+  end_commands(s);
   ++run_.step;
   run_.finished = run_.lost || run_.step >= steps_total_;
   return true;
+}
+
+InstructorStatus TrackingMode::apply_gust(const Eigen::Vector3d& force, double duration) {
+  if (remote()) return InstructorStatus::remote_vehicle;
+  simulated_.gust(force, std::lround(duration / h_));
+  return InstructorStatus::applied;
+}
+
+InstructorStatus TrackingMode::apply_extra_delay(double delay) {
+  if (remote()) return InstructorStatus::remote_vehicle;
+  simulated_.set_extra_delay(std::lround(delay / h_));
+  return InstructorStatus::applied;
+}
+
+// The gust as the controller's clock sees it: step k's state is boundary k·s + n_c.
+InstructorInForce TrackingMode::in_force(std::int64_t k) const {
+  InstructorInForce f;
+  if (remote()) return f;
+  const long left = simulated_.gust_left(long(k) * s_ + n_c_);
+  if (left > 0) {
+    f.gust = simulated_.data().gust;
+    f.gust_left = double(left) * h_;
+  }
+  f.extra_delay = double(simulated_.extra_delay()) * h_;
+  return f;
 }
 
 // Step k with a remote vehicle: the newest state (a round-trip and an error sample when it is
@@ -316,6 +344,7 @@ bool TrackingMode::step_remote() {
     remote_.finish();
     set_telemetry();
     run_.telemetry.x = run_.y;
+    end_commands(run_.telemetry);
     ++run_.step;
     return true;
   }
@@ -337,6 +366,7 @@ bool TrackingMode::step_remote() {
   s.events |= deadline_event(run_.step, run_.compute_us, s.solved && s.stats.overrun);
   s.x = run_.predicted;
   set_channels(run_.predict_us.back(), run_.solve_us.back());
+  end_commands(s);
   ++run_.step;
   run_.finished = run_.step >= steps_total_;
   if (run_.finished) remote_.finish();

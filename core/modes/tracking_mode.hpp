@@ -107,6 +107,11 @@ class TrackingMode final : public Mode {
   // tracking_rms_m, max_error_m, final_error_m, [overshoot_m, settle_time_s: smooth step],
   // rti_median_us, rti_p99_us, fallbacks (NMPC) or lqr_median_us, lqr_p99_us (LQR),
   // predictor_median_us, max_input_violation, rtt_s, compensation, steps, lost.
+  InstructorStatus accepts(InstructorCommandKind kind) const override {
+    if (kind == InstructorCommandKind::gust || kind == InstructorCommandKind::extra_delay)
+      return remote() ? InstructorStatus::remote_vehicle : InstructorStatus::applied;
+    return Mode::accepts(kind);
+  }
   Metrics metrics() const override;
   std::string summary() const override;
   ModeView view() const override;
@@ -130,6 +135,12 @@ class TrackingMode final : public Mode {
   // commands, the simulated vehicle and Run. With a remote vehicle they refuse.
   void save_state(std::unique_ptr<ModeSnapshot::State>& state) const override;
   [[nodiscard]] RestoreStatus restore_state(const ModeSnapshot::State& state) override;
+  // The instructor (Mode::instruct, SPEC §10): a gust on the simulated plant; an extra delay
+  // on the measurement y, which the delay compensation does not know of (it predicts over the
+  // scenario's rtt alone). With a remote vehicle both are refused.
+  [[nodiscard]] InstructorStatus apply_gust(const Eigen::Vector3d& force, double duration) override;
+  [[nodiscard]] InstructorStatus apply_extra_delay(double delay) override;
+  InstructorInForce in_force(std::int64_t k) const override;
 
  private:
   struct Saved;

@@ -191,6 +191,19 @@ constexpr const char kLogSchema[] =
     "MSG: builtin_interfaces/Time\n"
     "int32 sec\n"
     "uint32 nanosec\n";
+constexpr const char kInstructorCommandSchema[] =
+    "# An instructor's command and the control step it took effect at (replays apply it there).\n"
+    "builtin_interfaces/Time stamp\n"
+    "uint64 step\n"
+    "uint8 kind              # 0 bounds, 1 gust, 2 extra delay, 3 input loss, 4 marker, 5 pause,\n"
+    "                        # 6 resume, 7 end\n"
+    "float64 floor           # bounds: lambda never below it, 0 <= floor <= ceiling\n"
+    "float64 ceiling         # bounds: lambda never above it, ceiling <= 1\n"
+    "float64[3] force        # gust [N], world frame (x north, y west, z up), |force| <= 20\n"
+    "float64 duration        # [s] gust, input loss: 0 < duration <= 10\n"
+    "float64 delay           # [s] extra delay, 0 <= delay <= 0.5 (0 removes it)\n"
+    "string text             # marker\n"
+    "\n" MIXPILOT_TIME_DEP;
 #undef MIXPILOT_TIME_DEP
 #undef MIXPILOT_SEP
 
@@ -206,6 +219,7 @@ constexpr RecordedType kTypes[] = {
     {"/mode/channels", "mixpilot_msgs/msg/ModeChannels", kModeChannelsSchema},
     {"/controller/lambda_reason", "mixpilot_msgs/msg/LambdaReason", kLambdaReasonSchema},
     {"/rosout", "rcl_interfaces/msg/Log", kLogSchema},
+    {"/instructor/command", "mixpilot_msgs/msg/InstructorCommand", kInstructorCommandSchema},
 };
 
 // rosbag2's serialization of one QoS profile (reliable, volatile, default durations): the ros2
@@ -243,6 +257,7 @@ void encode_body(const SolverStatsMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const PredictionMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const ModeChannelsMsg& m, const RosTime& stamp, CdrWriter& w);
 void encode_body(const LambdaReasonMsg& m, const RosTime& stamp, CdrWriter& w);
+void encode_body(const InstructorCommandMsg& m, const RosTime& stamp, CdrWriter& w);
 
 namespace {
 void put_time(const RosTime& t, CdrWriter& w) {
@@ -434,6 +449,26 @@ bool decode(std::span<const uint8_t> d, LogMsg& m, std::string& error) {
   return finish(r, error);
 }
 
+void encode(const InstructorCommandMsg& m, CdrWriter& w) { encode_body(m, m.stamp, w); }
+void encode_body(const InstructorCommandMsg& m, const RosTime& stamp, CdrWriter& w) {
+  put_time(stamp, w);
+  w.write(m.step);
+  w.write(m.kind);
+  w.write(m.floor);
+  w.write(m.ceiling);
+  put_array(m.force, w);
+  w.write(m.duration);
+  w.write(m.delay);
+  w.write_string(m.text);
+}
+bool decode(std::span<const uint8_t> d, InstructorCommandMsg& m, std::string& error) {
+  CdrReader r(d);
+  (void)(get_time(r, m.stamp) && r.read(m.step) && r.read(m.kind) && r.read(m.floor) &&
+         r.read(m.ceiling) && get_array(r, m.force) && r.read(m.duration) && r.read(m.delay) &&
+         r.read_string(m.text));
+  return finish(r, error);
+}
+
 void encode_float64(double v, CdrWriter& w) { w.write(v); }
 bool decode_float64(std::span<const uint8_t> d, double& v, std::string& error) {
   CdrReader r(d);
@@ -528,6 +563,9 @@ bool SessionRecorder::record_log(uint64_t step, const LogMsg& m) {
   cdr_.reset();
   encode(m, cdr_);
   return put_encoded(kLog, step);
+}
+bool SessionRecorder::record_command(const InstructorCommandMsg& m) {
+  return put(kCommand, m.step, m);
 }
 bool SessionRecorder::record_lambda(uint64_t step, double lambda) {
   cdr_.reset();
@@ -662,6 +700,7 @@ std::optional<RecordingContents> decode_recording(const McapFile& file, std::str
       case 7: ok = decode(data, out.channels.emplace_back(), why); break;
       case 8: ok = decode(data, out.reasons.emplace_back(), why); break;
       case 9: ok = decode(data, out.log.emplace_back(), why); break;
+      case 10: ok = decode(data, out.commands.emplace_back(), why); break;
       default: break;
     }
     if (!ok)

@@ -144,6 +144,22 @@ struct LogMsg {
 };
 inline constexpr const char* kDebriefLogger = "mixpilot.debrief";
 
+// mixpilot_msgs/msg/InstructorCommand on /instructor/command: an instructor's command (SPEC
+// §10, core/modes/instructor.hpp) and the control step it took effect at, so a replay applies
+// it at that step again. Every kind has every field; those of other kinds are their defaults.
+struct InstructorCommandMsg {
+  RosTime stamp;
+  uint64_t step = 0;
+  uint8_t kind = 0;                // InstructorCommandKind
+  double floor = 0.0;              // bounds
+  double ceiling = 1.0;
+  std::array<double, 3> force{};   // gust [N], world frame
+  double duration = 0.0;           // [s] gust, input loss
+  double delay = 0.0;              // [s] extra delay
+  std::string text;                // marker
+  bool operator==(const InstructorCommandMsg&) const = default;
+};
+
 // ---- encoding ---------------------------------------------------------------------------
 
 // The ros2msg schema (top-level definition followed by its dependencies) and schema name of
@@ -167,6 +183,7 @@ void encode(const PredictionMsg& m, CdrWriter& out);
 void encode(const ModeChannelsMsg& m, CdrWriter& out);
 void encode(const LambdaReasonMsg& m, CdrWriter& out);
 void encode(const LogMsg& m, CdrWriter& out);
+void encode(const InstructorCommandMsg& m, CdrWriter& out);
 void encode_float64(double v, CdrWriter& out);
 bool decode(std::span<const uint8_t> data, JoyMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, PilotCommandMsg& m, std::string& error);
@@ -177,6 +194,7 @@ bool decode(std::span<const uint8_t> data, PredictionMsg& m, std::string& error)
 bool decode(std::span<const uint8_t> data, ModeChannelsMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, LambdaReasonMsg& m, std::string& error);
 bool decode(std::span<const uint8_t> data, LogMsg& m, std::string& error);
+bool decode(std::span<const uint8_t> data, InstructorCommandMsg& m, std::string& error);
 bool decode_float64(std::span<const uint8_t> data, double& v, std::string& error);
 
 // ---- recording --------------------------------------------------------------------------
@@ -253,6 +271,7 @@ class SessionRecorder {
   bool record_reason(const LambdaReasonMsg& m);
   // At log time step·Δt with the stamp the message has (an event's start, before that step).
   bool record_log(uint64_t step, const LogMsg& m);
+  bool record_command(const InstructorCommandMsg& m);
 
   bool flush() { return writer_.flush(); }
   // Writes the "mixpilot_end" Metadata record (steps = the /vehicle/state messages recorded),
@@ -265,7 +284,7 @@ class SessionRecorder {
  private:
   enum Topic {
     kJoy, kPilot, kState, kLambda, kApplied, kSolver, kPrediction, kChannels, kReason, kLog,
-    kTopicCount
+    kCommand, kTopicCount
   };
   template <class Msg>
   bool put(Topic t, uint64_t step, const Msg& m);
@@ -293,6 +312,8 @@ struct RecordingContents {
   std::vector<ModeChannelsMsg> channels;
   std::vector<LambdaReasonMsg> reasons;  // empty in recordings older than the topic
   std::vector<LogMsg> log;  // /rosout: the debrief's events (none in recordings older than it)
+  // /instructor/command, in log-time order (none in recordings older than the topic).
+  std::vector<InstructorCommandMsg> commands;
   bool complete = true;  // false: read from a cut-short temporary (allow_truncated)
   // The "mixpilot_end" record: absent when the file was cut short (or is older than it).
   std::optional<RecordingEnd> end;

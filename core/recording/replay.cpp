@@ -131,7 +131,11 @@ std::unique_ptr<Mode> replay_own_steps(const RecordingContents& rec, const std::
     request.assist = assist;
     request.pilot_source = std::make_unique<ReplayPilot>(rec.pilot, "replay:" + path, first);
   }
+  // The instructor's commands (SPEC §10), applied again at the steps they took effect at.
+  std::optional<std::vector<StepCommand>> commands = recorded_commands(rec, path, error);
+  if (!commands) return nullptr;
   auto mode = make_mode(text, source, std::move(request), error);
+  if (mode) mode->replay_commands(std::move(*commands));
   if (mode && !duration) mode->stop_after(recorded);
   // What depended on the wall clock is replayed as recorded: the overruns' fallbacks and the
   // deadline misses.
@@ -198,11 +202,33 @@ void ReplayCheck::on_sample(const Telemetry& s) {
              (k >= rec_->reasons.size() || !same(rec_->reasons[k], s))) {
     // Recordings older than the topic have none: their λ alone is checked.
     what = "lambda reason";
+  } else if (!same_commands(s)) {
+    what = "instructor's commands";
   }
   if (what) {
     first_ = s.step;
     what_ = what;
   }
+}
+
+// The recorded /instructor/command messages of step s.step, in order, against the step's.
+bool ReplayCheck::same_commands(const Telemetry& s) {
+  const std::vector<InstructorCommandMsg>& recorded = rec_->commands;
+  std::size_t& n = next_command_;
+  while (n > 0 && std::int64_t(recorded[n - 1].step) >= s.step) --n;
+  while (n < recorded.size() && std::int64_t(recorded[n].step) < s.step) ++n;
+  int i = 0;
+  for (; n < recorded.size() && std::int64_t(recorded[n].step) == s.step; ++n, ++i) {
+    if (i >= s.num_commands) return false;
+    const InstructorCommand& c = s.commands[std::size_t(i)];
+    const InstructorCommandMsg& m = recorded[n];
+    if (m.kind != std::uint8_t(c.kind) || m.floor != c.bounds.floor ||
+        m.ceiling != c.bounds.ceiling || m.force[0] != c.force(0) || m.force[1] != c.force(1) ||
+        m.force[2] != c.force(2) || m.duration != c.duration || m.delay != c.delay ||
+        std::string_view(m.text) != c.text.view())
+      return false;
+  }
+  return i == s.num_commands;
 }
 
 bool ReplayCheck::matches(std::int64_t steps) const {

@@ -68,7 +68,8 @@ std::int64_t first_recorded_step(const RecordingContents& rec);
 
 // Compares each replayed step with the recorded one: the state, the applied input and, in
 // mixed initiative, λ and what decided it (where the recording has /controller/lambda_reason;
-// the last pilot command shows only in the last applied input), and at the end that every
+// the last pilot command shows only in the last applied input), the instructor's commands of
+// the step (/instructor/command), and at the end that every
 // recorded step was replayed. A branch's steps before its first recorded one are its parent's:
 // its replay checks those against the parent.
 class ReplayCheck final : public TelemetrySink {
@@ -85,7 +86,10 @@ class ReplayCheck final : public TelemetrySink {
   std::string difference_so_far() const;
 
  private:
+  bool same_commands(const Telemetry& s);
+
   const RecordingContents* rec_;
+  std::size_t next_command_ = 0;  // into rec_->commands
   std::int64_t first_step_ = 0;  // of the recording
   std::int64_t first_ = -1;      // first differing step
   const char* what_ = "";

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/base/input_file.hpp"
+
 namespace mixpilot {
 
 RecordingSink::~RecordingSink() {
@@ -157,8 +159,98 @@ void RecordingSink::write(const Telemetry& s) {
   }
   recorder_.record_channels(channels_);
 
+  for (int i = 0; i < s.num_commands; ++i) {
+    const InstructorCommand& c = s.commands[std::size_t(i)];
+    command_.stamp = stamp;
+    command_.step = step;
+    command_.kind = static_cast<std::uint8_t>(c.kind);
+    command_.floor = c.bounds.floor;
+    command_.ceiling = c.bounds.ceiling;
+    for (int j = 0; j < 3; ++j) command_.force[std::size_t(j)] = c.force(j);
+    command_.duration = c.duration;
+    command_.delay = c.delay;
+    command_.text.assign(c.text.view());
+    recorder_.record_command(command_);
+  }
+
   debrief_.add(s);
   write_events();
+}
+
+InstructorCommandMsg to_message(const InstructorCommand& c, std::uint64_t step) {
+  InstructorCommandMsg m;
+  m.stamp = RosTime{};
+  m.step = step;
+  m.kind = static_cast<std::uint8_t>(c.kind);
+  m.floor = c.bounds.floor;
+  m.ceiling = c.bounds.ceiling;
+  for (int j = 0; j < 3; ++j) m.force[std::size_t(j)] = c.force(j);
+  m.duration = c.duration;
+  m.delay = c.delay;
+  m.text.assign(c.text.view());
+  return m;
+}
+
+std::optional<InstructorCommand> from_message(const InstructorCommandMsg& m, std::string& why) {
+  const std::optional<InstructorCommandKind> kind = instructor_command_kind(m.kind);
+  if (!kind) {
+    why = "its kind is " + std::to_string(m.kind) + ", expected 0 to " +
+          std::to_string(kInstructorCommandKindCount - 1);
+    return std::nullopt;
+  }
+  if (m.text.size() > DebriefNote::kCapacity) {
+    why = "its text is " + std::to_string(m.text.size()) + " bytes long, expected at most " +
+          std::to_string(DebriefNote::kCapacity);
+    return std::nullopt;
+  }
+  if (escape_controls(m.text) != m.text) {
+    why = "its text holds control characters";
+    return std::nullopt;
+  }
+  InstructorCommand c;
+  c.kind = *kind;
+  c.bounds = AuthorityBounds{m.floor, m.ceiling};
+  c.force = Eigen::Vector3d(m.force[0], m.force[1], m.force[2]);
+  c.duration = m.duration;
+  c.delay = m.delay;
+  c.text.assign(m.text);
+  if (const char* bad = invalid_reason(c)) {
+    why = std::string("a ") + to_string(c.kind) + " whose values are out of range: " + bad;
+    return std::nullopt;
+  }
+  return c;
+}
+
+std::optional<std::vector<StepCommand>> recorded_commands(const RecordingContents& rec,
+                                                          const std::string& path,
+                                                          std::string& error) {
+  std::vector<StepCommand> out;
+  out.reserve(rec.commands.size());
+  for (std::size_t i = 0; i < rec.commands.size(); ++i) {
+    const InstructorCommandMsg& m = rec.commands[i];
+    const std::string which = path + ": its /instructor/command message " + std::to_string(i + 1) +
+                              " (step " + std::to_string(m.step) + ") ";
+    std::string why;
+    const std::optional<InstructorCommand> c = from_message(m, why);
+    if (!c) {
+      error = which + "is refused: " + why;
+      return std::nullopt;
+    }
+    if (m.step > (std::uint64_t(1) << 40) || (!out.empty() && std::int64_t(m.step) < out.back().step)) {
+      error = which + "is refused: its step is out of order";
+      return std::nullopt;
+    }
+    std::size_t same_step = 0;
+    for (auto it = out.rbegin(); it != out.rend() && it->step == std::int64_t(m.step); ++it)
+      ++same_step;
+    if (same_step >= std::size_t(kMaxCommandsPerStep)) {
+      error = which + "is refused: a step takes at most " + std::to_string(kMaxCommandsPerStep) +
+              " commands";
+      return std::nullopt;
+    }
+    out.push_back({std::int64_t(m.step), *c});
+  }
+  return out;
 }
 
 void RecordingSink::write_events() {

@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -92,11 +93,25 @@ class RecordingSink final : public TelemetrySink {
   JoyMsg joy_;
   ModeChannelsMsg channels_;
   LambdaReasonMsg reason_;
+  InstructorCommandMsg command_;
   // The debrief, built on the writer thread.
   DebriefBuilder debrief_;
   std::size_t logged_ = 0;  // events recorded
   LogMsg log_;
 };
+
+// An instructor's command as recorded at `step`, and back: nullopt with what is wrong when the
+// message holds an unknown kind, a value that is not finite or out of range
+// (invalid_reason()), or a marker text longer than DebriefNote::kCapacity bytes or with
+// control characters.
+InstructorCommandMsg to_message(const InstructorCommand& c, std::uint64_t step);
+std::optional<InstructorCommand> from_message(const InstructorCommandMsg& m, std::string& why);
+// The recording's commands at their steps, for Mode::replay_commands(); nullopt with
+// "<path>: its /instructor/command message N (step K) ..." when one is bad or they are not in
+// the order of their steps.
+std::optional<std::vector<StepCommand>> recorded_commands(const RecordingContents& rec,
+                                                          const std::string& path,
+                                                          std::string& error);
 
 class ReplayPilot final : public PilotSource {
  public:
@@ -111,6 +126,8 @@ class ReplayPilot final : public PilotSource {
   // Restored with a snapshot of any flight of the recorded scenario, it flies the recorded
   // commands from the snapshot's step on.
   [[nodiscard]] bool restore(const PilotState*) override { return true; }
+  // The recorded commands hold any input loss as it was flown.
+  [[nodiscard]] bool lose_input(std::int64_t) override { return true; }
 
  private:
   std::vector<PilotCommandMsg> commands_;

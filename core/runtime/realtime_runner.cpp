@@ -59,6 +59,8 @@ void RealtimeRunner::loop() {
   double overshoot_us = 0.0;
   while (!stop_.load(std::memory_order_relaxed)) {
     if (paused_.load(std::memory_order_relaxed)) {
+      session_->poll();
+      instructor_paused_.store(session_->paused(), std::memory_order_relaxed);
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       next = clock::now();  // resume without catching up
       overshoot_us = 0.0;
@@ -75,9 +77,16 @@ void RealtimeRunner::loop() {
     overshoot_us = 0.0;
     Mode& mode = session_->mode();
     mode.set_pacing(std::max(0.0, late_us), period_us);
-    const bool stepped = session_->step();
+    const bool more = session_->step();
     const auto ended = clock::now();
-    if (!stepped) break;
+    instructor_paused_.store(session_->paused(), std::memory_order_relaxed);
+    if (!more) break;
+    if (!session_->stepped()) {  // the instructor paused it: as the user's pause
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      next = clock::now();
+      overshoot_us = 0.0;
+      continue;
+    }
     ring_.push(mode.telemetry());
     const std::uint32_t events = mode.telemetry().events;
     const double step_us = std::chrono::duration<double, std::micro>(ended - started).count();

@@ -2,7 +2,9 @@
 // The real-time runner (SPEC §8 "Threads"): its own thread steps a session once per control
 // period Δt of the mode, paced by the wall clock (slowed down by `speed`), and hands each step's
 // telemetry to the UI through a ring that never blocks it. Pause, resume, speed and stop come
-// from any thread through atomics; the control thread never waits on them.
+// from any thread through atomics; the control thread never waits on them. The instructor's
+// commands reach it through the session's inbox (core/modes/session.hpp), taken before each
+// step and while paused; the instructor's pause holds the steps as the user's does.
 //
 // Deadlines: step k is scheduled at s_k = s_0 + k T (T = Δt / speed of wall time) and is due at
 // the end of its period, s_k + T. The runner tells the mode how late each step starts; the mode
@@ -55,6 +57,9 @@ class RealtimeRunner {
   void set_speed(double speed) { speed_.store(speed); }  // 1: real time; 0.5: half speed
   double speed() const { return speed_.load(); }
   bool running() const { return running_.load(); }  // false once the mode's run is over
+  // The instructor paused the flight (SPEC §10; Session::paused): no step flies until a
+  // resume or an end, as if set_paused(true).
+  bool instructor_paused() const { return instructor_paused_.load(); }
 
   // The UI's side: telemetry of the steps flown since the last call, oldest first.
   SpscRing<Telemetry>& telemetry() { return ring_; }
@@ -67,6 +72,7 @@ class RealtimeRunner {
   SpscRing<Telemetry> ring_;
   std::thread thread_;
   std::atomic<bool> stop_{false}, paused_{false}, running_{false}, fifo_{false};
+  std::atomic<bool> instructor_paused_{false};
   std::atomic<double> speed_{1.0};
   std::atomic<std::int64_t> steps_{0}, misses_{0}, late_starts_{0}, safe_{0};
   std::atomic<double> slip_s_{0.0};

@@ -271,6 +271,8 @@ void InstructorLink::announce() {
   put(s.scenario, options_.station.scenario);
   put(s.mode, options_.station.mode);
   s.state = state_.load(std::memory_order_relaxed);
+  if (s.state == std::uint8_t(StationState::flying) && options_.paused && options_.paused())
+    s.state = std::uint8_t(StationState::paused);
   s.t = t_.load(std::memory_order_relaxed);
   s.duration = options_.station.duration;
   s.lambda = lambda_.load(std::memory_order_relaxed);

@@ -16,6 +16,7 @@
 // wait) for the announcement's time, λ, deviation, time in B and mean λ so far.
 #include <array>
 #include <atomic>
+#include <functional>
 #include <cstdint>
 #include <mutex>
 #include <string>
@@ -83,6 +84,9 @@ class InstructorLink final : public TelemetrySink {
     CommandSecurity security = CommandSecurity::no_instructor;
     double announce_period_s = 0.5;
     InstructorCheck::Limits limits;
+    // Whether the flight is held by an instructor's pause (no step flies, so no sample says
+    // it), read by the announcing thread; empty: never paused.
+    std::function<bool()> paused;
   };
   static constexpr int kRecent = 8;  // the newest command results announced
 
