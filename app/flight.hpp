@@ -73,7 +73,8 @@ struct FlyOptions {
   // --assist on|off (mixed initiative): off flies a probe (SPEC §10). Unset: on for a new
   // flight, as recorded for a replay (which refuses another value).
   std::optional<Assistance> assist;
-  // --floor / --ceiling (mixed initiative): the instructor's bounds on λ for the whole flight.
+  // --floor / --ceiling, or a lesson step's ceiling (mixed initiative, SPEC §10): the bounds on
+  // λ from the first step.
   AuthorityBounds bounds = {};
   // --commands: a script of instructor's commands at flight times (core/modes/command_script.hpp).
   std::string commands;
@@ -95,8 +96,6 @@ struct FlyOptions {
   const char* command = "fly";     // for messages
   // Fly from here: the new flight goes on from this moment of a recording (the window's).
   std::shared_ptr<const FlyFrom> from;
-  // Mixed initiative: bounds on λ from the first step (a lesson step's ceiling, SPEC §10).
-  AuthorityBounds bounds = {};
   // A lesson step's flight: recorded in its metadata.
   LessonTag lesson;
   // The window: the lesson its picker starts on (a file; `mixpilot lesson` without --headless).

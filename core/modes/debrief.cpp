@@ -64,7 +64,7 @@ std::size_t without_partial(const char* text, std::size_t length) {
 
 void DebriefNote::assign(std::string_view text) {
   size_ = utf8_cut(text.data(), text.size(), kCapacity);
-  std::memcpy(text_.data(), text.data(), size_);
+  if (size_ > 0) std::memcpy(text_.data(), text.data(), size_);  // data() may be null when empty
   text_[size_] = '\0';
 }
 

@@ -174,7 +174,7 @@ CommandRefusal InstructorCheck::check(const InstructorFields& c, std::int64_t no
     *slot = Issuer{};
     slot->used = true;
     slot->size = c.issuer.size();
-    std::memcpy(slot->name.data(), c.issuer.data(), c.issuer.size());
+    if (!c.issuer.empty()) std::memcpy(slot->name.data(), c.issuer.data(), c.issuer.size());
   }
   slot->last_sequence = c.sequence;
   slot->last_ns = now;

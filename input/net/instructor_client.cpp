@@ -21,7 +21,7 @@ std::string text(const char* s, std::size_t capacity) { return {s, strnlen(s, ca
 template <std::size_t N>
 void put(char (&out)[N], std::string_view t) {
   const std::size_t n = std::min(t.size(), N - 1);
-  std::memcpy(out, t.data(), n);
+  if (n > 0) std::memcpy(out, t.data(), n);  // an empty view's data() may be null
   out[n] = '\0';
 }
 

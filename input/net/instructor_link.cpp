@@ -24,7 +24,7 @@ template <std::size_t N>
 void put(char (&out)[N], std::string_view text) {
   std::size_t n = std::min(text.size(), N - 1);
   while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xc0) == 0x80) --n;
-  std::memcpy(out, text.data(), n);
+  if (n > 0) std::memcpy(out, text.data(), n);  // an empty view's data() may be null
   out[n] = '\0';
 }
 
@@ -256,7 +256,7 @@ void InstructorLink::take_commands() {
     Result& r = recent_[std::size_t(recent_count_++)];
     r.issuer = {};
     const std::string_view issuer = f.issuer.substr(0, kMaxIssuer);
-    std::memcpy(r.issuer.data(), issuer.data(), issuer.size());
+    if (!issuer.empty()) std::memcpy(r.issuer.data(), issuer.data(), issuer.size());
     r.sequence = m.sequence_number;
     r.issued_ns = m.issued_ns;
     r.result = std::uint8_t(result);
