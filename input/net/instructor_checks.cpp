@@ -182,40 +182,4 @@ CommandRefusal InstructorCheck::check(const InstructorFields& c, std::int64_t no
   return CommandRefusal::none;
 }
 
-void RefusalLog::add(const RefusalNote& note) {
-  counts_[std::size_t(note.why)].fetch_add(1, std::memory_order_relaxed);
-  const std::uint32_t s = seq_.load(std::memory_order_relaxed);
-  seq_.store(s + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  why_.store(std::uint8_t(note.why), std::memory_order_relaxed);
-  format_.store(note.format, std::memory_order_relaxed);
-  a_.store(note.a, std::memory_order_relaxed);
-  b_.store(note.b, std::memory_order_relaxed);
-  c_.store(note.c, std::memory_order_relaxed);
-  seq_.store(s + 2, std::memory_order_release);
-}
-
-std::uint64_t RefusalLog::total() const {
-  std::uint64_t n = 0;
-  for (int r = 1; r < kCommandRefusals; ++r) n += count(CommandRefusal(r));
-  return n;
-}
-
-bool RefusalLog::last(RefusalNote& out) const {
-  for (int attempt = 0; attempt < 64; ++attempt) {
-    const std::uint32_t s = seq_.load(std::memory_order_acquire);
-    if (s == 0) return false;
-    if (s & 1u) continue;
-    RefusalNote n{CommandRefusal(why_.load(std::memory_order_relaxed)),
-                  format_.load(std::memory_order_relaxed), a_.load(std::memory_order_relaxed),
-                  b_.load(std::memory_order_relaxed), c_.load(std::memory_order_relaxed)};
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (seq_.load(std::memory_order_relaxed) == s) {
-      out = n;
-      return true;
-    }
-  }
-  return false;
-}
-
 }  // namespace mixpilot::net

@@ -22,6 +22,7 @@
 #include <string_view>
 
 #include "core/modes/instructor.hpp"
+#include "input/net/note_log.hpp"
 
 namespace mixpilot::net {
 
@@ -93,23 +94,7 @@ class InstructorCheck {
   std::array<Issuer, kMaxIssuers> issuers_{};
 };
 
-// The refusals of one station: written by one thread, read by any.
-class RefusalLog {
- public:
-  void add(const RefusalNote& note);  // writer only
-  std::uint64_t count(CommandRefusal r) const {
-    return counts_[std::size_t(r)].load(std::memory_order_relaxed);
-  }
-  std::uint64_t total() const;
-  // A consistent copy of the newest note; false before the first refusal.
-  bool last(RefusalNote& out) const;
-
- private:
-  std::array<std::atomic<std::uint64_t>, kCommandRefusals> counts_{};
-  std::atomic<std::uint32_t> seq_{0};
-  std::atomic<std::uint8_t> why_{0};
-  std::atomic<const char*> format_{""};
-  std::atomic<double> a_{0}, b_{0}, c_{0};
-};
+// The refusals of one station (input/net/note_log.hpp).
+using RefusalLog = NoteLog<RefusalNote, kCommandRefusals>;
 
 }  // namespace mixpilot::net

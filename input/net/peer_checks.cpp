@@ -40,42 +40,6 @@ void describe(const RejectionNote& note, char* out, std::size_t size) {
   std::snprintf(out, size, "%s: %s", to_string(note.why), what);
 }
 
-void RejectionLog::add(const RejectionNote& note) {
-  counts_[std::size_t(note.why)].fetch_add(1, std::memory_order_relaxed);
-  const std::uint32_t s = seq_.load(std::memory_order_relaxed);
-  seq_.store(s + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  why_.store(std::uint8_t(note.why), std::memory_order_relaxed);
-  format_.store(note.format, std::memory_order_relaxed);
-  a_.store(note.a, std::memory_order_relaxed);
-  b_.store(note.b, std::memory_order_relaxed);
-  c_.store(note.c, std::memory_order_relaxed);
-  seq_.store(s + 2, std::memory_order_release);
-}
-
-std::uint64_t RejectionLog::total() const {
-  std::uint64_t n = 0;
-  for (int r = 1; r < kRejectionKinds; ++r) n += count(Rejection(r));
-  return n;
-}
-
-bool RejectionLog::last(RejectionNote& out) const {
-  for (int attempt = 0; attempt < 64; ++attempt) {
-    const std::uint32_t s = seq_.load(std::memory_order_acquire);
-    if (s == 0) return false;
-    if (s & 1u) continue;
-    RejectionNote n{Rejection(why_.load(std::memory_order_relaxed)),
-                    format_.load(std::memory_order_relaxed), a_.load(std::memory_order_relaxed),
-                    b_.load(std::memory_order_relaxed), c_.load(std::memory_order_relaxed)};
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (seq_.load(std::memory_order_relaxed) == s) {
-      out = n;
-      return true;
-    }
-  }
-  return false;  // a writer flooding faster than a copy: nothing consistent to say this time
-}
-
 // --- Joy -------------------------------------------------------------------------------------
 
 Rejection JoyCheck::check(const JoyFields& m, std::int64_t now, std::int64_t& stamp,

@@ -20,6 +20,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "input/net/note_log.hpp"
+
 namespace mixpilot::net {
 
 enum class Rejection : std::uint8_t {
@@ -44,26 +46,8 @@ struct RejectionNote {
 // "<reason>: <what>" into `out` (at most `size` bytes, always terminated). Allocates nothing.
 void describe(const RejectionNote& note, char* out, std::size_t size);
 
-// The rejections of one reader: written by one thread, read by any (a sequence lock over
-// atomics: a reader never waits, and retries a torn copy).
-class RejectionLog {
- public:
-  // Writer only.
-  void add(const RejectionNote& note);
-  std::uint64_t count(Rejection r) const {
-    return counts_[std::size_t(r)].load(std::memory_order_relaxed);
-  }
-  std::uint64_t total() const;
-  // A consistent copy of the newest note; false before the first rejection.
-  bool last(RejectionNote& out) const;
-
- private:
-  std::array<std::atomic<std::uint64_t>, kRejectionKinds> counts_{};
-  std::atomic<std::uint32_t> seq_{0};
-  std::atomic<std::uint8_t> why_{0};
-  std::atomic<const char*> format_{""};
-  std::atomic<double> a_{0}, b_{0}, c_{0};
-};
+// The rejections of one reader (input/net/note_log.hpp).
+using RejectionLog = NoteLog<RejectionNote, kRejectionKinds>;
 
 // --- sensor_msgs/Joy at the trainer --------------------------------------------------------
 
