@@ -68,7 +68,7 @@ constexpr const char* kUsage =
     "  --domain N         DDS domain (0-232, default 0; 0-230 with DDS Security)\n"
     "  --dds-security FOLDER  authenticate as the identity in FOLDER (identity_ca.pem,\n"
     "                     cert.pem, key.pem, permissions_ca.pem, governance.p7s,\n"
-    "                     permissions.p7s; packaging/dds-security-ca.sh makes a test set)\n"
+    "                     permissions.p7s; mixpilot-security-ca DIR makes a test set)\n"
     "  --issuer NAME      who commands (default: login@host); a station keeps each issuer's\n"
     "                     commands in order\n"
     "  --count N          --list: stop as soon as N stations, their telemetry and a fresh\n"
