@@ -26,9 +26,12 @@ void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec
                    ImVec2 frame);
 // The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour; with
 // `names`, the shares' names under it (a text line below max.y). A probe flight's bar says
-// PROBE in its label and "assistance off" where the planner's share is named.
+// PROBE in its label and "assistance off" where the planner's share is named. The instructor's
+// `bounds` (SPEC §10), when not [0, 1]: the share λ cannot reach is shaded, a tick in the
+// caution colour marks each bound, and "ceiling 0.30" (or "floor 0.20 · ceiling 0.80") is said
+// under its tick between the names, or in the label where there is no room there.
 void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true,
-                        bool probe = false);
+                        bool probe = false, const AuthorityBounds& bounds = {});
 // Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
 // The thrust stick is centred on the hover rotor speed `hover`.
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
