@@ -37,8 +37,10 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
 // Rolling plots of the mode's channels (frozen while ui.plots_paused).
 void draw_plots(const Scene& scene, const History& history, UiState& ui);
-// The session panel: scenario, pilot, trainee, record, start / restart (run.session).
-void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out);
+// The session panel: scenario, pilot, trainee, record, start / restart (run.session); at most
+// `max_height` tall, the start or restart button always in sight under the choices (which
+// scroll when they do not fit).
+void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float max_height);
 // A replay's transport bar: timeline with event ticks, play / pause, events, speeds (run.replay).
 void draw_transport(const RunInfo& run, Requests& out);
 // The colour of a debrief event's kind, and its mark (shape and colour, `size` its half width)

@@ -659,14 +659,14 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   ImVec2 panel_max(vmin.x, vmin.y);  // its bottom right corner
   if (panel) {
     const float panel_w = session_panel_width(view_w);
+    const float panel_h = std::max(0.0f, vmax.y - top - 2 * m);
     ImGui::SetNextWindowPos(ImVec2(vmin.x + m, top + m));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(panel_w, 0),
-                                        ImVec2(panel_w, std::max(0.0f, vmax.y - top - 2 * m)));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(panel_w, 0), ImVec2(panel_w, panel_h));
     ImGui::Begin("Session", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                      ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                      ImGuiWindowFlags_AlwaysAutoResize);
-    draw_session_panel(run, ui, out);
+    draw_session_panel(run, ui, out, panel_h);
     panel_max = ImVec2(ImGui::GetWindowPos().x + ImGui::GetWindowWidth(),
                        ImGui::GetWindowPos().y + ImGui::GetWindowHeight());
     ImGui::End();
