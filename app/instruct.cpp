@@ -18,6 +18,7 @@
 #include "core/history/history.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/instructor_client.hpp"
+#include "ui/instructor_hud.hpp"
 
 namespace mixpilot::cli {
 
@@ -110,6 +111,12 @@ void print_station(const net::StationView& v) {
               v.station.c_str(), v.trainee.c_str(), v.scenario.c_str(), v.mode.c_str(),
               net::to_string(v.state), v.t, v.duration, v.lambda, v.deviation,
               100.0 * v.time_in_ball, v.mean_lambda);
+  // What the instructor's commands keep in force there, as its HUD says it.
+  std::string in_force;
+  for (const std::string& item :
+       ui::instructor_in_force(v.in_force, v.state == net::StationState::paused))
+    in_force += in_force.empty() ? item.substr(item.find(": ") + 2) : " " + item;
+  if (!in_force.empty()) std::printf("  in force: %s\n", in_force.c_str());
   const std::string refused = refused_words(v);
   std::printf("  instructor: %s; commands %llu accepted, %llu refused%s%s\n",
               net::to_string(v.security), (unsigned long long)v.accepted,
