@@ -45,21 +45,62 @@ std::string elide_middle(const std::string& text, float width) {
   return cut(lo);
 }
 
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool probe) {
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool probe,
+                        const AuthorityBounds& bounds) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const double l = std::clamp(lambda, 0.0, 1.0);
   // The pilot's share λ fills from the left in the pilot's colour, the planner's share 1 − λ
   // the rest in the planner's colour; the needle sits at λ.
-  const float x = float(min.x + l * (max.x - min.x));
+  const auto x_of = [&](double v) { return float(min.x + std::clamp(v, 0.0, 1.0) * (max.x - min.x)); };
+  const float x = x_of(l);
   const float round = scaled(4.0f);
   dl->AddRectFilled(min, max, colour::kPlanner, round);
   dl->AddRectFilled(min, ImVec2(x, max.y), colour::kPilot, round, ImDrawFlags_RoundCornersLeft);
+  // The instructor's bounds: what λ cannot reach shaded and hatched, each bound a tick.
+  const bool ceiling = bounds.ceiling < 1.0, floor = bounds.floor > 0.0;
+  const auto out_of_reach = [&](float a, float b) {
+    if (b - a < 1.0f) return;
+    dl->AddRectFilled(ImVec2(a, min.y), ImVec2(b, max.y), colour::rgb(0x10, 0x12, 0x15, 120));
+    dl->PushClipRect(ImVec2(a, min.y), ImVec2(b, max.y), true);
+    const float h = max.y - min.y;
+    for (float s = a - h; s < b; s += scaled(7.0f))
+      dl->AddLine(ImVec2(s, max.y), ImVec2(s + h, min.y), colour::rgb(0x10, 0x12, 0x15, 110),
+                  scaled(1.5f));
+    dl->PopClipRect();
+  };
+  if (ceiling) out_of_reach(x_of(bounds.ceiling), max.x);
+  if (floor) out_of_reach(min.x, x_of(bounds.floor));
+  const auto bound_tick = [&](double v) {
+    const float bx = x_of(v);
+    dl->AddLine(ImVec2(bx, min.y - scaled(4)), ImVec2(bx, max.y + scaled(4)), colour::kCaution,
+                scaled(2.5f));
+  };
+  if (ceiling) bound_tick(bounds.ceiling);
+  if (floor) bound_tick(bounds.floor);
   const float mid = 0.5f * (min.x + max.x);  // the 0.5 tick
   dl->AddLine(ImVec2(mid, min.y - scaled(3)), ImVec2(mid, max.y + scaled(3)), colour::kText, scaled(1.0f));
   dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));  // the needle
-  char label[64];
-  std::snprintf(label, sizeof label, "%s%s %.2f", probe ? "PROBE · " : "",
-                l >= 0.5 ? "PILOT" : "PLANNER", l);
+  char bound_text[64] = "";
+  if (floor && ceiling)
+    std::snprintf(bound_text, sizeof bound_text, "floor %.2f · ceiling %.2f", bounds.floor,
+                  bounds.ceiling);
+  else if (ceiling)
+    std::snprintf(bound_text, sizeof bound_text, "ceiling %.2f", bounds.ceiling);
+  else if (floor)
+    std::snprintf(bound_text, sizeof bound_text, "floor %.2f", bounds.floor);
+  // Under the ticks, between the shares' names, where it fits; else in the label.
+  const float below = max.y + scaled(4);
+  const char* planner = probe ? "assistance off" : "planner share 1 − λ";
+  const float gap = ImGui::CalcTextSize("  ").x;
+  const float left_end = min.x + scaled(2) + ImGui::CalcTextSize("pilot share λ").x + gap;
+  const float right_start = max.x - scaled(2) - ImGui::CalcTextSize(planner).x - gap;
+  const float bw = ImGui::CalcTextSize(bound_text).x;
+  const bool bound_below = names && bound_text[0] != '\0' && right_start - left_end >= bw;
+  char label[128];
+  std::snprintf(label, sizeof label, "%s%s %.2f%s%s", probe ? "PROBE · " : "",
+                l >= 0.5 ? "PILOT" : "PLANNER", l,
+                bound_text[0] != '\0' && !bound_below ? " · " : "",
+                bound_below ? "" : bound_text);
   const ImVec2 ts = ImGui::CalcTextSize(label);
   const ImVec2 at(mid - 0.5f * ts.x, 0.5f * (min.y + max.y) - 0.5f * ts.y);
   dl->AddRectFilled(ImVec2(at.x - scaled(6), at.y - scaled(1)),
@@ -67,13 +108,19 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool 
                     colour::rgb(0x10, 0x12, 0x15, 200), scaled(3.0f));
   dl->AddText(at, colour::kText, label);
   if (!names) return;
-  const float below = max.y + scaled(4);
   dl->AddText(ImVec2(min.x + scaled(2), below), colour::kPilot, "pilot share λ");
   // A probe: the planner's reference has no weight in the cost (SPEC §10).
-  const char* planner = probe ? "assistance off" : "planner share 1 − λ";
   const ImVec2 ps = ImGui::CalcTextSize(planner);
   dl->AddText(ImVec2(max.x - ps.x - scaled(2), below), probe ? colour::kCaution : colour::kPlanner,
               planner);
+  if (bound_below) {
+    // Centred under its tick (between both ticks), kept between the names.
+    const double centre = floor && ceiling ? 0.5 * (bounds.floor + bounds.ceiling)
+                          : ceiling        ? bounds.ceiling
+                                           : bounds.floor;
+    const float bx = std::clamp(x_of(centre) - 0.5f * bw, left_end, right_start - bw);
+    dl->AddText(ImVec2(bx, below), colour::kCaution, bound_text);
+  }
 }
 
 namespace {
