@@ -267,36 +267,40 @@ pid_t parent_of(pid_t pid) {
   return static_cast<pid_t>(ppid);
 }
 
-bool controller_runs(const fs::path& folder) {
-  pid_t pid = 0;
-  std::ifstream(folder / "run" / "slurmctld.pid") >> pid;
-  return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM);
+// A cluster's folder whose test process is gone: its `owner` file names a process that no longer
+// runs (or, without one, the folder is over an hour old).
+bool abandoned(const fs::path& folder) {
+  pid_t owner = 0;
+  if (std::ifstream(folder / "owner") >> owner)
+    return owner > 0 && ::kill(owner, 0) != 0 && errno == ESRCH;
+  std::error_code ec;
+  const auto age = fs::file_time_type::clock::now() - fs::last_write_time(folder, ec);
+  return !ec && age > std::chrono::hours(1);
 }
 
 // A test process killed by SIGKILL stops its daemons (the death signal) but not the jobs they
-// ran, nor can it remove its folder. The jobs of clusters whose controller is gone are killed
-// (processes whose SLURM_CONF is a mixpilot-slurm folder's), and such folders older than an
-// hour removed.
+// ran, nor can it remove its folder. The processes of such clusters (those whose SLURM_CONF is
+// an abandoned mixpilot-slurm folder's) are killed and the folders removed.
 void remove_stale_clusters(const fs::path& base) {
   const std::string prefix = "SLURM_CONF=" + (base / "mixpilot-slurm.").string();
   std::error_code ec;
   for (const auto& e : fs::directory_iterator("/proc", ec)) {
     const std::string name = e.path().filename().string();
     if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(name));
+    if (pid == ::getpid()) continue;
     std::ifstream in(e.path() / "environ", std::ios::binary);
     for (std::string var; std::getline(in, var, '\0');) {
       if (var.rfind(prefix, 0) != 0) continue;
-      const fs::path folder = fs::path(var.substr(std::strlen("SLURM_CONF="))).parent_path();
-      if (!controller_runs(folder)) ::kill(static_cast<pid_t>(std::stol(name)), SIGKILL);
+      if (abandoned(fs::path(var.substr(std::strlen("SLURM_CONF="))).parent_path()))
+        ::kill(pid, SIGKILL);
       break;
     }
   }
-  const auto now = fs::file_time_type::clock::now();
   for (const auto& e : fs::directory_iterator(base, ec)) {
     const std::string name = e.path().filename().string();
     if (name.rfind("mixpilot-slurm.", 0) != 0 || name.size() != 21 || !e.is_directory(ec)) continue;
-    if (now - e.last_write_time(ec) < std::chrono::hours(1) || ec) continue;
-    if (!controller_runs(e.path())) fs::remove_all(e.path(), ec);
+    if (abandoned(e.path())) fs::remove_all(e.path(), ec);
   }
 }
 
@@ -342,6 +346,7 @@ std::unique_ptr<SlurmCluster> SlurmCluster::start(Start& status, std::string& re
   c->folder_ = tmpl;
   const fs::path& dir = c->folder_;
   std::error_code ec;
+  std::ofstream(dir / "owner") << ::getpid() << '\n';
   for (const char* sub : {"munge", "state", "spool", "run", "log"}) fs::create_directory(dir / sub, ec);
   fs::create_directory(dir / "spool" / kNode, ec);
   // munged wants its socket's folder open to every user, its key readable by its owner only.
