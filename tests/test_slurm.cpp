@@ -1,6 +1,9 @@
-// Sweeps and scoring on a Slurm cluster, against a real single-node cluster that each test starts
-// itself (tests/slurm_cluster.hpp): the cluster runs an array and stays on loopback, and leaves
-// nothing behind.
+// Sweeps and scoring on a Slurm cluster (app/slurm.hpp, SPEC §11), against a real single-node
+// cluster that each test starts itself (tests/slurm_cluster.hpp): the cluster runs an array,
+// stays on loopback and leaves nothing behind; the array of shards is submitted, followed,
+// not submitted twice, and a cancelled task's shard alone submitted again; Slurm's answers
+// read as they are written.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -17,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/slurm.hpp"
 #include "slurm_cluster.hpp"
 
 namespace mixpilot::test {
@@ -178,6 +182,316 @@ TEST_F(Slurm, ClusterStopsAndLeavesNothing) {
   // The first cluster is untouched.
   ASSERT_EQ(cluster_->run({"sinfo", "--noheader", "--format=%t"}, out), 0) << out;
   EXPECT_EQ(out, "idle\n");
+}
+
+// ---- Slurm's answers and the job script -------------------------------------------------
+
+namespace sl = mixpilot::cli::slurm;
+
+std::vector<int> indices(const std::string& text) {
+  std::vector<int> out;
+  EXPECT_TRUE(sl::parse_indices(text, out)) << text;
+  return out;
+}
+
+TEST(SlurmParse, ArrayIndices) {
+  EXPECT_EQ(indices("3"), (std::vector<int>{3}));
+  EXPECT_EQ(indices("1-3,5"), (std::vector<int>{1, 2, 3, 5}));
+  EXPECT_EQ(indices("[4-6%2]"), (std::vector<int>{4, 5, 6}));
+  EXPECT_EQ(indices("1-9:4,2"), (std::vector<int>{1, 2, 5, 9}));
+  std::vector<int> out;
+  for (const char* bad : {"", "N/A", "3-1", "1-", "a", "1,,2", "1%", "-2"})
+    EXPECT_FALSE(sl::parse_indices(bad, out)) << bad;
+  EXPECT_EQ(sl::array_spec({1, 2, 3, 5, 7, 8}), "1-3,5,7-8");
+  EXPECT_EQ(sl::array_spec({2}), "2");
+  EXPECT_EQ(indices(sl::array_spec({1, 2, 4, 9, 10, 11})), (std::vector<int>{1, 2, 4, 9, 10, 11}));
+}
+
+TEST(SlurmParse, SqueueRows) {
+  std::vector<sl::TaskRecord> rows;
+  std::string error;
+  // What 22.05 prints for `--array --states=all --format=%F|%K|%T|%r|%j`, a job that is no
+  // array among them, and a name holding the separator.
+  ASSERT_TRUE(sl::parse_squeue("12|3|PENDING|Resources|mixpilot-sweep-out\n"
+                               "12|[5-6]|PENDING|JobArrayTaskLimit|mixpilot-sweep-out\n"
+                               "12|1|RUNNING|None|mixpilot-sweep-out\n"
+                               "12|2|CANCELLED|None|mixpilot-sweep-out\n"
+                               "40|N/A|RUNNING|None|someone-else\n"
+                               "41|1|COMPLETED|None|a|b\n",
+                               rows, error))
+      << error;
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0].job, "12");
+  EXPECT_EQ(rows[0].tasks, (std::vector<int>{3}));
+  EXPECT_EQ(rows[0].detail, "Resources");
+  EXPECT_EQ(rows[1].tasks, (std::vector<int>{5, 6}));
+  EXPECT_EQ(rows[3].state, "CANCELLED");
+  EXPECT_EQ(rows[4].name, "a|b");
+  EXPECT_FALSE(sl::parse_squeue("slurm_load_jobs error: Socket timed out\n", rows, error));
+  EXPECT_NE(error.find("Socket timed out"), std::string::npos) << error;
+}
+
+TEST(SlurmParse, SacctRows) {
+  // `sacct --noheader --parsable2 --allocations --format=JobID,State,ExitCode` with slurmdbd.
+  const auto rows = sl::parse_sacct(
+      "12_1|COMPLETED|0:0\n12_2|CANCELLED by 0|0:15\n12_[3-4%2]|PENDING|0:0\n"
+      "12_1.batch|COMPLETED|0:0\n99|COMPLETED|0:0\n");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[1].state, "CANCELLED");
+  EXPECT_EQ(rows[1].detail, "0:15");
+  EXPECT_EQ(rows[2].tasks, (std::vector<int>{3, 4}));
+  EXPECT_EQ(sl::classify("CANCELLED by 1000"), sl::TaskState::failed);
+  EXPECT_EQ(sl::classify("COMPLETED"), sl::TaskState::done);
+  for (const char* w : {"FAILED", "TIMEOUT", "NODE_FAIL", "OUT_OF_MEMORY", "PREEMPTED"})
+    EXPECT_EQ(sl::classify(w), sl::TaskState::failed) << w;
+  for (const char* w : {"PENDING", "REQUEUED", "REQUEUE_HOLD"})
+    EXPECT_EQ(sl::classify(w), sl::TaskState::pending) << w;
+  for (const char* w : {"RUNNING", "COMPLETING", "CONFIGURING", "SUSPENDED", "SOMETHING_NEW"})
+    EXPECT_EQ(sl::classify(w), sl::TaskState::running) << w;
+}
+
+// The script asks for what was given, its paths survive spaces, quotes and '%', and its task
+// runs the command with the shard of its array index.
+TEST(SlurmParse, JobScriptRunsTheShardOfItsIndex) {
+  const fs::path dir = fs::temp_directory_path() / ("mixpilot_slurm_script." + std::to_string(::getpid())) / "out 50% 'a'";
+  fs::create_directories(dir);
+  const fs::path echo = dir.parent_path() / "args.sh";
+  std::ofstream(echo) << "#!/bin/sh\nfor a in \"$@\"; do printf '<%s>' \"$a\"; done\n";
+  fs::permissions(echo, fs::perms::owner_all);
+  sl::ArrayRequest r;
+  r.kind = "sweep";
+  r.dir = dir;
+  r.task = {echo.string(), "sweep", "/data/my sweep's.toml", "--out", dir.string()};
+  r.tasks = 4;
+  r.cpus_per_task = 2;
+  r.partition = "short";
+  EXPECT_EQ(sl::job_name(r), "mixpilot-sweep-out_50___a_");
+  EXPECT_EQ(sl::unscriptable_path(dir), "");
+  EXPECT_NE(sl::unscriptable_path("/a/b\"c"), "");
+  const std::string script = sl::job_script(r, {1, 2, 4}, sl::job_name(r));
+  for (const std::string& line : std::vector<std::string>{
+           "#SBATCH --array=1-2,4\n", "#SBATCH --cpus-per-task=2\n", "#SBATCH --partition=short\n",
+        "#SBATCH --job-name=mixpilot-sweep-out_50___a_\n",
+        "#SBATCH --output=\"" + dir.parent_path().string() + "/out 50%% 'a'/slurm/%A_%a.out\"\n",
+        "#SBATCH --chdir=\"" + dir.string() + "\"\n"})
+    EXPECT_NE(script.find(line), std::string::npos) << line << "\nin\n" << script;
+  const fs::path file = dir / "job.sh";
+  std::ofstream(file) << script;
+  ::setenv("JOB_SCRIPT", file.c_str(), 1);
+  ::setenv("JOB_SAID", (dir / "said").c_str(), 1);
+  ASSERT_EQ(std::system("env -u SLURM_CPUS_PER_TASK SLURM_ARRAY_TASK_ID=4 sh \"$JOB_SCRIPT\" > "
+                        "\"$JOB_SAID\""),
+            0);
+  EXPECT_EQ(slurp_text(dir / "said"), "<sweep></data/my sweep's.toml><--out><" + dir.string() +
+                                          "><--shard><4/4><--jobs><2>");
+  fs::remove_all(dir.parent_path());
+}
+
+// Without sbatch, --slurm says so before anything is written.
+TEST(SlurmArray, SaysWhenSbatchIsMissing) {
+  const fs::path dir = fs::temp_directory_path() / ("mixpilot_slurm_nosbatch." + std::to_string(::getpid()));
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", "/nonexistent", 1);
+  sl::ArrayRequest r;
+  r.kind = "sweep";
+  r.dir = dir;
+  r.task = {"/bin/true"};
+  r.missing = [] { return std::vector<std::size_t>{0}; };
+  const auto outcome = sl::run_array(r);
+  ::setenv("PATH", path.c_str(), 1);
+  EXPECT_EQ(outcome.end, sl::ArrayEnd::error);
+  EXPECT_NE(outcome.message.find("sbatch is not in PATH"), std::string::npos) << outcome.message;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+// ---- Arrays of shards on the cluster --------------------------------------------------------
+
+// Stderr into a file while the object lives.
+class CapturedStderr {
+ public:
+  explicit CapturedStderr(const fs::path& file) : file_(file) {
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND, 0644);
+    ::dup2(fd, STDERR_FILENO);
+    ::close(fd);
+  }
+  ~CapturedStderr() {
+    std::fflush(stderr);
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+  }
+  std::string text() const {
+    std::fflush(stderr);
+    return slurp_text(file_);
+  }
+
+ private:
+  fs::path file_;
+  int saved_ = -1;
+};
+
+// A stand-in for `mixpilot sweep --shard i/n`: writes DIR/runs/<k>.json for each missing k of
+// its shard, waiting while DIR/hold-<i> exists.
+constexpr const char* kWorker = R"(#!/bin/sh
+dir=$1; total=$2; i=${4%/*}; n=${4#*/}
+mkdir -p "$dir/runs"
+k=0
+while [ $k -lt $total ]; do
+  if [ $((k % n)) -eq $((i - 1)) ] && [ ! -e "$dir/runs/$k.json" ]; then
+    while [ -e "$dir/hold-$i" ]; do sleep 0.2; done
+    echo "{\"k\": $k}" > "$dir/runs/$k.json.tmp" && mv "$dir/runs/$k.json.tmp" "$dir/runs/$k.json"
+  fi
+  k=$((k + 1))
+done
+)";
+
+class SlurmShards : public Slurm {
+ protected:
+  void SetUp() override {
+    Slurm::SetUp();
+    if (IsSkipped() || HasFatalFailure()) return;
+    ::setenv("SLURM_CONF", cluster_->conf().c_str(), 1);
+    dir_ = cluster_->folder() / "work dir";
+    fs::create_directories(dir_);
+    const fs::path worker = cluster_->folder() / "worker.sh";
+    std::ofstream(worker) << kWorker;
+    fs::permissions(worker, fs::perms::owner_all);
+    request_.kind = "sweep";
+    request_.dir = dir_;
+    request_.task = {worker.string(), dir_.string(), std::to_string(kTotal)};
+    request_.tasks = 4;
+    request_.poll_seconds = 0.5;
+    request_.total = kTotal;
+    const fs::path runs = dir_ / "runs";
+    request_.missing = [runs] {
+      std::vector<std::size_t> out;
+      for (std::size_t k = 0; k < kTotal; ++k)
+        if (!fs::exists(runs / (std::to_string(k) + ".json"))) out.push_back(k);
+      return out;
+    };
+  }
+  void TearDown() override { ::unsetenv("SLURM_CONF"); }
+
+  std::vector<std::string> records() {
+    std::vector<std::string> out;
+    std::ifstream in(dir_ / "slurm" / "jobs");
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty() && line[0] != '#') out.push_back(line);
+    return out;
+  }
+
+  static constexpr std::size_t kTotal = 14;
+  fs::path dir_;
+  sl::ArrayRequest request_;
+};
+
+// The shards run as one array of four tasks, followed to the end; every run is there.
+TEST_F(SlurmShards, RunAsAnArrayFollowedToTheEnd) {
+  CapturedStderr err(cluster_->folder() / "stderr.txt");
+  const auto outcome = sl::run_array(request_);
+  const std::string said = err.text();
+  ASSERT_EQ(outcome.end, sl::ArrayEnd::complete) << outcome.message << said << cluster_->logs();
+  EXPECT_TRUE(request_.missing().empty());
+  EXPECT_EQ(records(), std::vector<std::string>{outcome.job + " 4 1-4 mixpilot-sweep-work_dir"});
+  EXPECT_NE(said.find("slurm: submitted array job " + outcome.job + ": 4 tasks (of 4)"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("0 pending, 0 running, 4 done, 0 failed; 14 of 14 runs"), std::string::npos)
+      << said;
+  // Nothing missing: the same request submits nothing.
+  EXPECT_EQ(sl::run_array(request_).end, sl::ArrayEnd::complete);
+  EXPECT_EQ(records().size(), 1u);
+}
+
+// An array still in the queue is followed by the next command for its folder, not submitted
+// twice.
+TEST_F(SlurmShards, AQueuedArrayIsFollowedNotSubmittedAgain) {
+  for (int i = 1; i <= 4; ++i) std::ofstream(dir_ / ("hold-" + std::to_string(i)));
+  CapturedStderr err(cluster_->folder() / "stderr.txt");
+  request_.wait = false;
+  const auto first = sl::run_array(request_);
+  ASSERT_EQ(first.end, sl::ArrayEnd::submitted) << first.message << err.text();
+  request_.wait = true;
+  sl::ArrayOutcome second;
+  std::thread follow([&] { second = sl::run_array(request_); });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (err.text().find("following it rather than submitting again") == std::string::npos &&
+         std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (int i = 1; i <= 4; ++i) fs::remove(dir_ / ("hold-" + std::to_string(i)));
+  follow.join();
+  const std::string said = err.text();
+  EXPECT_NE(said.find("slurm: array job " + first.job + " of " + dir_.string() +
+                      " is still in the queue"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(second.end, sl::ArrayEnd::complete) << said;
+  EXPECT_EQ(second.job, first.job);
+  EXPECT_EQ(records().size(), 1u);
+  EXPECT_TRUE(request_.missing().empty());
+}
+
+// Tasks cancelled with scancel, one running and one pending, end the array incomplete, each
+// named with its log; the same request again submits those two shards alone, and then every run
+// is there.
+TEST_F(SlurmShards, CancelledTasksAreSubmittedAgainAlone) {
+  for (int i = 1; i <= 3; ++i) std::ofstream(dir_ / ("hold-" + std::to_string(i)));
+  CapturedStderr err(cluster_->folder() / "stderr.txt");
+  request_.wait = false;
+  const auto first = sl::run_array(request_);
+  ASSERT_EQ(first.end, sl::ArrayEnd::submitted) << first.message << err.text();
+  // Two CPUs: tasks 1 and 2 run (held), 3 and 4 wait for them.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  auto states = tasks(first.job);
+  while ((states["2"] != "RUNNING" || states["3"] != "PENDING") &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    states = tasks(first.job);
+  }
+  ASSERT_EQ(states["2"], "RUNNING");
+  ASSERT_EQ(states["3"], "PENDING");
+  std::string out;
+  ASSERT_EQ(cluster_->run({"scancel", first.job + "_2", first.job + "_3"}, out), 0) << out;
+  fs::remove(dir_ / "hold-1");
+  request_.wait = true;
+  const auto ended = sl::run_array(request_);
+  std::string said = err.text();
+  EXPECT_EQ(ended.end, sl::ArrayEnd::incomplete) << ended.message << said;
+  const std::string job = " of job " + first.job + ": ";
+  EXPECT_NE(said.find("slurm: task 2 (shard 2 of 4)" + job + "CANCELLED; its log: " +
+                      (dir_ / "slurm" / (first.job + "_2.err")).string()),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("slurm: task 3 (shard 3 of 4)" + job), std::string::npos) << said;
+  EXPECT_NE(said.find("7 of 14 runs missing (shards 2-3)"), std::string::npos) << said;
+  EXPECT_EQ(request_.missing(), (std::vector<std::size_t>{1, 2, 5, 6, 9, 10, 13}));
+
+  for (int i = 2; i <= 3; ++i) fs::remove(dir_ / ("hold-" + std::to_string(i)));
+  const auto again = sl::run_array(request_);
+  said = err.text();
+  ASSERT_EQ(again.end, sl::ArrayEnd::complete) << again.message << said;
+  EXPECT_NE(again.job, first.job);
+  EXPECT_EQ(records(), (std::vector<std::string>{first.job + " 4 1-4 mixpilot-sweep-work_dir",
+                                                 again.job + " 4 2-3 mixpilot-sweep-work_dir"}));
+  EXPECT_NE(said.find("slurm: submitted array job " + again.job + ": 2 tasks (of 4)"),
+            std::string::npos)
+      << said;
+  EXPECT_TRUE(request_.missing().empty());
+}
+
+// sbatch's refusal comes back with its own words and the script's path.
+TEST_F(SlurmShards, ARefusalSaysWhy) {
+  request_.partition = "nosuchpartition";
+  CapturedStderr err(cluster_->folder() / "stderr.txt");
+  const auto outcome = sl::run_array(request_);
+  EXPECT_EQ(outcome.end, sl::ArrayEnd::error);
+  EXPECT_NE(outcome.message.find("sbatch refused the array (its script: " +
+                                 (dir_ / "slurm" / "sweep-1.sh").string() + ")"),
+            std::string::npos)
+      << outcome.message;
+  EXPECT_NE(outcome.message.find("invalid partition"), std::string::npos) << outcome.message;
+  EXPECT_TRUE(records().empty());
 }
 
 }  // namespace
