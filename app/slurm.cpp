@@ -645,4 +645,107 @@ ArrayOutcome run_array(const ArrayRequest& r) {
   }
 }
 
+int default_tasks(std::size_t total) {
+  return static_cast<int>(std::clamp<std::size_t>(total, 1, kDefaultMaxTasks));
+}
+
+const char* const kOptionsHelp =
+    "  --slurm       fly the runs on a Slurm cluster (docs/slurm.md): the folder (on a\n"
+    "                filesystem every node shares) gets a job script, submitted with sbatch as\n"
+    "                an array of one task per shard, each task running --shard i/n; followed\n"
+    "                with squeue until it ends, then merged. Run the same command again to\n"
+    "                follow an array still queued, or to submit only the shards whose runs\n"
+    "                are missing (a task that failed or was cancelled)\n"
+    "  --partition P the Slurm partition (default: the cluster's default)\n"
+    "  --tasks N     shards, one array task each (default: one per run, at most 100)\n"
+    "  --cpus-per-task C  CPUs of each task, which flies C runs at once (default 1)\n"
+    "  --poll S      ask squeue every S seconds (default 10)\n"
+    "  --no-wait     submit and return; the same command later follows the array and merges\n";
+
+bool take_option(const char* command, int argc, char** argv, int& i, Options& o) {
+  const std::string_view arg = argv[i];
+  const auto whole = [&](const std::string& v, long lo, long hi) {
+    char* end = nullptr;
+    const long n = std::strtol(v.c_str(), &end, 10);
+    if (end == v.c_str() || *end != '\0' || n < lo || n > hi)
+      usage_error(command, std::string(arg) + " expects a whole number from " + std::to_string(lo) +
+                               " to " + std::to_string(hi) + ", got '" + v + "'");
+    return static_cast<int>(n);
+  };
+  if (arg == "--slurm") {
+    o.on = true;
+    return true;
+  }
+  if (arg == "--partition") {
+    o.partition = option_value(command, argc, argv, i);
+    if (o.partition.find_first_of(" \t\n\"'\\") != std::string::npos)
+      usage_error(command, "--partition expects a partition's name, got '" + o.partition + "'");
+  } else if (arg == "--tasks") {
+    o.tasks = whole(option_value(command, argc, argv, i), 1, 100000);
+  } else if (arg == "--cpus-per-task") {
+    o.cpus_per_task = whole(option_value(command, argc, argv, i), 1, 256);
+  } else if (arg == "--poll") {
+    const std::string v = option_value(command, argc, argv, i);
+    const auto s = parse_seconds(v, 3600);
+    if (!s) usage_error(command, "--poll expects seconds, more than 0 and at most 3600, got '" + v + "'");
+    o.poll_seconds = *s;
+  } else if (arg == "--no-wait") {
+    o.wait = false;
+  } else {
+    return false;
+  }
+  o.given.emplace_back(arg);
+  return true;
+}
+
+void check_options(const char* command, const Options& o, bool shard, bool merge, bool force,
+                   bool jobs) {
+  if (!o.on) {
+    if (!o.given.empty()) usage_error(command, o.given.front() + " goes with --slurm");
+    return;
+  }
+  if (shard) usage_error(command, "--slurm gives each array task its --shard itself");
+  if (merge) usage_error(command, "--slurm merges when its array ends; --merge is without it");
+  if (force)
+    usage_error(command,
+                "--slurm flies only what is missing from the folder; to fly everything again, "
+                "give another --out");
+  if (jobs) usage_error(command, "with --slurm, each task's parallel runs are --cpus-per-task");
+}
+
+std::string self_executable() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : p.string();
+}
+
+int run_command(const char* command, const Options& o, ArrayRequest r,
+                const std::function<int()>& merge) {
+  r.tasks = o.tasks > 0 ? o.tasks : default_tasks(r.total);
+  r.cpus_per_task = o.cpus_per_task;
+  r.partition = o.partition;
+  r.poll_seconds = o.poll_seconds;
+  r.wait = o.wait;
+  catch_interrupts();
+  const ArrayOutcome outcome = run_array(r);
+  switch (outcome.end) {
+    case ArrayEnd::complete:
+      return merge();
+    case ArrayEnd::submitted:
+      std::fprintf(stderr,
+                   "slurm: not following it (--no-wait); run the same command again to follow "
+                   "array job %s and merge\n",
+                   outcome.job.c_str());
+      return kExitOk;
+    case ArrayEnd::interrupted:
+      return kExitInterrupted;
+    case ArrayEnd::incomplete:
+      return kExitError;
+    case ArrayEnd::error:
+      break;
+  }
+  std::fprintf(stderr, "mixpilot %s: %s\n", command, outcome.message.c_str());
+  return kExitError;
+}
+
 }  // namespace mixpilot::cli::slurm

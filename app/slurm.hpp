@@ -99,4 +99,42 @@ std::string unscriptable_path(const std::filesystem::path& dir);
 // Submits and follows `r`'s array as described above, reporting on stderr.
 ArrayOutcome run_array(const ArrayRequest& r);
 
+// ---- The command line of `sweep ... --slurm` and `score DIR ... --slurm` ----
+
+// The default number of shards: one per run (a one-CPU task is what a scheduler backfills
+// soonest, and a lost task loses one run), at most this many (well under Slurm's default
+// MaxArraySize of 1001 and the per-user job limits sites set).
+inline constexpr int kDefaultMaxTasks = 100;
+int default_tasks(std::size_t total);
+
+struct Options {
+  bool on = false;          // --slurm
+  std::string partition;    // --partition P
+  int tasks = 0;            // --tasks N (0: default_tasks)
+  int cpus_per_task = 1;    // --cpus-per-task C
+  double poll_seconds = 10; // --poll S
+  bool wait = true;         // --no-wait clears it
+  std::vector<std::string> given;  // the options above given, but --slurm (for usage errors)
+};
+
+// The options' lines of `--help`.
+extern const char* const kOptionsHelp;
+
+// Takes argv[i] when it is one of the options above (moving i past its value; a bad value is
+// a usage error of `command`): true, or false when it is none of them.
+bool take_option(const char* command, int argc, char** argv, int& i, Options& o);
+// Usage errors: an option above without --slurm; --slurm with --shard, --merge, --force or
+// --jobs, which it decides itself.
+void check_options(const char* command, const Options& o, bool shard, bool merge, bool force,
+                   bool jobs);
+
+// This executable's absolute path (what the job script runs on the nodes).
+std::string self_executable();
+
+// Fills `r` from `o` (tasks, CPUs, partition, polling, waiting), runs the array and, once every
+// shard's work is in the folder, `merge()`: the command's exit status (0 merged, or submitted
+// with --no-wait; 1 tasks failed or an error, said on stderr; 130 interrupted).
+int run_command(const char* command, const Options& o, ArrayRequest r,
+                const std::function<int()>& merge);
+
 }  // namespace mixpilot::cli::slurm
