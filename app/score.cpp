@@ -14,6 +14,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/flight_rig.hpp"
+#include "app/slurm.hpp"
 #include "app/sweep.hpp"
 #include "app/sweep_folder.hpp"
 #include "core/base/content_hash.hpp"
@@ -34,6 +35,8 @@ namespace {
 constexpr const char* kScoreUsage =
     "usage: mixpilot score FILE.mcap... [--jobs N] [--json OUT]\n"
     "       mixpilot score DIR [--out OUT] [--jobs N] [--shard i/n] [--merge] [--force]\n"
+    "       mixpilot score DIR --slurm [--out OUT] [--partition P] [--tasks N]\n"
+    "                          [--cpus-per-task C] [--poll S] [--no-wait]\n"
     "\n"
     "Flies each recording again through a fresh session of its embedded scenario and checks the\n"
     "replayed states against the recorded ones bit for bit: mixed_initiative recordings replay\n"
@@ -62,9 +65,13 @@ constexpr const char* kScoreUsage =
     "  --merge      score nothing: merge the reports into OUT/table.csv and table.json;\n"
     "               exits 1 naming the recordings still missing\n"
     "  --force      score the selected recordings again even where their report exists\n"
+    "\n";
+// Then the --slurm options (slurm::kOptionsHelp: its runs are the recordings), then this.
+constexpr const char* kScoreUsageEnd =
     "\n"
-    "exit status: 0 done, 1 a recording could not be read or replayed, 2 usage, 3 a replay\n"
-    "differs from its recording\n";
+    "exit status: 0 done (--no-wait: submitted), 1 a recording could not be read or replayed\n"
+    "(--slurm: also a task that failed or was cancelled, or Slurm refused the array), 2 usage,\n"
+    "3 a replay differs from its recording\n";
 
 struct ScoreRow {
   std::string file;
@@ -139,6 +146,7 @@ struct FolderArgs {
   int jobs = 1;
   std::optional<Shard> shard;
   bool merge = false, force = false, allow_mismatch = false;
+  slurm::Options slurm;
 };
 
 // A folder's recordings in sorted name order, as the plan of its results' folder.
@@ -277,6 +285,30 @@ int score_folder(const FolderArgs& a) {
     std::fprintf(stderr, "mixpilot score: %s\n", error.c_str());
     return kExitError;
   }
+  if (a.slurm.on) {
+    // The array's tasks score the shards (`--shard i/n` into this folder); here, the merge.
+    slurm::ArrayRequest r;
+    r.kind = "score";
+    r.dir = fs::absolute(out, ec).lexically_normal();
+    r.task = {slurm::self_executable(), "score", fs::absolute(a.dir, ec).lexically_normal().string(),
+              "--out", r.dir.string()};
+    if (a.allow_mismatch) r.task.push_back("--allow-mismatch");
+    r.unit = "recordings";
+    r.total = plan->files.size();
+    r.missing = [&plan, &folder] {
+      std::vector<std::size_t> missing;
+      for (std::size_t k = 0; k < plan->folder.ids.size(); ++k)
+        if (!folder.finished(plan->folder.ids[k])) missing.push_back(k);
+      return missing;
+    };
+    std::printf("mixpilot score: %s: %zu recordings, results in %s, on Slurm\n", a.dir.c_str(),
+                plan->files.size(), out.c_str());
+    std::fflush(stdout);
+    const bool allow_mismatch = a.allow_mismatch;
+    return slurm::run_command("score", a.slurm, std::move(r), [&plan, &folder, allow_mismatch] {
+      return merge_scores(*plan, folder, allow_mismatch);
+    });
+  }
   const std::vector<std::size_t> selected = shard_runs(plan->files.size(), a.shard);
   std::vector<std::size_t> todo;
   std::vector<std::string> todo_ids;
@@ -352,10 +384,13 @@ int score_command(int argc, char** argv) {
   std::string json_path, out;
   std::optional<Shard> shard;
   bool allow_mismatch = false, force = false, merge = false, jobs_given = false;
+  slurm::Options slurm;
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "-h" || a == "--help") {
       std::fputs(kScoreUsage, stdout);
+      std::fputs(slurm::kOptionsHelp, stdout);
+      std::fputs(kScoreUsageEnd, stdout);
       return kExitOk;
     } else if (a == "--jobs") {
       const std::string v = option_value("score", argc, argv, i);
@@ -381,6 +416,7 @@ int score_command(int argc, char** argv) {
       allow_mismatch = true;
     } else if (a == "--force") {
       force = true;
+    } else if (slurm::take_option("score", argc, argv, i, slurm)) {
     } else if (a.size() > 1 && a[0] == '-') {
       usage_error("score", "unknown option '" + std::string(a) + "'");
     } else {
@@ -395,8 +431,12 @@ int score_command(int argc, char** argv) {
       if (std::filesystem::is_directory(f, dir_ec))
         usage_error("score", "'" + f + "' is a folder: score a folder alone (mixpilot score DIR), "
                              "or recordings (FILE.mcap...)");
-    if (!out.empty() || shard || merge)
-      usage_error("score", std::string(!out.empty() ? "--out" : shard ? "--shard" : "--merge") +
+    if (!out.empty() || shard || merge || slurm.on || !slurm.given.empty())
+      usage_error("score", std::string(!out.empty() ? "--out"
+                                       : shard      ? "--shard"
+                                       : merge      ? "--merge"
+                                       : slurm.on   ? "--slurm"
+                                                    : slurm.given.front()) +
                                " goes with a folder of recordings (mixpilot score DIR)");
   } else {
     if (!json_path.empty())
@@ -405,6 +445,7 @@ int score_command(int argc, char** argv) {
     if (merge && (shard || force || jobs_given))
       usage_error("score", std::string(shard ? "--shard" : force ? "--force" : "--jobs") +
                                " scores recordings; --merge only gathers the reports");
+    slurm::check_options("score", slurm, shard.has_value(), merge, force, jobs_given);
     FolderArgs fa;
     fa.dir = files[0];
     fa.out = out;
@@ -413,6 +454,7 @@ int score_command(int argc, char** argv) {
     fa.merge = merge;
     fa.force = force;
     fa.allow_mismatch = allow_mismatch;
+    fa.slurm = slurm;
     return score_folder(fa);
   }
   if (!json_path.empty()) {

@@ -407,6 +407,8 @@ ArrayOutcome run_array(const ArrayRequest& r) {
     return fail(std::string(tools.sbatch.empty() ? "sbatch" : "squeue") +
                 " is not in PATH: --slurm submits with Slurm's sbatch and follows with squeue "
                 "(run it on the cluster's login node; Debian: slurm-client)");
+  if (r.task.empty() || r.task[0].empty())
+    return fail("cannot tell this program's own path (/proc/self/exe), which the job script runs");
   if (const std::string why = unscriptable_path(r.dir); !why.empty())
     return fail(r.dir.string() + " cannot be written into a Slurm job script: " + why);
 
@@ -479,6 +481,8 @@ ArrayOutcome run_array(const ArrayRequest& r) {
     if (job_ids.empty()) {
       const std::vector<int> shards = shards_missing();
       if (shards.empty()) {
+        std::fprintf(stderr, "slurm: all %zu %s of %s are there: nothing to submit\n", r.total,
+                     r.unit.c_str(), r.dir.string().c_str());
         outcome.end = ArrayEnd::complete;
         return outcome;
       }

@@ -13,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/flight.hpp"
 #include "app/flight_rig.hpp"
+#include "app/slurm.hpp"
 #include "core/base/input_file.hpp"
 #include "core/base/report_table.hpp"
 #include "core/modes/report.hpp"
@@ -26,6 +27,8 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSweepUsage =
     "usage: mixpilot sweep SWEEP.toml [--out DIR] [--jobs N] [--shard i/n] [--merge] [--force]\n"
+    "       mixpilot sweep SWEEP.toml --slurm [--out DIR] [--partition P] [--tasks N]\n"
+    "                                 [--cpus-per-task C] [--poll S] [--no-wait]\n"
     "       mixpilot sweep SWEEP.toml --check\n"
     "\n"
     "Flies every run of a sweep file (docs/sweeps.md): a base scenario and what to vary in it,\n"
@@ -51,13 +54,17 @@ constexpr const char* kSweepUsage =
     "  --check       read the sweep file, check every run's scenario and print the plan;\n"
     "                nothing is flown or written\n"
     "  -h, --help    show this help\n"
+    "\n";
+// Then the --slurm options (slurm::kOptionsHelp), then this.
+constexpr const char* kSweepUsageEnd =
     "\n"
     "Progress on stderr, one line per finished run ([done/total], its id, its headline\n"
     "metric, its wall time, the time left). ^C (or SIGTERM) stops the runs in flight, which\n"
     "leave nothing; the finished ones are kept.\n"
     "\n"
-    "exit status: 0 done, 1 a bad sweep file, a refused folder, a failed or missing run,\n"
-    "2 usage, 130 interrupted\n";
+    "exit status: 0 done (--no-wait: submitted), 1 a bad sweep file, a refused folder, a\n"
+    "failed or missing run (--slurm: a task that failed or was cancelled, or Slurm refused the\n"
+    "array), 2 usage, 130 interrupted\n";
 
 struct SweepArgs {
   std::string file;
@@ -66,6 +73,7 @@ struct SweepArgs {
   bool jobs_given = false;
   std::optional<Shard> shard;
   bool merge = false, force = false, check = false;
+  slurm::Options slurm;
 };
 
 SweepArgs parse_args(int argc, char** argv) {
@@ -94,6 +102,7 @@ SweepArgs parse_args(int argc, char** argv) {
       a.force = true;
     } else if (arg == "--check") {
       a.check = true;
+    } else if (slurm::take_option("sweep", argc, argv, i, a.slurm)) {
     } else if (arg.size() > 1 && arg[0] == '-') {
       usage_error("sweep", "unknown option '" + std::string(arg) + "'");
     } else if (a.file.empty()) {
@@ -107,8 +116,10 @@ SweepArgs parse_args(int argc, char** argv) {
   if (a.merge && (a.shard || a.force || a.jobs_given))
     usage_error("sweep", std::string(a.shard ? "--shard" : a.force ? "--force" : "--jobs") +
                              " flies runs; --merge only gathers the finished ones");
-  if (a.check && (a.merge || a.shard || a.force || a.jobs_given || !a.out.empty()))
+  if (a.check && (a.merge || a.shard || a.force || a.jobs_given || !a.out.empty() ||
+                  a.slurm.on || !a.slurm.given.empty()))
     usage_error("sweep", "--check only reads the sweep file: no other option goes with it");
+  slurm::check_options("sweep", a.slurm, a.shard.has_value(), a.merge, a.force, a.jobs_given);
   return a;
 }
 
@@ -283,6 +294,8 @@ int sweep_command(int argc, char** argv) {
   for (int i = 2; i < argc; ++i)
     if (std::string_view(argv[i]) == "-h" || std::string_view(argv[i]) == "--help") {
       std::fputs(kSweepUsage, stdout);
+      std::fputs(slurm::kOptionsHelp, stdout);
+      std::fputs(kSweepUsageEnd, stdout);
       return kExitOk;
     }
   const SweepArgs a = parse_args(argc, argv);
@@ -335,6 +348,27 @@ int sweep_command(int argc, char** argv) {
                    dir.c_str(), ec.message().c_str());
       return kExitError;
     }
+  }
+  if (a.slurm.on) {
+    // The array's tasks fly the shards (`--shard i/n` into this folder); here, the merge.
+    slurm::ArrayRequest r;
+    r.kind = "sweep";
+    std::error_code ec;
+    r.dir = fs::absolute(dir, ec).lexically_normal();
+    r.task = {slurm::self_executable(), "sweep", fs::absolute(a.file, ec).lexically_normal().string(),
+              "--out", r.dir.string()};
+    r.total = plan->runs.size();
+    r.missing = [&plan, &folder] {
+      std::vector<std::size_t> missing;
+      for (std::size_t k = 0; k < plan->runs.size(); ++k)
+        if (!folder.finished(plan->runs[k].id)) missing.push_back(k);
+      return missing;
+    };
+    std::printf("mixpilot sweep: %s: %zu runs in %s, on Slurm\n", plan->name.c_str(),
+                plan->runs.size(), dir.c_str());
+    std::fflush(stdout);
+    return slurm::run_command("sweep", a.slurm, std::move(r),
+                              [&plan, &folder] { return merge(*plan, folder); });
   }
   const std::vector<std::size_t> selected = shard_runs(plan->runs.size(), a.shard);
   std::vector<std::size_t> todo;

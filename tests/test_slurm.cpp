@@ -22,6 +22,9 @@
 
 #include "app/slurm.hpp"
 #include "slurm_cluster.hpp"
+#include "spawned.hpp"
+#include "sweep_table.hpp"
+#include "temp_files.hpp"
 
 namespace mixpilot::test {
 namespace {
@@ -332,15 +335,18 @@ class CapturedStderr {
 };
 
 // A stand-in for `mixpilot sweep --shard i/n`: writes DIR/runs/<k>.json for each missing k of
-// its shard, waiting while DIR/hold-<i> exists.
+// its shard, noting each k in DIR/flown-<i>; after its first run it waits while DIR/hold-<i>
+// exists.
 constexpr const char* kWorker = R"(#!/bin/sh
 dir=$1; total=$2; i=${4%/*}; n=${4#*/}
 mkdir -p "$dir/runs"
-k=0
+k=0; flown=0
 while [ $k -lt $total ]; do
   if [ $((k % n)) -eq $((i - 1)) ] && [ ! -e "$dir/runs/$k.json" ]; then
-    while [ -e "$dir/hold-$i" ]; do sleep 0.2; done
+    while [ $flown -gt 0 ] && [ -e "$dir/hold-$i" ]; do sleep 0.2; done
     echo "{\"k\": $k}" > "$dir/runs/$k.json.tmp" && mv "$dir/runs/$k.json.tmp" "$dir/runs/$k.json"
+    echo $k >> "$dir/flown-$i"
+    flown=$((flown + 1))
   fi
   k=$((k + 1))
 done
@@ -432,25 +438,27 @@ TEST_F(SlurmShards, AQueuedArrayIsFollowedNotSubmittedAgain) {
   EXPECT_TRUE(request_.missing().empty());
 }
 
-// Tasks cancelled with scancel, one running and one pending, end the array incomplete, each
-// named with its log; the same request again submits those two shards alone, and then every run
-// is there.
+// Tasks cancelled with scancel, one running (one of its runs written) and one pending, end the
+// array incomplete, each named with its log; the same request again submits those two shards
+// alone, which write only the runs still missing, and then every run is there.
 TEST_F(SlurmShards, CancelledTasksAreSubmittedAgainAlone) {
   for (int i = 1; i <= 3; ++i) std::ofstream(dir_ / ("hold-" + std::to_string(i)));
   CapturedStderr err(cluster_->folder() / "stderr.txt");
   request_.wait = false;
   const auto first = sl::run_array(request_);
   ASSERT_EQ(first.end, sl::ArrayEnd::submitted) << first.message << err.text();
-  // Two CPUs: tasks 1 and 2 run (held), 3 and 4 wait for them.
+  // Two CPUs: tasks 1 and 2 run (held after their first run), 3 and 4 wait for them.
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   auto states = tasks(first.job);
-  while ((states["2"] != "RUNNING" || states["3"] != "PENDING") &&
+  while ((states["2"] != "RUNNING" || states["3"] != "PENDING" ||
+          !fs::exists(dir_ / "flown-2")) &&
          std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     states = tasks(first.job);
   }
   ASSERT_EQ(states["2"], "RUNNING");
   ASSERT_EQ(states["3"], "PENDING");
+  ASSERT_EQ(slurp_text(dir_ / "flown-2"), "1\n");
   std::string out;
   ASSERT_EQ(cluster_->run({"scancel", first.job + "_2", first.job + "_3"}, out), 0) << out;
   fs::remove(dir_ / "hold-1");
@@ -464,8 +472,8 @@ TEST_F(SlurmShards, CancelledTasksAreSubmittedAgainAlone) {
             std::string::npos)
       << said;
   EXPECT_NE(said.find("slurm: task 3 (shard 3 of 4)" + job), std::string::npos) << said;
-  EXPECT_NE(said.find("7 of 14 runs missing (shards 2-3)"), std::string::npos) << said;
-  EXPECT_EQ(request_.missing(), (std::vector<std::size_t>{1, 2, 5, 6, 9, 10, 13}));
+  EXPECT_NE(said.find("6 of 14 runs missing (shards 2-3)"), std::string::npos) << said;
+  EXPECT_EQ(request_.missing(), (std::vector<std::size_t>{2, 5, 6, 9, 10, 13}));
 
   for (int i = 2; i <= 3; ++i) fs::remove(dir_ / ("hold-" + std::to_string(i)));
   const auto again = sl::run_array(request_);
@@ -478,6 +486,11 @@ TEST_F(SlurmShards, CancelledTasksAreSubmittedAgainAlone) {
             std::string::npos)
       << said;
   EXPECT_TRUE(request_.missing().empty());
+  // Each run written once: shard 2's first before its task was cancelled, the rest after.
+  EXPECT_EQ(slurp_text(dir_ / "flown-1"), "0\n4\n8\n12\n");
+  EXPECT_EQ(slurp_text(dir_ / "flown-2"), "1\n5\n9\n13\n");
+  EXPECT_EQ(slurp_text(dir_ / "flown-3"), "2\n6\n10\n");
+  EXPECT_EQ(slurp_text(dir_ / "flown-4"), "3\n7\n11\n");
 }
 
 // sbatch's refusal comes back with its own words and the script's path.
@@ -492,6 +505,254 @@ TEST_F(SlurmShards, ARefusalSaysWhy) {
       << outcome.message;
   EXPECT_NE(outcome.message.find("invalid partition"), std::string::npos) << outcome.message;
   EXPECT_TRUE(records().empty());
+}
+
+// ---- mixpilot sweep and score with --slurm --------------------------------------------------
+
+// 40 runs of 1.5 s of the tracking smooth step: ten round trips, with and without the delay
+// predictor, two horizons.
+const std::string kSweep40 = "scenario = \"" + std::string(MIXPILOT_SOURCE_DIR) +
+                             "/scenarios/tracking_smooth_step.toml\"\n"
+                             "duration = 1.5\n"
+                             "[grid]\n"
+                             "\"plant.rtt\" = [0.0, 0.006, 0.009, 0.012, 0.015, 0.018, 0.021, "
+                             "0.024, 0.03, 0.06]\n"
+                             "\"controller.compensation\" = [true, false]\n"
+                             "\"controller.N\" = [10, 20]\n";
+
+// mixpilot run as a user would, on the cluster of the test (SLURM_CONF) with user folders of its
+// own; its exit status, its output in home/<out>.
+class SlurmCommand : public Slurm {
+ protected:
+  void SetUp() override {
+    Slurm::SetUp();
+    if (IsSkipped() || HasFatalFailure()) return;
+    home_ = fresh_path("slurm", ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(home_);
+  }
+  int mixpilot(const std::vector<std::string>& args, const std::string& out, bool on_slurm = true) {
+    std::vector<std::string> argv = {MIXPILOT_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    std::vector<std::pair<std::string, std::string>> env = {
+        {"XDG_CONFIG_HOME", (home_ / "config").string()}, {"XDG_DATA_HOME", (home_ / "data").string()}};
+    if (on_slurm) env.emplace_back("SLURM_CONF", cluster_->conf().string());
+    const int rc = run_to_end(argv, home_ / out, 900, env);
+    said_ = slurp_text(home_ / out);
+    return rc;
+  }
+  // The array jobs DIR/slurm/jobs remembers.
+  std::vector<std::string> records(const fs::path& dir) {
+    std::vector<std::string> out;
+    std::ifstream in(dir / "slurm" / "jobs");
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty() && line[0] != '#') out.push_back(line);
+    return out;
+  }
+  // The last-write times of the run files.
+  std::map<std::string, fs::file_time_type> run_times(const fs::path& dir) {
+    std::map<std::string, fs::file_time_type> out;
+    for (const auto& e : fs::directory_iterator(dir / "runs"))
+      if (e.path().extension() == ".json") out[e.path().filename().string()] = e.last_write_time();
+    return out;
+  }
+
+  fs::path home_;
+  std::string said_;
+};
+
+class SlurmSweep : public SlurmCommand {
+ protected:
+  void SetUp() override {
+    SlurmCommand::SetUp();
+    if (IsSkipped() || HasFatalFailure()) return;
+    file_ = home_ / "forty.toml";
+    std::ofstream(file_) << kSweep40;
+    // The reference: the same sweep flown here, on two cores.
+    ASSERT_EQ(mixpilot({"sweep", file_.string(), "--out", (home_ / "local").string(), "--jobs", "2"},
+                       "local.txt", false),
+              0)
+        << said_;
+    local_ = non_timing(read_csv_table(home_ / "local" / "table.csv"));
+    ASSERT_EQ(local_.size(), 41u);
+  }
+  fs::path file_;
+  Table local_;
+};
+
+// The 40-run sweep as an array of four tasks, each flying its shard of ten runs into the
+// folder, followed and merged: the table the local run gives (timing fields aside).
+TEST_F(SlurmSweep, FortyRunsAsFourTasksGiveTheLocalTable) {
+  const fs::path dir = home_ / "on slurm";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(mixpilot({"sweep", file_.string(), "--out", dir.string(), "--slurm", "--tasks", "4",
+                      "--poll", "1"},
+                     "slurm.txt"),
+            0)
+      << said_ << cluster_->logs();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("the sweep on Slurm took %.1f s\n", seconds);
+  EXPECT_EQ(non_timing(read_csv_table(dir / "table.csv")), local_);
+  const auto jobs = records(dir);
+  ASSERT_EQ(jobs.size(), 1u);
+  const std::string job = jobs[0].substr(0, jobs[0].find(' '));
+  EXPECT_EQ(jobs[0], job + " 4 1-4 mixpilot-sweep-on_slurm");
+  EXPECT_NE(said_.find("slurm: submitted array job " + job + ": 4 tasks (of 4) of " + dir.string()),
+            std::string::npos)
+      << said_;
+  EXPECT_NE(said_.find("0 pending, 0 running, 4 done, 0 failed; 40 of 40 runs"), std::string::npos)
+      << said_;
+  // Each task flew its own shard, ten runs, with its output in the folder.
+  for (int i = 1; i <= 4; ++i) {
+    const std::string log = slurp_text(dir / "slurm" / (job + "_" + std::to_string(i) + ".out"));
+    EXPECT_NE(log.find("shard " + std::to_string(i) + "/4: 10 of 40 runs in " + dir.string() +
+                       ", 0 finished, 10 to fly"),
+              std::string::npos)
+        << log;
+  }
+  // Done: the same command submits nothing and merges again.
+  ASSERT_EQ(mixpilot({"sweep", file_.string(), "--out", dir.string(), "--slurm", "--tasks", "4"},
+                     "again.txt"),
+            0)
+      << said_;
+  EXPECT_EQ(said_.find("submitted"), std::string::npos) << said_;
+  EXPECT_NE(said_.find("slurm: all 40 runs of " + dir.string() + " are there: nothing to submit"),
+            std::string::npos)
+      << said_;
+  EXPECT_EQ(records(dir).size(), 1u);
+}
+
+// A task cancelled with scancel while it waits leaves its shard's runs missing: the command says
+// so and exits 1; the same command again submits that shard alone, which flies the missing
+// runs only (the others' files untouched), and the table is the local run's.
+TEST_F(SlurmSweep, ACancelledTaskIsFlownAgainByTheSameCommand) {
+  const fs::path dir = home_ / "cancelled";
+  // Two CPUs a task, on a node of two: one task at a time, the others pending.
+  const std::vector<std::string> cmd = {"sweep",   file_.string(), "--out",           dir.string(),
+                                        "--slurm", "--tasks",      "4",               "--poll",
+                                        "1",       "--cpus-per-task", "2"};
+  std::vector<std::string> submit = cmd;
+  submit.push_back("--no-wait");
+  ASSERT_EQ(mixpilot(submit, "submit.txt"), 0) << said_;
+  auto jobs = records(dir);
+  ASSERT_EQ(jobs.size(), 1u) << said_;
+  const std::string job = jobs[0].substr(0, jobs[0].find(' '));
+  EXPECT_NE(said_.find("run the same command again to follow array job " + job), std::string::npos)
+      << said_;
+  const auto states = tasks(job);
+  ASSERT_EQ(states.at("4"), "PENDING") << "task 4 ran before it could be cancelled";
+  std::string out;
+  ASSERT_EQ(cluster_->run({"scancel", job + "_4"}, out), 0) << out;
+
+  ASSERT_EQ(mixpilot(cmd, "follow.txt"), 1) << said_;
+  EXPECT_NE(said_.find("slurm: task 4 (shard 4 of 4) of job " + job + ": "), std::string::npos)
+      << said_;
+  EXPECT_NE(said_.find("its log: " + (dir / "slurm" / (job + "_4.err")).string()), std::string::npos)
+      << said_;
+  EXPECT_NE(said_.find("10 of 40 runs missing (shards 4); run the same command again"),
+            std::string::npos)
+      << said_;
+  EXPECT_FALSE(fs::exists(dir / "table.csv"));
+  const auto before = run_times(dir);
+  ASSERT_EQ(before.size(), 30u);
+
+  ASSERT_EQ(mixpilot(cmd, "again.txt"), 0) << said_ << cluster_->logs();
+  jobs = records(dir);
+  ASSERT_EQ(jobs.size(), 2u);
+  const std::string again = jobs[1].substr(0, jobs[1].find(' '));
+  EXPECT_EQ(jobs[1], again + " 4 4 mixpilot-sweep-cancelled");
+  const std::string log = slurp_text(dir / "slurm" / (again + "_4.out"));
+  EXPECT_NE(log.find("shard 4/4: 10 of 40 runs in " + dir.string() + ", 0 finished, 10 to fly"),
+            std::string::npos)
+      << log;
+  const auto after = run_times(dir);
+  EXPECT_EQ(after.size(), 40u);
+  for (const auto& [name, time] : before) EXPECT_EQ(after.at(name), time) << name << " flown again";
+  EXPECT_EQ(non_timing(read_csv_table(dir / "table.csv")), local_);
+}
+
+// A folder of recordings scored as an array of two tasks: the table of scoring it here.
+TEST_F(SlurmCommand, AFolderOfRecordingsScoredAsAnArrayGivesTheLocalTable) {
+  const fs::path file = home_ / "flights.toml";
+  std::ofstream(file) << "scenario = \"" MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml\"\n"
+                         "duration = 2\nrecord = true\n"
+                         "pilots = [\"novice\", \"experienced\"]\n"
+                         "[grid]\n\"controller.ph.r\" = [0.15, 0.175]\n";
+  ASSERT_EQ(mixpilot({"sweep", file.string(), "--out", (home_ / "flown").string(), "--jobs", "2"},
+                     "flown.txt", false),
+            0)
+      << said_;
+  const fs::path recordings = home_ / "flown" / "recordings";
+  ASSERT_EQ(mixpilot({"score", recordings.string(), "--out", (home_ / "local").string(), "--jobs",
+                      "2"},
+                     "local.txt", false),
+            0)
+      << said_;
+  const fs::path dir = home_ / "scores";
+  ASSERT_EQ(mixpilot({"score", recordings.string(), "--out", dir.string(), "--slurm", "--tasks",
+                      "2", "--poll", "1"},
+                     "slurm.txt"),
+            0)
+      << said_ << cluster_->logs();
+  EXPECT_NE(said_.find("0 pending, 0 running, 2 done, 0 failed; 4 of 4 recordings"),
+            std::string::npos)
+      << said_;
+  const auto jobs = records(dir);
+  ASSERT_EQ(jobs.size(), 1u);
+  EXPECT_EQ(jobs[0].substr(jobs[0].find(' ')), " 2 1-2 mixpilot-score-scores");
+  const Table table = non_timing(read_csv_table(dir / "table.csv"));
+  EXPECT_EQ(table.size(), 5u);
+  EXPECT_EQ(table, non_timing(read_csv_table(home_ / "local" / "table.csv")));
+}
+
+// What --slurm takes and refuses, said before anything is submitted; without sbatch, the
+// command says so.
+TEST(SlurmCli, TheCommandLineSaysWhatItExpects) {
+  const fs::path home = fresh_path("slurm", "cli");
+  fs::create_directories(home);
+  const fs::path file = home / "forty.toml";
+  std::ofstream(file) << kSweep40;
+  const auto run = [&](const std::vector<std::string>& args,
+                       const std::vector<std::pair<std::string, std::string>>& env = {}) {
+    std::vector<std::string> argv = {MIXPILOT_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    auto e = env;
+    e.emplace_back("XDG_DATA_HOME", (home / "data").string());
+    e.emplace_back("XDG_CONFIG_HOME", (home / "config").string());
+    const int rc = run_to_end(argv, home / "out.txt", 300, e);
+    return std::make_pair(rc, slurp_text(home / "out.txt"));
+  };
+  const std::string f = file.string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> usage = {
+      {{"sweep", f, "--partition", "short"}, "--partition goes with --slurm"},
+      {{"sweep", f, "--no-wait"}, "--no-wait goes with --slurm"},
+      {{"sweep", f, "--slurm", "--shard", "1/2"}, "--slurm gives each array task its --shard"},
+      {{"sweep", f, "--slurm", "--merge"}, "--slurm merges when its array ends"},
+      {{"sweep", f, "--slurm", "--force"}, "give another --out"},
+      {{"sweep", f, "--slurm", "--jobs", "2"}, "each task's parallel runs are --cpus-per-task"},
+      {{"sweep", f, "--slurm", "--tasks", "0"}, "--tasks expects a whole number from 1"},
+      {{"sweep", f, "--slurm", "--cpus-per-task", "x"}, "--cpus-per-task expects a whole number"},
+      {{"sweep", f, "--slurm", "--poll", "-1"}, "--poll expects seconds"},
+      {{"sweep", f, "--slurm", "--partition", "a b"}, "--partition expects a partition's name"},
+      {{"sweep", f, "--check", "--slurm"}, "--check only reads the sweep file"},
+      {{"score", f, "--slurm"}, "--slurm goes with a folder of recordings"},
+  };
+  for (const auto& [args, message] : usage) {
+    const auto [rc, said] = run(args);
+    EXPECT_EQ(rc, 2) << said;
+    EXPECT_NE(said.find(message), std::string::npos) << said;
+  }
+  const auto [help_rc, help] = run({"sweep", "--help"});
+  EXPECT_EQ(help_rc, 0);
+  for (const char* option : {"--slurm", "--partition P", "--tasks N", "--cpus-per-task C",
+                             "--poll S", "--no-wait", "docs/slurm.md"})
+    EXPECT_NE(help.find(option), std::string::npos) << option;
+  EXPECT_NE(run({"score", "--help"}).second.find("--cpus-per-task C"), std::string::npos);
+  // No Slurm here: the runs are checked, the folder claimed, and nothing submitted.
+  const auto [rc, said] = run({"sweep", f, "--out", (home / "out").string(), "--slurm"},
+                              {{"PATH", "/nonexistent"}});
+  EXPECT_EQ(rc, 1) << said;
+  EXPECT_NE(said.find("mixpilot sweep: sbatch is not in PATH"), std::string::npos) << said;
+  EXPECT_FALSE(fs::exists(home / "out" / "slurm" / "jobs"));
 }
 
 }  // namespace
