@@ -670,8 +670,10 @@ TEST_F(SlurmSweep, ACancelledTaskIsFlownAgainByTheSameCommand) {
   EXPECT_EQ(non_timing(read_csv_table(dir / "table.csv")), local_);
 }
 
+class SlurmScore : public SlurmCommand {};
+
 // A folder of recordings scored as an array of two tasks: the table of scoring it here.
-TEST_F(SlurmCommand, AFolderOfRecordingsScoredAsAnArrayGivesTheLocalTable) {
+TEST_F(SlurmScore, AFolderOfRecordingsAsAnArrayGivesTheLocalTable) {
   const fs::path file = home_ / "flights.toml";
   std::ofstream(file) << "scenario = \"" MIXPILOT_SOURCE_DIR "/scenarios/mi_helix.toml\"\n"
                          "duration = 2\nrecord = true\n"
