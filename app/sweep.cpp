@@ -378,7 +378,8 @@ int sweep_command(int argc, char** argv) {
                                 });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!todo.empty())
-    std::printf("  %zu runs flown in %s%s\n", r.flown - r.failed, duration_text(wall).c_str(),
+    std::printf("  %zu run%s flown in %s%s\n", r.flown - r.failed, r.flown - r.failed == 1 ? "" : "s",
+                duration_text(wall).c_str(),
                 r.failed ? (", " + std::to_string(r.failed) + " failed").c_str() : "");
   if (r.interrupted) {
     std::printf("  interrupted: the runs finished are kept; the same command flies the rest\n");

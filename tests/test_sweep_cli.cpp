@@ -190,6 +190,45 @@ TEST(Sweep, ASweepFliesEveryRunIntoItsFolderAndTheSecondTimeFliesNothing) {
   EXPECT_EQ(read_csv(ref.dir / "table.csv"), table);
 }
 
+TEST(Sweep, ARunFileThatIsNotThisPlansIsFlownAgainAndForceFliesAgain) {
+  const Reference& ref = reference();
+  const fs::path home = home_of("replaced");
+  const fs::path dir = home / "results";
+  fs::copy(ref.dir, dir, fs::copy_options::recursive);
+  const fs::path file = write(home / "tracking.toml", kTrackingSweep);
+  // One cut short (no writer of mixpilot leaves one: an editor's or a copy's), one of
+  // another plan, and the temporary of a run killed while writing.
+  write(dir / "runs" / "0002-rtt=0.012-compensation=true.json", "{\"format\": \"mixpilot sw");
+  const std::string other = std::regex_replace(
+      test::read_file(dir / "runs" / "0005-rtt=0.03-compensation=false.json"),
+      std::regex("\"plan_sha256\": \"[0-9a-f]+\""), "\"plan_sha256\": \"0123\"");
+  write(dir / "runs" / "0005-rtt=0.03-compensation=false.json", other);
+  write(dir / "runs" / "0002-rtt=0.012-compensation=true.json.Ab12Cd.tmp", "{");
+  // The merge will not take them.
+  EXPECT_EQ(sweep(home, file.string() + " --out " + dir.string() + " --merge", "merge.txt"), 1);
+  const std::string merge = test::read_file(home / "merge.txt");
+  EXPECT_NE(merge.find("0002-rtt=0.012-compensation=true.json: not a run's JSON"), std::string::npos) << merge;
+  EXPECT_NE(merge.find("0005-rtt=0.03-compensation=false.json: a run of another plan (plan_sha256 0123"),
+            std::string::npos)
+      << merge;
+  // The sweep flies them again, and only them.
+  ASSERT_EQ(sweep(home, file.string() + " --out " + dir.string()), 0) << test::read_file(home / "out.txt");
+  const std::string said = test::read_file(home / "out.txt");
+  EXPECT_NE(said.find("6 finished, 2 to fly"), std::string::npos) << said;
+  EXPECT_EQ(count_lines(said, "\\] 0002-rtt=0.012-compensation=true: "), 1u) << said;
+  EXPECT_EQ(count_lines(said, "\\] 0005-rtt=0.03-compensation=false: "), 1u) << said;
+  for (const auto& e : fs::directory_iterator(dir / "runs"))
+    EXPECT_EQ(e.path().extension(), ".json") << e.path();
+  EXPECT_EQ(non_timing(read_csv(dir / "table.csv")), non_timing(read_csv(ref.dir / "table.csv")));
+  // --force flies the selected runs whether finished or not.
+  const auto before = fs::last_write_time(dir / "runs" / "0003-rtt=0.012-compensation=false.json");
+  ASSERT_EQ(sweep(home, file.string() + " --out " + dir.string() + " --force --shard 4/8", "force.txt"), 0)
+      << test::read_file(home / "force.txt");
+  EXPECT_NE(test::read_file(home / "force.txt").find("0 finished, 1 to fly"), std::string::npos)
+      << test::read_file(home / "force.txt");
+  EXPECT_NE(fs::last_write_time(dir / "runs" / "0003-rtt=0.012-compensation=false.json"), before);
+}
+
 TEST(Sweep, KilledHalfwayItFliesOnlyTheMissingRunsAndTheTableEqualsAnUninterruptedOne) {
   const Reference& ref = reference();
   const fs::path home = home_of("killed");
