@@ -180,7 +180,8 @@ RunOutcome fly_sweep_run(const SweepPlan& plan, const SweepRun& run, const std::
   int status = kExitOk;
   const std::unique_ptr<FlightRig> rig = FlightRig::assemble(o, error, status);
   if (!rig) {
-    out.error = explain_run_error(plan, run, error);
+    for (const std::string& line : explain_run_error(plan, run, error))
+      out.error += (out.error.empty() ? "" : "\n") + line;
     return out;
   }
   std::string recording;
@@ -236,17 +237,28 @@ namespace {
 // Every run's scenario and options checked as its flight will be set up, before anything is
 // flown: a sweep that cannot fly one of its runs flies none.
 bool check_runs(const SweepPlan& plan, std::string& error) {
-  std::vector<std::string> problems;
+  // Each complaint once, with the runs it concerns (a bad value of an axis spoils every run
+  // that flies it).
+  std::vector<std::pair<std::string, std::vector<std::string>>> problems;
   for (const SweepRun& run : plan.runs) {
     std::string why;
     int status = kExitOk;
     if (FlightRig::assemble(sweep_fly_options(plan, run), why, status)) continue;
-    const std::string said = explain_run_error(plan, run, why);
-    if (std::find(problems.begin(), problems.end(), said) == problems.end()) problems.push_back(said);
-    if (problems.size() >= 20) break;
+    for (const std::string& line : explain_run_error(plan, run, why)) {
+      auto it = std::find_if(problems.begin(), problems.end(),
+                             [&](const auto& p) { return p.first == line; });
+      if (it == problems.end()) it = problems.insert(problems.end(), {line, {}});
+      it->second.push_back(run.id);
+    }
   }
   error.clear();
-  for (const std::string& p : problems) error += (error.empty() ? "" : "\n") + p;
+  for (std::size_t i = 0; i < problems.size() && i < 20; ++i) {
+    const auto& [line, runs] = problems[i];
+    error += (error.empty() ? "" : "\n") + line + (runs.size() == 1 ? " (run " : " (runs ") +
+             id_list(runs, 3) + ")";
+  }
+  if (problems.size() > 20)
+    error += "\n... and " + std::to_string(problems.size() - 20) + " more problems";
   return problems.empty();
 }
 
@@ -305,8 +317,6 @@ int sweep_command(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", escape_controls(error, true).c_str());
     return kExitError;
   }
-  for (const std::string& note : plan->notes)
-    std::fprintf(stderr, "mixpilot sweep: note: %s\n", note.c_str());
   const std::string dir = a.out.empty() ? plan->name : a.out;
   const FolderPlan fplan = folder_plan(*plan);
 
@@ -324,6 +334,8 @@ int sweep_command(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", error.c_str());
     return kExitError;
   }
+  for (const std::string& note : plan->notes)
+    std::fprintf(stderr, "mixpilot sweep: note: %s\n", note.c_str());
   if (a.check) {
     std::printf("mixpilot sweep: %s: %zu runs of %s%s\n", plan->name.c_str(), plan->runs.size(),
                 plan->scenario_file.c_str(),
@@ -400,7 +412,8 @@ int sweep_command(int argc, char** argv) {
                                 });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!todo.empty())
-    std::printf("  %zu runs flown in %s%s\n", r.flown - r.failed, duration_text(wall).c_str(),
+    std::printf("  %zu run%s flown in %s%s\n", r.flown - r.failed, r.flown - r.failed == 1 ? "" : "s",
+                duration_text(wall).c_str(),
                 r.failed ? (", " + std::to_string(r.failed) + " failed").c_str() : "");
   if (r.interrupted) {
     std::printf("  interrupted: the runs finished are kept; the same command flies the rest\n");

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -13,6 +15,7 @@
 
 #include "app/cli.hpp"
 #include "core/base/input_file.hpp"
+#include "core/base/output_file.hpp"
 #include "core/scenario/scenario_toml.hpp"
 
 namespace mixpilot::cli {
@@ -205,8 +208,16 @@ void ResultFolder::clear_leftovers(const std::vector<std::string>& ids, const st
 
 bool ResultFolder::write_run(const std::string& id, const std::string& json,
                              std::string& error) const {
-  // Over a file only when it is no finished run of this plan (finished() said so) or --force.
-  return write_file(run_path(id), json, /*overwrite=*/true, error);
+  // Over a file only when it is no finished run of this plan or with --force: finished() read
+  // it to know, which makes it one of this process's inputs, here rewritten on purpose.
+  OutputFile out;
+  if (!out.open(run_path(id), /*overwrite=*/true, error, InputReplacement::allowed)) return false;
+  if (std::fwrite(json.data(), 1, json.size(), out.stream()) != json.size()) {
+    error = run_path(id) + ": write failed: " + std::strerror(errno) + "; nothing written";
+    out.discard();
+    return false;
+  }
+  return out.commit(error, /*keep_partial=*/false);
 }
 
 ResultFolder::Gathered ResultFolder::gather() const {

@@ -252,8 +252,12 @@ bool compatible(const toml::node& n, const SweepValue& v, std::string& why) {
     why = "expected " + what + " like the scenario's value " + describe(n) + ", got " + v.toml();
     return false;
   };
-  if (n.is_table() || n.is_array_of_tables())
-    return expect("a value inside it (a key of the table, or [index].key)");
+  if (n.is_table() || n.is_array_of_tables()) {
+    why = std::string(n.is_table() ? "a table" : "an array of tables") +
+          " in the scenario: expected the key of a value inside it (" +
+          (n.is_table() ? "table.key" : "array[index].key") + "), got " + v.toml();
+    return false;
+  }
   if (n.is_integer() && v.type != T::integer) return expect("an integer");
   if (n.is_floating_point() && v.type != T::number && v.type != T::integer)
     return expect("a number");
@@ -1041,21 +1045,22 @@ std::string sweep_plan_json(const SweepPlan& plan, std::string_view version) {
   return out;
 }
 
-std::string explain_run_error(const SweepPlan& plan, const SweepRun& run,
-                              const std::string& loader_error) {
+std::vector<std::string> explain_run_error(const SweepPlan& plan, const SweepRun& run,
+                                           const std::string& loader_error) {
   const auto at = [&](std::uint32_t line, std::uint32_t col) {
     return plan.file + ':' + std::to_string(line) + ':' + std::to_string(col) + ": ";
   };
   std::string settings;
-  for (const SweepSetting& s : plan.fixed) settings += (settings.empty() ? "" : ", ") + s.key + " = " + s.value.toml();
+  for (const SweepSetting& s : plan.fixed)
+    settings += (settings.empty() ? "" : ", ") + s.key + " = " + s.value.toml();
   for (const SweepSetting& s : run.parameters)
     settings += (settings.empty() ? "" : ", ") + s.key + " = " + s.value.toml();
-  std::string out;
+  std::vector<std::string> out;
   std::size_t from = 0;
-  while (from <= loader_error.size()) {
+  while (from < loader_error.size()) {
     std::size_t eol = loader_error.find('\n', from);
     if (eol == std::string::npos) eol = loader_error.size();
-    std::string line = loader_error.substr(from, eol - from);
+    const std::string line = loader_error.substr(from, eol - from);
     from = eol + 1;
     if (line.empty()) continue;
     // "<scenario>:<line>:<col>: <key>: <what>" or "<scenario>: <what>": the positions are the
@@ -1077,27 +1082,27 @@ std::string explain_run_error(const SweepPlan& plan, const SweepRun& run,
     }
     const std::size_t colon = rest.find(": ");
     const std::string key = colon == std::string::npos ? "" : rest.substr(0, colon);
-    const SweepSetting* match = nullptr;
-    const auto consider = [&](const SweepSetting& s) {
-      if (match) return;
-      if (key == s.key || (key.size() > s.key.size() && key.compare(0, s.key.size(), s.key) == 0 &&
-                           (key[s.key.size()] == '[' || key[s.key.size()] == '.')))
-        match = &s;
+    // The setting the complaint is about: its key, a part of its value (reference.center[1]),
+    // or a table it adds (nowhere.x: "nowhere: unknown key").
+    const auto within = [](const std::string& inner, const std::string& outer) {
+      return inner.size() > outer.size() && inner.compare(0, outer.size(), outer) == 0 &&
+             (inner[outer.size()] == '[' || inner[outer.size()] == '.');
     };
-    for (const SweepSetting& s : run.parameters) consider(s);
-    for (const SweepSetting& s : plan.fixed) consider(s);
-    if (!out.empty()) out += '\n';
+    const SweepSetting* match = nullptr;
+    for (const auto* list : {&run.parameters, &plan.fixed})
+      for (const SweepSetting& s : *list)
+        if (!match && !key.empty() && (key == s.key || within(key, s.key) || within(s.key, key)))
+          match = &s;
     if (match) {
-      out += at(match->line, match->column) + match->key + " = " + match->value.toml() + " (run " +
-             run.id + "): " + (key == match->key ? rest.substr(colon + 2) : rest);
+      out.push_back(at(match->line, match->column) + rest);
     } else {
-      const std::uint32_t l = run.parameters.empty() ? plan.scenario_line : run.parameters[0].line;
-      const std::uint32_t c = run.parameters.empty() ? plan.scenario_column : run.parameters[0].column;
-      out += at(l, c) + "run " + run.id + (settings.empty() ? "" : " (" + settings + ")") +
-             ": the scenario " + plan.scenario_file + " with these settings: " + rest;
+      out.push_back(at(plan.scenario_line, plan.scenario_column) + "scenario: " +
+                    plan.scenario_file + (settings.empty() ? "" : " with " + settings) + ": " +
+                    rest);
     }
+    out.back() = escape_controls(out.back());
   }
-  return escape_controls(out, /*multiline=*/true);
+  return out;
 }
 
 }  // namespace mixpilot

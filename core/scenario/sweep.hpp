@@ -94,9 +94,10 @@ std::optional<SweepPlan> parse_sweep(std::string_view text, const std::string& s
 std::string sweep_plan_json(const SweepPlan& plan, std::string_view version);
 
 // The complaint of the scenario loader (or make_mode) about `run`, said against the sweep
-// file: each line at the setting it concerns (`<sweep>:<line>:<col>: <key> = <value> (run
-// <id>): <what>`), or at the run's first parameter with the run's settings named.
-std::string explain_run_error(const SweepPlan& plan, const SweepRun& run,
-                              const std::string& loader_error);
+// file: each line at the setting it concerns (`<sweep>:<line>:<col>: <key>: <what>`, the
+// scenario's own key path and words), or at `scenario` with the run's settings named. The
+// caller says which run (several runs often share one complaint).
+std::vector<std::string> explain_run_error(const SweepPlan& plan, const SweepRun& run,
+                                           const std::string& loader_error);
 
 }  // namespace mixpilot
