@@ -473,8 +473,9 @@ ArrayOutcome run_array(const ArrayRequest& r) {
         for (const auto& j : job_ids) ids_said += (ids_said.empty() ? "" : ", ") + j;
         std::fprintf(stderr,
                      "slurm: array job %s of %s is still in the queue (%zu pending, %zu running): "
-                     "following it rather than submitting again\n",
-                     ids_said.c_str(), r.dir.string().c_str(), pending, running);
+                     "not submitting again%s\n",
+                     ids_said.c_str(), r.dir.string().c_str(), pending, running,
+                     r.wait ? "; following it" : "");
       }
     }
 

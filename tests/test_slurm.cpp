@@ -422,7 +422,7 @@ TEST_F(SlurmShards, AQueuedArrayIsFollowedNotSubmittedAgain) {
   sl::ArrayOutcome second;
   std::thread follow([&] { second = sl::run_array(request_); });
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (err.text().find("following it rather than submitting again") == std::string::npos &&
+  while (err.text().find("not submitting again; following it") == std::string::npos &&
          std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   for (int i = 1; i <= 4; ++i) fs::remove(dir_ / ("hold-" + std::to_string(i)));
