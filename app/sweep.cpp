@@ -398,10 +398,10 @@ int sweep_command(int argc, char** argv) {
                     ": " + std::to_string(selected.size()) + " of " +
                     std::to_string(plan->runs.size()) + " runs"
               : std::to_string(plan->runs.size()) + " runs";
-  std::printf("mixpilot sweep: %s: %s in %s, %zu finished, %zu to fly on %d job%s\n",
-              plan->name.c_str(), scope.c_str(), dir.c_str(), done_before, todo.size(),
-              std::min<int>(a.jobs, int(std::max<std::size_t>(1, todo.size()))),
-              a.jobs == 1 || todo.size() == 1 ? "" : "s");
+  const int jobs = std::min<int>(a.jobs, int(std::max<std::size_t>(1, todo.size())));
+  std::printf("mixpilot sweep: %s: %s in %s, %zu finished, %zu to fly%s\n", plan->name.c_str(),
+              scope.c_str(), dir.c_str(), done_before, todo.size(),
+              todo.empty() ? "" : (" on " + std::to_string(jobs) + (jobs == 1 ? " job" : " jobs")).c_str());
   std::fflush(stdout);
 
   catch_interrupts();

@@ -274,6 +274,10 @@ TEST(Sweep, ThePlansHashChangesWithWhatIsFlownOnly) {
                            "\"plant.rtt\" = [0.0, 0.012]\n";
   const SweepPlan a = must_plan(text);
   const SweepPlan same = must_plan("# a comment\n" + text);
+  std::string error;
+  const auto renamed = parse_sweep(text, kScenarios + "sweeps/renamed.toml", error);
+  ASSERT_TRUE(renamed) << error;
+  EXPECT_EQ(a.sha256, renamed->sha256);
   const SweepPlan other_value = must_plan("scenario = \"../tracking_smooth_step.toml\"\n[grid]\n"
                                           "\"plant.rtt\" = [0.0, 0.015]\n");
   const SweepPlan shorter = must_plan(text + "[set]\n\"controller.N\" = 40\n");
@@ -284,7 +288,6 @@ TEST(Sweep, ThePlansHashChangesWithWhatIsFlownOnly) {
   EXPECT_NE(a.sha256, shorter.sha256);
   EXPECT_NE(a.sha256, longer.sha256);
   // plan.json carries it, and every run's id and parameters.
-  std::string error;
   const auto j = parse_json(sweep_plan_json(a, "mixpilot test"), error);
   ASSERT_TRUE(j) << error;
   ASSERT_TRUE(j->string_at("plan_sha256"));

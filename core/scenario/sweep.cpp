@@ -962,10 +962,14 @@ class SweepReader {
   static std::string plan_hash(const SweepPlan& plan) {
     std::string all = "mixpilot sweep plan 1\nrecord " + std::string(plan.record ? "true" : "false") + '\n';
     for (const SweepRun& run : plan.runs) {
+      // The scenario without its first line, which names the sweep (its file's name) and the
+      // run: what flies, not what it is called.
+      const std::string_view text = run.scenario_text;
+      const std::string_view body = text.substr(std::min(text.size(), text.find('\n') + 1));
       all += "run " + run.id + "\nduration " + (run.duration ? shortest(*run.duration) : "-") +
              "\nassist " + (run.assist == Assistance::off ? "off" : "on") + "\nbounds " +
              shortest(run.bounds.floor) + ' ' + shortest(run.bounds.ceiling) + "\nscenario " +
-             std::to_string(run.scenario_text.size()) + '\n' + run.scenario_text + '\n';
+             std::to_string(body.size()) + '\n' + std::string(body) + '\n';
     }
     return sha256_hex(all);
   }
