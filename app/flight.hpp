@@ -53,6 +53,9 @@ struct LessonTag {
 
 struct FlyOptions {
   std::string scenario_path;
+  // The scenario's text when it is not the file's own (a sweep's run: the file with the run's
+  // values); scenario_path then names it in messages and anchors its relative paths.
+  std::string scenario_text;
   std::string pilot;
   bool headless = false;
   std::optional<double> duration;
