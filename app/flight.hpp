@@ -24,6 +24,7 @@
 #include "core/recording/recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/scenario/scenario.hpp"
+#include "core/scenario/scenario_keys.hpp"
 
 namespace mixpilot::cli {
 
@@ -53,6 +54,9 @@ struct LessonTag {
 
 struct FlyOptions {
   std::string scenario_path;
+  // Keys of --scenario set to other values before it flies (core/scenario/scenario_keys.hpp):
+  // a variant of a shipped scenario, whose text (as flown) is what a recording embeds.
+  std::vector<ScenarioKey> scenario_keys;
   std::string pilot;
   bool headless = false;
   std::optional<double> duration;
