@@ -31,6 +31,7 @@ constexpr const char* kUsage =
     "  instruct        the instructor: list the stations (fly --publish), command one\n"
     "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
     "  lesson  fly a trainee's current step of a lesson, judged and remembered\n"
+    "  figures the thesis's figures from flights of the shipped scenarios (PNG, CSV, index)\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -148,6 +149,7 @@ int dispatch(int argc, char** argv) {
   if (cmd == "history") return history_command(argc, argv);
   if (cmd == "instruct") return instruct_command(argc, argv);
   if (cmd == "lesson") return lesson_command(argc, argv);
+  if (cmd == "figures") return figures_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {
