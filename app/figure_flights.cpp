@@ -1,5 +1,6 @@
 // The flights of the thesis's figures (app/figures.hpp): flown through the flight assembly,
 // scheduled on threads, and the figures' tables and rendering.
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <chrono>
@@ -16,6 +17,8 @@
 #include "app/flight_rig.hpp"
 #include "app/offscreen.hpp"
 #include "ui/theme.hpp"
+
+#include <stb/stb_image_write.h>  // implemented in Debian's libstb, which ImGui links
 
 namespace mixpilot::cli {
 
@@ -224,7 +227,21 @@ bool render_figure_png(const ui::Figure& figure, int width, int height, float sc
   (void)ui::add_heading_font(scale, 1.3f);
   // Two frames: ImGui settles a new window's layout in its first.
   for (int f = 0; f < 2; ++f) screen.frame([&] { ui::draw_figure(figure); });
-  png = screen.png();
+  // The page is opaque: RGB, a quarter smaller than the RGBA of a screenshot.
+  const std::vector<std::uint8_t> rgba = screen.pixels();
+  std::vector<std::uint8_t> rgb(std::size_t(width) * std::size_t(height) * 3);
+  for (std::size_t i = 0, n = std::size_t(width) * std::size_t(height); i < n; ++i)
+    std::copy_n(rgba.data() + 4 * i, 3, rgb.data() + 3 * i);
+  png.clear();
+  stbi_write_png_to_func(
+      [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
+      },
+      &png, width, height, 3, rgb.data(), width * 3);
+  if (png.empty()) {
+    error = "the PNG could not be encoded";
+    return false;
+  }
   return true;
 }
 

@@ -76,7 +76,7 @@ struct FigureDef {
   const char* file;   // DIR/<file>.png and .csv: "fig_5_6"
   const char* title;  // "Tracking error against the round-trip time"
   const char* shows;  // what it shows, for DIR/index.md
-  int width, height;  // [px] of the PNG
+  int width, height;  // [px] of the PNG at print size (width = kFigureWidth)
   std::vector<FigureFlight> (*flights)(FigureLength length);
   // The figure and its data from its flights, given in the order flights() named them.
   void (*build)(const std::vector<const FlownFlight*>& flights, ui::Figure& figure,
@@ -109,8 +109,10 @@ struct BuiltFigure {
                                  std::vector<BuiltFigure>& out, std::string& error,
                                  std::FILE* progress = nullptr);
 
-// The print scale of the figures' text and lines (the UI's display scale): at 1800 px across a
-// 15 cm column, 300 dpi, 15 px × 2.2 is 8 pt text.
+// The print size: every figure is kFigureWidth pixels across (FigureDef::width), 300 dpi over
+// a 15 cm column, and its text and lines drawn at the UI's display scale kFigureScale
+// (15 px × 2.2 is 8 pt text there).
+inline constexpr int kFigureWidth = 1800;
 inline constexpr float kFigureScale = 2.2f;
 
 // A figure rendered offscreen (EGL) at width × height and `scale`, as PNG bytes; false with

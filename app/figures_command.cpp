@@ -1,6 +1,7 @@
 // `mixpilot figures`: the thesis's figures (SPEC §11) as PNG and CSV, with an index.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -20,12 +21,13 @@ namespace mixpilot::cli {
 namespace {
 
 constexpr const char* kUsageHead =
-    "usage: mixpilot figures --out DIR [--only ID[,ID...]] [--force] [--jobs N]\n"
+    "usage: mixpilot figures --out DIR [--only ID[,ID...]] [--force] [--jobs N] [--width PX]\n"
     "\n"
     "Renders the thesis's figures (SPEC 11) from flights of the shipped scenarios, flown headless\n"
     "as `mixpilot fly --headless` flies them (variants by setting scenario keys: the round trip,\n"
     "the predictor, the constraint form, the pilot). Each figure is written as DIR/fig_<id>.png\n"
-    "(print resolution, 1800 px wide, drawn offscreen through EGL by the app's plot code), its\n"
+    "(print resolution: 1800 px wide, 300 dpi across 15 cm; drawn offscreen through EGL by the\n"
+    "app's plot code), its\n"
     "data as DIR/fig_<id>.csv (a header of names with units), and DIR/index.md lists them with\n"
     "what each shows. Which flight is flying goes to stderr; all figures take minutes.\n"
     "\n"
@@ -41,6 +43,8 @@ constexpr const char* kUsageTail =
     "                before anything flies)\n"
     "  --jobs N      flights flown at once (default: the number of cores); the flights whose RTI\n"
     "                times a figure plots (Fig. 7.9) fly alone afterwards\n"
+    "  --width PX    the images' width, 600 to 7200 (default 1800); heights, text and lines\n"
+    "                in proportion (1200 suits a screen or a web page)\n"
     "  -h, --help    show this help\n"
     "\n"
     "environment: MIXPILOT_DATA_DIR, the folder holding scenarios/ (see 'mixpilot --help')\n"
@@ -81,6 +85,7 @@ int figures_command(int argc, char** argv) {
   std::vector<const FigureDef*> chosen;
   bool force = false;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  int width = kFigureWidth;
   for (int i = 2; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -94,6 +99,7 @@ int figures_command(int argc, char** argv) {
       while (start <= v.size()) {
         const std::size_t comma = std::min(v.find(',', start), v.size());
         const std::string id = v.substr(start, comma - start);
+        if (id.empty()) usage_error("figures", "--only: an empty id in '" + v + "' (ids separated by commas: 7.5,7.9)");
         const FigureDef* d = find_figure(id);
         if (!d)
           usage_error("figures", "--only: no figure '" + id + "' (the figures: " + figure_ids() + ")");
@@ -109,6 +115,13 @@ int figures_command(int argc, char** argv) {
       if (end == v.c_str() || *end != '\0' || n < 1 || n > 256)
         usage_error("figures", "--jobs expects a whole number from 1 to 256, got '" + v + "'");
       jobs = int(n);
+    } else if (a == "--width") {
+      const std::string v = option_value("figures", argc, argv, i);
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < 600 || n > 7200)
+        usage_error("figures", "--width expects a whole number of pixels from 600 to 7200, got '" + v + "'");
+      width = int(n);
     } else if (a.size() > 1 && a[0] == '-') {
       usage_error("figures", "unknown option '" + std::string(a) + "'");
     } else {
@@ -169,10 +182,12 @@ int figures_command(int argc, char** argv) {
   for (const BuiltFigure& b : figures) {
     if (interrupted()) return kExitInterrupted;
     const std::string png_path = path(std::string(b.def->file) + ".png");
-    std::fprintf(stderr, "mixpilot figures: rendering Fig. %s (%dx%d)\n", b.def->id, b.def->width,
-                 b.def->height);
+    // The figure's own proportions and print scale, at `width` pixels across.
+    const double zoom = double(width) / double(b.def->width);
+    const int height = int(std::lround(zoom * b.def->height));
+    std::fprintf(stderr, "mixpilot figures: rendering Fig. %s (%dx%d)\n", b.def->id, width, height);
     std::string png;
-    if (!render_figure_png(b.figure, b.def->width, b.def->height, kFigureScale, png, error) ||
+    if (!render_figure_png(b.figure, width, height, float(zoom) * kFigureScale, png, error) ||
         !write_file(png_path, png, force, error) ||
         !write_file(path(std::string(b.def->file) + ".csv"), b.table.csv(), force, error)) {
       std::fprintf(stderr, "mixpilot figures: Fig. %s: %s\n", b.def->id, error.c_str());
