@@ -257,9 +257,7 @@ std::vector<FigureFlight> step_flights(FigureLength) { return {tracking(kStep, 0
 
 void step_build(const std::vector<const FlownFlight*>& flights, ui::Figure& fig, FigureTable& table) {
   const FlownFlight& f = *flights[0];
-  heading(fig, "5.3", ("Crazyflie smooth step from hover (0, 0, 0.4) to (1, \u22121, 1) m, " +
-                       delay_words(f))
-                          .c_str(),
+  heading(fig, "5.3", ("Smooth step from hover (0, 0, 0.4) to (1, \u22121, 1) m: " + delay_words(f)).c_str(),
           flights);
   tracking_header(table);
   tracking_rows(f, table);
@@ -302,8 +300,7 @@ std::vector<double> seen(const FlownFlight& f, const Axis3& a, bool reference = 
 
 void helix_build(const std::vector<const FlownFlight*>& flights, ui::Figure& fig, FigureTable& table) {
   const FlownFlight& f = *flights[0];
-  heading(fig, "5.4", ("Crazyflie helix (radius 0.3 m, climbing 2 mm per 15 ms), " + delay_words(f)).c_str(),
-          flights);
+  heading(fig, "5.4", ("Helix of radius 0.3 m, 2 mm up per 15 ms: " + delay_words(f)).c_str(), flights);
   tracking_header(table);
   tracking_rows(f, table);
   Chart top;
@@ -1022,8 +1019,9 @@ const std::vector<FigureDef>& figure_defs() {
       {"7.9", "fig_7_9", "RTI time",
        "The distribution of the mixed-initiative NMPC's time per RTI step (prepare + feedback) "
        "over each flight, for virtual horizons N_b of 5, 10, 25 and 50, for both pilots, against "
-       "the 15 ms sampling period; measured on the machine that rendered the figure, each "
-       "flight flown alone.",
+       "the 15 ms sampling period (logarithmic). Wall-clock times of the machine that rendered "
+       "the figure, each flight flown alone: on a busy machine the tail holds the time the "
+       "process waited for a core.",
        1800, 900, rti_flights, rti_build},
   };
   return defs;

@@ -88,6 +88,7 @@ std::string tick_label(double value, double step) {
     for (const char c : s) zero &= c == '-' || c == '0' || c == '.';
     if (zero) s.erase(0, 1);
   }
+  if (!s.empty() && s[0] == '-') s.replace(0, 1, "\u2212");  // a minus sign, not a hyphen
   return s;
 }
 
