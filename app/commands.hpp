@@ -18,6 +18,7 @@ int history_command(int argc, char** argv);
 int instruct_command(int argc, char** argv);
 int lesson_command(int argc, char** argv);
 int sweep_command(int argc, char** argv);
+int figures_command(int argc, char** argv);
 // A flight as `fly` flies it (the window, or headless), from its options.
 int run_fly(const FlyOptions& o);
 

@@ -24,6 +24,7 @@
 #include "core/recording/recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/scenario/scenario.hpp"
+#include "core/scenario/scenario_keys.hpp"
 
 namespace mixpilot::cli {
 
@@ -56,6 +57,9 @@ struct FlyOptions {
   // The scenario's text when it is not the file's own (a sweep's run: the file with the run's
   // values); scenario_path then names it in messages and anchors its relative paths.
   std::string scenario_text;
+  // Keys of --scenario set to other values before it flies (core/scenario/scenario_keys.hpp):
+  // a variant of a shipped scenario, whose text (as flown) is what a recording embeds.
+  std::vector<ScenarioKey> scenario_keys;
   std::string pilot;
   bool headless = false;
   std::optional<double> duration;

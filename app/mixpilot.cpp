@@ -32,6 +32,7 @@ constexpr const char* kUsage =
     "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
     "  lesson  fly a trainee's current step of a lesson, judged and remembered\n"
     "  sweep   fly a sweep file's grid of runs on every core (or one shard) into a table\n"
+    "  figures the thesis's figures from flights of the shipped scenarios (PNG, CSV, index)\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -150,6 +151,7 @@ int dispatch(int argc, char** argv) {
   if (cmd == "instruct") return instruct_command(argc, argv);
   if (cmd == "lesson") return lesson_command(argc, argv);
   if (cmd == "sweep") return sweep_command(argc, argv);
+  if (cmd == "figures") return figures_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

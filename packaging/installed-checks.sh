@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # What a user does with the installed package, from a folder that holds no source: the demo, a
 # flight of an installed scenario with a report, a recording scored, a headless screenshot, a
-# video of a replay (or, without ffmpeg, the package to install), the instructor's DDS Security
-# test CA (mixpilot-security-ca), the man pages and the help.
+# thesis figure, a video of a replay (or, without ffmpeg, the package to install), the
+# instructor's DDS Security test CA (mixpilot-security-ca), the man pages and the help.
 # Runs wherever mixpilot is installed (this machine, or the throwaway root of
 # packaging/debootstrap-test.sh). Usage: installed-checks.sh WORK_DIR
 set -euo pipefail
@@ -37,6 +37,12 @@ mixpilot fly --scenario $share/scenarios/mi_helix.toml --pilot novice --headless
   --screenshot "2:$work/shot.png"
 [ "$(head -c 8 "$work/shot.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || {
   say "the screenshot is not a PNG"; exit 1; }
+say "a thesis figure from the installed scenarios"
+mixpilot figures --out "$work/figures" --only 4.4 --width 600 2>"$work/figures.err" || {
+  cat "$work/figures.err"; say "figures failed"; exit 1; }
+[ "$(head -c 8 "$work/figures/fig_4_4.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || {
+  say "the figure is not a PNG"; exit 1; }
+grep -q '^t \[s\],q1 \[rad\]' "$work/figures/fig_4_4.csv" || { say "the figure's CSV has no header"; exit 1; }
 # ffmpeg is recommended, not required: without it the command names the package to install.
 if command -v ffmpeg >/dev/null; then
   say "video of a replay"
@@ -75,8 +81,8 @@ else
   grep -q "apt-get install openssl" "$work/ca.err" || { say "no word of the openssl package"; exit 1; }
 fi
 say "man pages"
-for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-lesson mixpilot-reference \
-            mixpilot-security-ca; do
+for page in mixpilot mixpilot-fly mixpilot-score mixpilot-vehicle mixpilot-lesson mixpilot-sweep \
+            mixpilot-figures mixpilot-reference mixpilot-security-ca; do
   [ -f /usr/share/man/man1/$page.1.gz ] || { say "no man page $page(1)"; exit 1; }
   zcat /usr/share/man/man1/$page.1.gz | grep -q '^\.TH' || { say "$page(1) is not a man page"; exit 1; }
 done

@@ -385,7 +385,9 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("lesson --record-dir", ["lesson", "beginner", "--trainee", "t", "--headless",
                                      "--record-dir", ""], "--record-dir"),
             ("lesson --history", ["lesson", "beginner", "--trainee", "t", "--status",
-                                  "--history", ""], "--history")):
+                                  "--history", ""], "--history"),
+            ("figures --out", ["figures", "--out", ""], "--out"),
+            ("figures --only", ["figures", "--out", "{D}/figures", "--only", ""], "--only")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
 
     # replay --video's values: out of range, not numbers, not finite; each a usage error

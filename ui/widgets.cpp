@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ui/panels.hpp"
+#include "ui/plot.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -252,44 +253,22 @@ void plot(const History& h, const char* title, std::span<const Series> named, do
   const double pad = 0.08 * (hi - lo);
   lo -= pad;
   hi += pad;
-  const auto to_px = [&](double t, double v) {
-    return ImVec2(float(min.x + (t - t0) / window * (max.x - min.x)),
-                  float(max.y - (v - lo) / (hi - lo) * (max.y - min.y)));
-  };
-  // One polyline per series through each pixel column's extremes, in the order they occur:
-  // thousands of samples cost a few hundred points, and no spike is lost.
+  const PlotFrame frame{min, max, t0, t1, lo, hi};
+  // One polyline per series through each pixel column's extremes (ui/plot.hpp).
   // An integer width lets ImGui draw the line from its anti-aliased texture: a third of the
   // triangles of a fractional width, which a software rasterizer feels.
   const float line_width = std::max(1.0f, std::round(scaled(2.0f)));
   for (int k = 0; k < count; ++k) {
     const Indexed& s = series[k];
-    int column = -1;
-    float y_lo = 0, y_hi = 0;
-    bool lo_first = true;
-    const auto flush = [&] {
-      if (column < 0) return;
-      const float a = lo_first ? y_lo : y_hi, b = lo_first ? y_hi : y_lo;
-      dl->PathLineTo(ImVec2(float(column), a));
-      if (b != a) dl->PathLineTo(ImVec2(float(column), b));
-    };
-    for (std::size_t i = first; i < end; ++i) {
-      if (s.channel >= h[i].num_channels) continue;
-      const ImVec2 p = to_px(h[i].t, h[i].channels[std::size_t(s.channel)].value);
-      const int c = int(p.x);
-      if (c != column) {
-        flush();
-        column = c;
-        y_lo = y_hi = p.y;
-        lo_first = true;
-      } else if (p.y < y_lo) {
-        y_lo = p.y;
-        lo_first = false;
-      } else if (p.y > y_hi) {
-        y_hi = p.y;
-      }
-    }
-    flush();
-    dl->PathStroke(s.colour, 0, line_width);
+    // Samples without the channel are left out (stroke_thinned asks for its points in order).
+    std::size_t n = 0;
+    for (std::size_t i = first; i < end; ++i) n += s.channel < h[i].num_channels;
+    std::size_t next = first;
+    stroke_thinned(dl, n, [&](std::size_t) {
+      while (s.channel >= h[next].num_channels) ++next;
+      const Telemetry& v = h[next++];
+      return frame.to_px(v.t, v.channels[std::size_t(s.channel)].value);
+    }, s.colour, line_width);
   }
   const float inset = scaled(3.0f);
   std::snprintf(buf, sizeof buf, "%.3g", hi - pad);
@@ -298,7 +277,7 @@ void plot(const History& h, const char* title, std::span<const Series> named, do
   dl->AddText(ImVec2(min.x + inset, max.y - ImGui::GetTextLineHeight() - scaled(1)),
               colour::rgb(170, 170, 170), buf);
   if (hovered) {
-    const float x = to_px(at->t, 0.0).x;
+    const float x = frame.px_x(at->t);
     dl->AddLine(ImVec2(x, min.y), ImVec2(x, max.y), colour::rgb(0xDD, 0xDD, 0xDD, 140), scaled(1.0f));
   }
 }
