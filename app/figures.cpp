@@ -85,20 +85,19 @@ PlotLine level(std::string label, ImU32 colour, double y, double x0, double x1,
   return line(std::move(label), colour, {x0, x1}, {y, y}, dash, width);
 }
 
-ui::PlotAxis axis(std::string label, double min = kNaN, double max = kNaN);
-
-// The time axis of a flight of `duration` seconds (533 steps of 15 ms end at 7.995 s: the axis
-// ends at 8).
-ui::PlotAxis time_axis(double duration) {
-  return axis("t [s]", 0.0, std::ceil(duration * 10.0 - 1e-6) / 10.0);
-}
-
-ui::PlotAxis axis(std::string label, double min, double max) {
+// An axis with its label; its range as given (NaN: from the data).
+ui::PlotAxis axis(std::string label, double min = kNaN, double max = kNaN) {
   ui::PlotAxis a;
   a.label = std::move(label);
   a.min = min;
   a.max = max;
   return a;
+}
+
+// The time axis of a flight of `duration` seconds (533 steps of 15 ms end at 7.995 s: the axis
+// ends at 8).
+ui::PlotAxis time_axis(double duration) {
+  return axis("t [s]", 0.0, std::ceil(duration * 10.0 - 1e-6) / 10.0);
 }
 
 // "Fig. 5.6 — title" (the page's heading) and the footer naming what flew.
@@ -112,6 +111,7 @@ void heading(ui::Figure& fig, const char* id, const char* title,
   fig.footer = std::string(version()) + ", flown headless from " + list + " (mixpilot figures)";
 }
 
+// A time in milliseconds to 0.1 ms, shortest: "15", "22.5".
 std::string ms(double seconds) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", std::round(seconds * 1e4) / 10.0);
@@ -276,7 +276,7 @@ std::vector<FigureFlight> helix_flights(FigureLength length) {
   return {f};
 }
 
-// A path seen from above (x–y) or from the side (x–z): axes `a` and `b` of the positions.
+// Coordinate i of each step's position (or of its reference): a path seen along an axis.
 std::vector<double> coordinate(const FlownFlight& f, int i, bool reference = false) {
   return each(f, [i, reference](const Telemetry& s) { return reference ? s.reference(i) : s.x(i); });
 }

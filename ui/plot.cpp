@@ -180,7 +180,6 @@ void dash_pattern(Dash d, float w, float& on, float& off) {
   switch (d) {
     case Dash::dashed: on = 5.0f * w; off = 3.5f * w; return;
     case Dash::dotted: on = 1.2f * w; off = 2.2f * w; return;
-    case Dash::dash_dot: on = 6.0f * w; off = 2.5f * w; return;  // drawn as long dashes
     case Dash::solid: break;
   }
   on = 1.0f;

@@ -74,7 +74,7 @@ void stroke_dashed(ImDrawList* dl, std::span<const ImVec2> points, ImU32 colour,
 
 // ---- Charts: printed figures ---------------------------------------------------------------
 
-enum class Dash { solid, dashed, dotted, dash_dot };
+enum class Dash { solid, dashed, dotted };
 enum class Marker { none, circle, square, diamond, triangle, cross, star };
 
 // One series: a curve through (x[i], y[i]) (NaN: a gap), markers at its points, or both.
