@@ -16,6 +16,7 @@
 #include "app/figures.hpp"
 #include "app/flight_rig.hpp"
 #include "app/offscreen.hpp"
+#include "core/scenario/scenario_toml.hpp"
 #include "ui/theme.hpp"
 
 #include <stb/stb_image_write.h>  // implemented in Debian's libstb, which ImGui links
@@ -111,7 +112,18 @@ FlownFlight fly_figure_flight(const FigureFlight& flight, const std::string& dat
   out.flight = flight;
   FlyOptions o;
   o.scenario_path = data_dir + "/scenarios/" + flight.scenario;
-  o.scenario_keys = flight.keys;
+  if (!flight.keys.empty()) {
+    // The variant: the shipped file with its keys set, flown as that text.
+    std::string text;
+    std::optional<std::string> variant;
+    if (read_text_file(o.scenario_path, text, out.error))
+      variant = set_scenario_keys(text, o.scenario_path, flight.keys, out.error);
+    if (!variant) {
+      out.error = flight.describe() + ": " + out.error;
+      return out;
+    }
+    o.scenario_text = std::move(*variant);
+  }
   o.pilot = flight.pilot;
   o.headless = true;
   o.duration = flight.duration;

@@ -38,14 +38,6 @@ std::string rejection_counts(const net::JoyPeerStats& s) {
 // specific exit status than kExitError.
 std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& status) {
   Flight f;
-  if (!o.scenario_keys.empty() &&
-      (o.from || o.replay || o.pilot.ends_with(".mcap") || o.scenario_path.empty())) {
-    error = usage_message(o.command, "scenario keys are set on a --scenario file's new flight (a "
-                                     "replay or a flight from here flies its recording's scenario "
-                                     "as it was)");
-    status = kExitUsage;
-    return std::nullopt;
-  }
   if (o.from) {
     // Fly from here: the recorded flight's own scenario, whatever its file says now.
     f.scenario_text = o.from->scenario_text;
@@ -63,11 +55,6 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
     if (!o.scenario_text.empty()) f.scenario_text = o.scenario_text;
     else if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
     f.scenario_source = o.scenario_path;
-    if (!o.scenario_keys.empty()) {
-      auto text = set_scenario_keys(f.scenario_text, o.scenario_path, o.scenario_keys, error);
-      if (!text) return std::nullopt;
-      f.scenario_text = std::move(*text);
-    }
     f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
     if (f.recording && *embedded_scenario(*f.recording, o.pilot, error) != f.scenario_text &&
         !o.allow_mismatch) {

@@ -24,7 +24,6 @@
 #include "core/recording/recording.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "core/scenario/scenario.hpp"
-#include "core/scenario/scenario_keys.hpp"
 
 namespace mixpilot::cli {
 
@@ -54,12 +53,11 @@ struct LessonTag {
 
 struct FlyOptions {
   std::string scenario_path;
-  // The scenario's text when it is not the file's own (a sweep's run: the file with the run's
-  // values); scenario_path then names it in messages and anchors its relative paths.
+  // The scenario's text when it is not the file's own: a variant of it with some keys set to
+  // other values (core/scenario/scenario_keys.hpp: a sweep's run, a figure's flight), which a
+  // recording embeds as flown; scenario_path then names it in messages and anchors its
+  // relative paths.
   std::string scenario_text;
-  // Keys of --scenario set to other values before it flies (core/scenario/scenario_keys.hpp):
-  // a variant of a shipped scenario, whose text (as flown) is what a recording embeds.
-  std::vector<ScenarioKey> scenario_keys;
   std::string pilot;
   bool headless = false;
   std::optional<double> duration;

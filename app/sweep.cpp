@@ -130,7 +130,7 @@ std::string metric_text(double v) {
 }
 
 // The CSV text of a parameter's value.
-std::string cell_of(const SweepValue& v) { return v.text(); }
+std::string cell_of(const ScenarioValue& v) { return v.text(); }
 
 }  // namespace
 

@@ -734,27 +734,72 @@ TEST(ScenarioKeys, AMissingKeyIsAddedUnderItsTable) {
   EXPECT_NE(error.find("plant.typo"), std::string::npos) << error;
 }
 
-// What cannot be set is refused with the setting named.
+// An element of an array is a key too: a value of an array of tables' element, an element of
+// a value array, a key an element leaves out (under its [[header]]); a table the file lacks, or
+// has no header of its own, is appended with its header; an inline table takes a key inside its
+// braces.
+TEST(ScenarioKeys, ArrayElementsInlineAndMissingTables) {
+  std::string error;
+  const std::string t = "[a]\nv = [1.0, 2.0]  # x\nin = { p = 1 }\n[[e]]\nf = 3\n[[e]]\nf = 4\n[g.h]\ni = 4\n";
+  EXPECT_EQ(keys_test::set(t, {{"e[1].f", "5"}, {"a.v[1]", "-0.5"}, {"e[0].k", "true"},
+                               {"a.in.q", "\"s\""}, {"g.z", "1"}, {"x.y.w", "[1, 2]"}},
+                           error),
+            "[a]\nv = [1.0, -0.5]  # x\nin = { p = 1 , q = \"s\" }\n[[e]]\nk = true\nf = 3\n[[e]]\n"
+            "f = 5\n[g.h]\ni = 4\n\n[g]\nz = 1\n\n[x.y]\nw = [1, 2]\n")
+      << error;
+  // A shipped scenario's obstacle: the loader reads the new radius, every other byte is kept.
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml";
+  std::string text;
+  ASSERT_TRUE(read_text_file(path, text, error)) << error;
+  const auto before = parse_scenario(text, path, error);
+  ASSERT_TRUE(before) << error;
+  const std::string edited = keys_test::set(text, {{"arena.obstacles[1].radius", "0.125"}}, error);
+  ASSERT_FALSE(edited.empty()) << error;
+  const auto after = parse_scenario(edited, path, error);
+  ASSERT_TRUE(after) << error;
+  ASSERT_GT(before->arena.obstacles.size(), 2u);
+  EXPECT_NE(before->arena.obstacles[1].radius, 0.125);
+  EXPECT_EQ(after->arena.obstacles[1].radius, 0.125);
+  EXPECT_EQ(after->arena.obstacles[0].radius, before->arena.obstacles[0].radius);
+  EXPECT_EQ(after->arena.obstacles[2].radius, before->arena.obstacles[2].radius);
+  // Only that value changed: the second obstacle's "radius = 0.2" line.
+  const std::size_t second = text.find("[[arena.obstacles]]", text.find("[[arena.obstacles]]") + 1);
+  const std::size_t at = text.find("radius = 0.2\n", second);
+  ASSERT_NE(at, std::string::npos);
+  std::string expected = text;
+  expected.replace(at, 12, "radius = 0.125");
+  EXPECT_EQ(edited, expected);
+}
+
+// What cannot be set is refused with the setting and the file named.
 TEST(ScenarioKeys, RefusalsNameTheSetting) {
-  const std::string t = "name = \"n\"\n[a]\nb = 1\n[a.c]\nd = 2\n[[e]]\nf = 3\n[g.h]\ni = 4\n";
+  const std::string t = "name = \"n\"\n[a]\nb = 1\nv = [1.0, 2.0]\n[a.c]\nd = 2\n[[e]]\nf = 3\n";
   const struct {
     ScenarioKey key;
     const char* says;
   } cases[] = {
-      {{"x.y", "1"}, "the scenario has no table [x]"},
-      {{"a", "1"}, "a is a table, not a key"},
-      {{"e.f", "1"}, "e is an array of tables"},
-      {{"a.b.z", "1"}, "a.b is not a table"},
-      {{"g.z", "1"}, "[g] has no header of its own"},
+      {{"a", "1"}, "a table in the scenario: expected the key of a value inside it"},
+      {{"e", "1"}, "an array of tables in the scenario: expected the key of a value inside it"},
+      {{"e.f", "1"}, "e is an array of tables in the scenario: expected an element of it, e[index].f"},
+      {{"e[1].f", "1"}, "has 1 elements: index 1 is out of range"},
+      {{"a.v[2]", "1.0"}, "has 2 elements: index 2 is out of range"},
+      {{"a.b[0]", "1"}, "b is 1 in the scenario, not an array"},
+      {{"x[0].y", "1"}, "the scenario has no x"},
+      {{"a.b.z", "1"}, "a.b is 1 in the scenario, not a table"},
+      {{"a.b", "\"s\""}, "expected an integer like the scenario's value 1, got \"s\""},
+      {{"a.v", "1.0"}, "expected an array"},
+      {{"name", "true"}, "expected a string"},
       {{"a.b", "lcl"}, "not one TOML value"},
       {{"a.b", "1\nc = 2"}, "on one line"},
-      {{"a..b", "1"}, "dotted path of bare keys"},
-      {{"a.\"b\"", "1"}, "dotted path of bare keys"},
+      {{"a..b", "1"}, "expected a key path of the scenario"},
+      {{"a.\"b\"", "1"}, "expected a key path of the scenario"},
+      {{"a.v[x]", "1"}, "expected [index] with a whole number after \"v\""},
   };
   for (const auto& c : cases) {
     std::string error;
     EXPECT_FALSE(set_scenario_keys(t, "t.toml", {c.key}, error)) << c.key.key;
     EXPECT_NE(error.find(c.says), std::string::npos) << error;
+    EXPECT_NE(error.find("setting " + c.key.key + " = "), std::string::npos) << error;
     EXPECT_NE(error.find("t.toml"), std::string::npos) << error;
   }
   std::string error;

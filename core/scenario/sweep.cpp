@@ -14,6 +14,7 @@
 #include "core/base/toml_read.hpp"
 #include "core/scenario/data_files.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "core/scenario/scenario_value_toml.hpp"
 
 namespace mixpilot {
 
@@ -28,428 +29,11 @@ constexpr const char* kFloor = "floor";
 constexpr const char* kCeiling = "ceiling";
 bool flight_option(std::string_view key) { return key == kAssist || key == kFloor || key == kCeiling; }
 
-// Shortest text that reads back as `v`: 0.012, 30, 1e-13, inf, -inf, nan.
-std::string shortest(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-std::string toml_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (ch) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
-      default:
-        if (c < 0x20 || c == 0x7F) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04X", c);
-          out += buf;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + '"';
-}
-
-}  // namespace
-
-std::string SweepValue::toml() const {
-  switch (type) {
-    case Type::boolean: return boolean ? "true" : "false";
-    case Type::integer: return std::to_string(integer);
-    case Type::number: return std::isfinite(number) ? fmt(number) : shortest(number);
-    case Type::string: return toml_string(string);
-    case Type::array: {
-      std::string out = "[";
-      for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i].toml();
-      return out + ']';
-    }
-  }
-  return {};
-}
-
-std::string SweepValue::text() const {
-  switch (type) {
-    case Type::boolean: return boolean ? "true" : "false";
-    case Type::integer: return std::to_string(integer);
-    case Type::number: return shortest(number);
-    case Type::string: return string;
-    case Type::array: {
-      std::string out = "[";
-      for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i].text();
-      return out + ']';
-    }
-  }
-  return {};
-}
-
-std::string SweepValue::json() const {
-  switch (type) {
-    case Type::boolean: return boolean ? "true" : "false";
-    case Type::integer: return std::to_string(integer);
-    case Type::number: return std::isfinite(number) ? shortest(number) : "null";
-    case Type::string: return json_quote(string);
-    case Type::array: {
-      std::string out = "[";
-      for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i].json();
-      return out + ']';
-    }
-  }
-  return {};
-}
-
-namespace {
-
-// ---- values and keys ------------------------------------------------------------------------
-
-// A TOML value of the sweep file as a SweepValue; false with what was expected.
-bool value_of(const toml::node& n, SweepValue& out, std::string& why) {
-  switch (n.type()) {
-    case toml::node_type::boolean:
-      out.type = SweepValue::Type::boolean;
-      out.boolean = n.as_boolean()->get();
-      return true;
-    case toml::node_type::integer:
-      out.type = SweepValue::Type::integer;
-      out.integer = n.as_integer()->get();
-      return true;
-    case toml::node_type::floating_point:
-      out.type = SweepValue::Type::number;
-      out.number = n.as_floating_point()->get();
-      return true;
-    case toml::node_type::string:
-      out.type = SweepValue::Type::string;
-      out.string = n.as_string()->get();
-      return true;
-    case toml::node_type::array: {
-      out.type = SweepValue::Type::array;
-      for (const toml::node& e : *n.as_array()) {
-        out.items.emplace_back();
-        if (!value_of(e, out.items.back(), why)) return false;
-      }
-      return true;
-    }
-    default:
-      why = "expected a number, a boolean, a string or an array of them, got " + describe(n);
-      return false;
-  }
-}
-
-// One part of a key path: a key, and an element of the array it names.
-struct Part {
-  std::string name;
-  std::optional<std::size_t> index;
-};
-
+// A path's characters and a file name's: letters, digits, _ and -.
 bool bare_key_char(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
          c == '-';
 }
-
-// "a.b[2].c" → parts; false with what was expected.
-bool parse_path(std::string_view key, std::vector<Part>& parts, std::string& why) {
-  parts.clear();
-  std::size_t i = 0;
-  while (true) {
-    Part p;
-    const std::size_t from = i;
-    while (i < key.size() && bare_key_char(key[i])) ++i;
-    if (i == from) {
-      why = "expected a key path of the scenario: names of letters, digits, _ and - joined by "
-            "'.', each with an optional [index] (plant.rtt, arena.obstacles[0].radius)";
-      return false;
-    }
-    p.name.assign(key.substr(from, i - from));
-    if (i < key.size() && key[i] == '[') {
-      const std::size_t close = key.find(']', i);
-      std::size_t v = 0;
-      const auto r = close == std::string_view::npos
-                         ? std::from_chars_result{nullptr, std::errc::invalid_argument}
-                         : std::from_chars(key.data() + i + 1, key.data() + close, v);
-      if (close == std::string_view::npos || close == i + 1 || r.ec != std::errc() ||
-          r.ptr != key.data() + close || v > 1000000) {
-        why = "expected [index] with a whole number after \"" + p.name + "\"";
-        return false;
-      }
-      p.index = v;
-      i = close + 1;
-    }
-    parts.push_back(std::move(p));
-    if (i == key.size()) return true;
-    if (key[i] != '.') {
-      why = "expected '.' or the end of the key after \"" + parts.back().name + "\"";
-      return false;
-    }
-    ++i;
-  }
-}
-
-std::string path_text(const std::vector<Part>& parts, std::size_t n) {
-  std::string out;
-  for (std::size_t j = 0; j < n && j < parts.size(); ++j) {
-    if (j) out += '.';
-    out += parts[j].name;
-    if (parts[j].index) out += '[' + std::to_string(*parts[j].index) + ']';
-  }
-  return out;
-}
-
-// Where `parts` leads in the base scenario: the node it names, or nullptr where the scenario
-// leaves it out (the loader then judges the key). False with why it cannot name a value.
-bool resolve(const toml::table& root, const std::vector<Part>& parts, const toml::node*& found,
-             std::string& why) {
-  const toml::node* cur = &root;
-  found = nullptr;
-  for (std::size_t j = 0; j < parts.size(); ++j) {
-    const toml::table* t = cur->as_table();
-    if (!t) {
-      why = path_text(parts, j) + " is " + describe(*cur) + " in the scenario, not a table";
-      return false;
-    }
-    const toml::node* child = t->get(parts[j].name);
-    if (!child) {
-      if (parts[j].index) {
-        why = "the scenario has no " + parts[j].name + ": [" + std::to_string(*parts[j].index) +
-              "] sets an element of an array the scenario has";
-        return false;
-      }
-      return true;
-    }
-    if (parts[j].index) {
-      const toml::array* a = child->as_array();
-      if (!a) {
-        why = parts[j].name + " is " + describe(*child) + " in the scenario, not an array";
-        return false;
-      }
-      if (*parts[j].index >= a->size()) {
-        why = "the scenario's " + path_text(parts, j) + (j ? "." : "") + parts[j].name + " has " +
-              std::to_string(a->size()) + " elements: index " + std::to_string(*parts[j].index) +
-              " is out of range";
-        return false;
-      }
-      child = a->get(*parts[j].index);
-    }
-    cur = child;
-  }
-  found = cur;
-  return true;
-}
-
-// Whether `v` can stand where the scenario has `n`: the same kind of value (an integer for an
-// integer key; any number for a number's).
-bool compatible(const toml::node& n, const SweepValue& v, std::string& why) {
-  using T = SweepValue::Type;
-  const auto expect = [&](const std::string& what) {
-    why = "expected " + what + " like the scenario's value " + describe(n) + ", got " + v.toml();
-    return false;
-  };
-  if (n.is_table() || n.is_array_of_tables()) {
-    why = std::string(n.is_table() ? "a table" : "an array of tables") +
-          " in the scenario: expected the key of a value inside it (" +
-          (n.is_table() ? "table.key" : "array[index].key") + "), got " + v.toml();
-    return false;
-  }
-  if (n.is_integer() && v.type != T::integer) return expect("an integer");
-  if (n.is_floating_point() && v.type != T::number && v.type != T::integer)
-    return expect("a number");
-  if (n.is_boolean() && v.type != T::boolean) return expect("true or false");
-  if (n.is_string() && v.type != T::string) return expect("a string");
-  if (n.is_array() && v.type != T::array) return expect("an array");
-  return true;
-}
-
-// Whether the node `n` of a written scenario holds `v`.
-bool holds(const toml::node& n, const SweepValue& v) {
-  using T = SweepValue::Type;
-  switch (v.type) {
-    case T::boolean: return n.is_boolean() && n.as_boolean()->get() == v.boolean;
-    case T::integer: return n.is_integer() && n.as_integer()->get() == v.integer;
-    case T::number: {
-      if (!n.is_floating_point()) return false;
-      const double x = n.as_floating_point()->get();
-      return x == v.number || (std::isnan(x) && std::isnan(v.number));
-    }
-    case T::string: return n.is_string() && n.as_string()->get() == v.string;
-    case T::array: {
-      const toml::array* a = n.as_array();
-      if (!a || a->size() != v.items.size()) return false;
-      for (std::size_t i = 0; i < v.items.size(); ++i)
-        if (!holds(*a->get(i), v.items[i])) return false;
-      return true;
-    }
-  }
-  return false;
-}
-
-// ---- writing values into the scenario's text -----------------------------------------------
-
-// Edits of the base scenario's text: values replaced where they stand, keys the file leaves out
-// added to their table, tables it lacks appended.
-class TextPatch {
- public:
-  explicit TextPatch(std::string_view text) : text_(text) {
-    starts_.push_back(0);
-    for (std::size_t i = 0; i < text_.size(); ++i)
-      if (text_[i] == '\n') starts_.push_back(i + 1);
-  }
-
-  // Sets `parts` to `v`; false with why it cannot be written.
-  bool set(const toml::table& root, const std::vector<Part>& parts, const SweepValue& v,
-           std::string& why) {
-    const toml::node* cur = &root;
-    std::string header_path;   // the path of `cur` as a table header names it
-    bool under_array = false;  // `cur` is an element of an array of tables, or inside one
-    for (std::size_t j = 0; j + 1 < parts.size(); ++j) {
-      const toml::table* t = cur->as_table();
-      const toml::node* child = t ? t->get(parts[j].name) : nullptr;
-      const std::string child_path = header_path + (header_path.empty() ? "" : ".") + parts[j].name;
-      if (!child) {  // tables the scenario lacks: appended, each with its header
-        for (std::size_t m = j; m < parts.size(); ++m)
-          if (parts[m].index) {
-            why = "the scenario has no " + parts[m].name + " to set element [" +
-                  std::to_string(*parts[m].index) + "] of";
-            return false;
-          }
-        if (under_array) {
-          why = "cannot add the table " + path_text(parts, parts.size() - 1) +
-                " inside an element of an array of tables; write it in the scenario";
-          return false;
-        }
-        std::string table = child_path;
-        for (std::size_t m = j + 1; m + 1 < parts.size(); ++m) table += '.' + parts[m].name;
-        appended_[table] += parts.back().name + " = " + v.toml() + '\n';
-        return true;
-      }
-      if (parts[j].index) {
-        const toml::array* a = child->as_array();
-        child = a ? a->get(*parts[j].index) : nullptr;
-        under_array = true;
-      }
-      if (!child || !child->is_table()) {
-        why = path_text(parts, j + 1) + " is not a table in the scenario";
-        return false;
-      }
-      cur = child;
-      header_path = child_path;
-    }
-    const toml::table* t = cur->as_table();
-    const Part& last = parts.back();
-    const toml::node* n = t->get(last.name);
-    if (n && last.index) {
-      const toml::array* a = n->as_array();
-      n = a ? a->get(*last.index) : nullptr;
-      if (!n) {
-        why = "the scenario has no element " + path_text(parts, parts.size());
-        return false;
-      }
-    } else if (!n && last.index) {
-      why = "the scenario has no " + last.name + " to set element [" + std::to_string(*last.index) +
-            "] of";
-      return false;
-    }
-    const std::string line = last.name + " = " + v.toml();
-    if (n) {  // replaced where it stands
-      const std::size_t from = offset(n->source().begin), to = offset(n->source().end);
-      if (from >= to || to > text_.size()) {
-        why = "cannot find its value in the scenario's text";
-        return false;
-      }
-      edits_.push_back({from, to - from, v.toml(), edits_.size()});
-      return true;
-    }
-    if (t == &root) {  // a top-level key: before the first table
-      edits_.push_back({0, 0, line + '\n', edits_.size()});
-      return true;
-    }
-    if (t->is_inline()) {  // { a = 1 }: before its closing brace
-      const std::size_t end = offset(t->source().end);
-      if (end == 0 || end > text_.size() || text_[end - 1] != '}') {
-        why = "cannot find the end of its inline table in the scenario's text";
-        return false;
-      }
-      const bool first = t->empty() && added_inline_[t]++ == 0;
-      edits_.push_back({end - 1, 0, (first ? " " : ", ") + line + ' ', edits_.size()});
-      return true;
-    }
-    // A table with its own [header] (or an element's [[header]]): on the line after it.
-    const std::size_t at = offset(t->source().begin);
-    if (header_at(at) == header_path) {
-      const std::uint32_t l = t->source().begin.line;
-      if (l < starts_.size()) {
-        edits_.push_back({starts_[l], 0, line + '\n', edits_.size()});
-      } else {  // the header is the last line, without a line break
-        edits_.push_back({text_.size(), 0, '\n' + line + '\n', edits_.size()});
-      }
-      return true;
-    }
-    // A table the file only names in its sub-tables' headers: its own header, appended.
-    if (under_array) {
-      why = "cannot add " + last.name + " to " + path_text(parts, parts.size() - 1) +
-            ", which has no [header] of its own in the scenario; write it there";
-      return false;
-    }
-    appended_[header_path] += line + '\n';
-    return true;
-  }
-
-  std::string result() const {
-    std::string out(text_);
-    std::vector<Edit> edits = edits_;
-    std::sort(edits.begin(), edits.end(), [](const Edit& a, const Edit& b) {
-      return a.at != b.at ? a.at > b.at : a.order > b.order;
-    });
-    for (const Edit& e : edits) out.replace(e.at, e.length, e.with);
-    if (!appended_.empty() && !out.empty() && out.back() != '\n') out += '\n';
-    for (const auto& [table, lines] : appended_) out += "\n[" + table + "]\n" + lines;
-    return out;
-  }
-
- private:
-  struct Edit {
-    std::size_t at, length;
-    std::string with;
-    std::size_t order;
-  };
-
-  // The byte offset of a toml++ position (1-based line, column in code points).
-  std::size_t offset(const toml::source_position& p) const {
-    if (p.line == 0 || p.line > starts_.size()) return text_.size() + 1;
-    std::size_t i = starts_[p.line - 1];
-    for (std::uint32_t c = 1; c < p.column && i < text_.size(); ++c) {
-      ++i;
-      while (i < text_.size() && (static_cast<unsigned char>(text_[i]) & 0xC0) == 0x80) ++i;
-    }
-    return i;
-  }
-
-  // The table a [header] or [[header]] at `at` names ("" when there is none).
-  std::string header_at(std::size_t at) const {
-    if (at >= text_.size() || text_[at] != '[') return {};
-    const std::size_t close = text_.find(']', at);
-    const std::size_t eol = text_.find('\n', at);
-    if (close == std::string_view::npos || (eol != std::string_view::npos && close > eol))
-      return {};
-    std::string name;
-    for (char c : text_.substr(at, close - at))
-      if (c != '[' && c != ' ' && c != '\t') name += c;
-    return name;
-  }
-
-  std::string_view text_;
-  std::vector<std::size_t> starts_;  // byte offset of each line
-  std::vector<Edit> edits_;
-  std::map<std::string, std::string> appended_;  // table path → its lines
-  std::map<const toml::table*, int> added_inline_;
-};
 
 // ---- the sweep file -------------------------------------------------------------------------
 
@@ -679,8 +263,14 @@ class SweepReader {
     base_text_ = normalize_text(base_text_);
     plan.scenario_sha256 = sha256_hex(base_text_);
     Diagnostics sd(plan.scenario_file);
-    if (!parse_toml(base_text_, plan.scenario_file, sd, base_)) {
+    toml::table parsed;
+    if (!parse_toml(base_text_, plan.scenario_file, sd, parsed)) {
       d_.add(at, "scenario", "is not a scenario that loads: " + sd.str());
+      return false;
+    }
+    base_ = ScenarioEdit::open(base_text_, plan.scenario_file, error);
+    if (!base_) {
+      d_.add(at, "scenario", "is not a scenario that loads: " + error);
       return false;
     }
     const std::optional<std::string> mode = scenario_mode(base_text_, plan.scenario_file, error);
@@ -700,7 +290,7 @@ class SweepReader {
     out.line = p.line;
     out.column = p.col;
     std::string why;
-    if (!value_of(node, out.value, why)) {
+    if (!scenario_value_of(node, out.value, why)) {
       d_.add(p, where, why);
       return false;
     }
@@ -751,7 +341,7 @@ class SweepReader {
   // The key names something the scenario can take, with a value of its kind.
   bool check_key(const SweepSetting& s, const std::string& where) {
     const Pos p{s.line, s.column};
-    using T = SweepValue::Type;
+    using T = ScenarioValue::Type;
     if (flight_option(s.key)) {
       if (mode_ != "mixed_initiative") {
         d_.add(p, where, s.key + " (fly --" + s.key + ") is for mixed_initiative scenarios; the "
@@ -774,18 +364,8 @@ class SweepReader {
       }
       return true;
     }
-    std::vector<Part> parts;
     std::string why;
-    if (!parse_path(s.key, parts, why)) {
-      d_.add(p, where, why);
-      return false;
-    }
-    const toml::node* n = nullptr;
-    if (!resolve(base_, parts, n, why)) {
-      d_.add(p, where, why);
-      return false;
-    }
-    if (n && !compatible(*n, s.value, why)) {
+    if (!base_->check(s.key, s.value, why)) {
       d_.add(p, where, why);
       return false;
     }
@@ -838,14 +418,7 @@ class SweepReader {
   static void name_runs(SweepPlan& plan) {
     std::vector<std::string> labels;
     for (const std::string& c : plan.columns) {
-      std::vector<Part> parts;
-      std::string why;
-      std::string label = c;
-      if (parse_path(c, parts, why)) {
-        label = parts.back().name;
-        if (parts.back().index) label += std::to_string(*parts.back().index);
-      }
-      labels.push_back(label);
+      labels.push_back(key_label(c));
     }
     const std::vector<std::string> short_labels = labels;
     for (std::size_t i = 0; i < labels.size(); ++i)
@@ -858,7 +431,7 @@ class SweepReader {
         const std::size_t c = std::size_t(
             std::find(plan.columns.begin(), plan.columns.end(), s.key) - plan.columns.begin());
         std::string value;
-        if (s.value.type == SweepValue::Type::array) {
+        if (s.value.type == ScenarioValue::Type::array) {
           for (std::size_t k = 0; k < s.value.items.size(); ++k)
             value += (k ? "_" : "") + s.value.items[k].text();
         } else {
@@ -877,7 +450,7 @@ class SweepReader {
 
   // The run's scenario text: [set] and its parameters written into the base text.
   bool write_run(SweepPlan& plan, SweepRun& run) {
-    TextPatch patch(base_text_);
+    ScenarioEdit patch = *base_;
     std::string said;
     std::vector<const SweepSetting*> all;
     for (const SweepSetting& s : plan.fixed) all.push_back(&s);
@@ -890,14 +463,13 @@ class SweepReader {
         continue;
       }
       if (s->key == kFloor || s->key == kCeiling) {
-        const double x = s->value.type == SweepValue::Type::integer ? double(s->value.integer)
+        const double x = s->value.type == ScenarioValue::Type::integer ? double(s->value.integer)
                                                                     : s->value.number;
         (s->key == kFloor ? run.bounds.floor : run.bounds.ceiling) = x;
         continue;
       }
-      std::vector<Part> parts;
       std::string why;
-      if (!parse_path(s->key, parts, why) || !patch.set(base_, parts, s->value, why)) {
+      if (!patch.set(s->key, s->value, why)) {
         d_.add(Pos{s->line, s->column}, s->key, why);
         return false;
       }
@@ -917,8 +489,11 @@ class SweepReader {
                         body;
     // The text says what was asked: read back, every value where it belongs.
     Diagnostics check(plan.scenario_file);
-    toml::table written;
-    if (!parse_toml(run.scenario_text, plan.scenario_file, check, written)) {
+    toml::table parsed;
+    std::string why;
+    std::optional<ScenarioEdit> written;
+    if (!parse_toml(run.scenario_text, plan.scenario_file, check, parsed) ||
+        !(written = ScenarioEdit::open(run.scenario_text, plan.scenario_file, why))) {
       const SweepSetting* s = all.empty() ? nullptr : all.back();
       d_.add(s ? Pos{s->line, s->column} : Pos{1, 1}, s ? s->key : "sweep",
              "cannot be written into " + plan.scenario_file + " (run " + run.id + "): " +
@@ -927,11 +502,7 @@ class SweepReader {
     }
     for (const SweepSetting* s : all) {
       if (flight_option(s->key)) continue;
-      std::vector<Part> parts;
-      std::string why;
-      const toml::node* n = nullptr;
-      if (!parse_path(s->key, parts, why) || !resolve(written, parts, n, why) || !n ||
-          !holds(*n, s->value)) {
+      if (!written->holds(s->key, s->value)) {
         d_.add(Pos{s->line, s->column}, s->key,
                "could not be written into " + plan.scenario_file + " (run " + run.id + ")");
         return false;
@@ -977,7 +548,7 @@ class SweepReader {
   Diagnostics& d_;
   std::string source_;
   std::string base_text_;
-  toml::table base_;
+  std::optional<ScenarioEdit> base_;  // the base scenario, and the runs' edits of it
   std::string mode_;
   Pos duration_at_;
 };

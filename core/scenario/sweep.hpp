@@ -6,8 +6,8 @@
 // identifies it, so a folder of results can refuse a changed sweep.
 //
 // A run's scenario is the base file's own text with the run's values written over the values
-// they replace (comments and layout kept; a key the file leaves at its default is added to its
-// table), under a first comment line naming the sweep and the run. Whether the scenario
+// they replace (core/scenario/scenario_keys.hpp: comments and layout kept; a key the file leaves
+// at its default is added to its table), under a first comment line naming the sweep and the run. Whether the scenario
 // accepts the values is for its loader (make_mode) to say; explain_run_error() says its
 // complaint against the sweep file's line.
 //
@@ -22,26 +22,12 @@
 
 #include "core/control/mi_settings.hpp"
 #include "core/control/ph_index.hpp"
+#include "core/scenario/scenario_keys.hpp"
 
 namespace mixpilot {
 
 // Largest plan a sweep file may expand to (each run keeps its scenario text in memory).
 inline constexpr std::size_t kMaxSweepRuns = 10000;
-
-// A value a sweep sets: a TOML scalar or an array of them (a scenario's vectors).
-struct SweepValue {
-  enum class Type { boolean, integer, number, string, array };
-  Type type = Type::integer;
-  bool boolean = false;
-  std::int64_t integer = 0;
-  double number = 0.0;
-  std::string string;
-  std::vector<SweepValue> items;
-
-  std::string toml() const;  // as TOML source: 0.012, true, "novice", [0.0, 0.5]
-  std::string text() const;  // for names and tables: 0.012, true, novice, [0, 0.5]
-  std::string json() const;  // as JSON (a non-finite number: null)
-};
 
 // One key set to one value.
 struct SweepSetting {
@@ -49,7 +35,7 @@ struct SweepSetting {
   // for an element of an array ("arena.obstacles[2].radius", "plant.start[2]"); or a flight
   // option of `fly`: "assist" (on | off), "floor", "ceiling".
   std::string key;
-  SweepValue value;
+  ScenarioValue value;
   std::uint32_t line = 1, column = 1;  // the value's position in the sweep file
 };
 
