@@ -22,6 +22,7 @@
 #include "app/flight_rig.hpp"
 #include "app/progress.hpp"
 #include "app/progress_html.hpp"
+#include "core/base/json.hpp"
 #include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
 #include "core/base/content_hash.hpp"
@@ -360,25 +361,6 @@ void print_csv(const std::vector<history::StoredFlight>& rows) {
   }
 }
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c == '"') out += "\\\"";
-    else if (c == '\\') out += "\\\\";
-    else if (c == '\n') out += "\\n";
-    else if (c == '\t') out += "\\t";
-    else if (c < 0x20 || c == 0x7F) {
-      char u[8];
-      std::snprintf(u, sizeof u, "\\u%04x", c);
-      out += u;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
 void print_json(const std::vector<history::StoredFlight>& rows) {
   std::string out = "[";
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -387,7 +369,7 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
     out += i ? ",\n  {" : "\n  {";
     for (std::size_t k = 0; k < values.size(); ++k) {
       const std::string_view name = kFields[k];
-      out += (k ? ", " : "") + json_string(name) + ": ";
+      out += (k ? ", " : "") + json_quote(name) + ": ";
       if (name == "id" || name == "started_unix_ms")
         out += values[k];
       else if (name == "duration_s" || name == "parent_step")
@@ -403,12 +385,12 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
       else if (name == "probe")
         out += f.probe ? "true" : "false";
       else
-        out += json_string(values[k]);
+        out += json_quote(values[k]);
     }
     out += ", \"metrics\": {";
     for (std::size_t m = 0; m < f.metrics.size(); ++m) {
       const std::string v = number(f.metrics[m].second);
-      out += (m ? ", " : "") + json_string(f.metrics[m].first) + ": " + (v.empty() ? "null" : v);
+      out += (m ? ", " : "") + json_quote(f.metrics[m].first) + ": " + (v.empty() ? "null" : v);
     }
     out += "}}";
   }

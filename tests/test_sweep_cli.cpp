@@ -22,6 +22,7 @@
 #include "core/base/report_table.hpp"
 #include "run_mixpilot.hpp"
 #include "spawned.hpp"
+#include "sweep_table.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot {
@@ -51,51 +52,6 @@ fs::path home_of(const std::string& name) {
 fs::path write(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
   return p;
-}
-
-std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
-  const std::string text = test::read_file(p);
-  std::vector<std::vector<std::string>> rows(1);
-  std::string field;
-  bool quoted = false, was_quoted = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
-      else if (c == '"') quoted = false;
-      else field += c;
-    } else if (c == '"') {
-      quoted = was_quoted = true;
-    } else if (c == ',') {
-      rows.back().push_back(field);
-      field.clear();
-    } else if (c == '\n') {
-      rows.back().push_back(field);
-      field.clear();
-      rows.emplace_back();
-    } else {
-      field += c;
-    }
-  }
-  (void)was_quoted;
-  if (rows.back().empty()) rows.pop_back();
-  return rows;
-}
-
-// The table without its timing columns (is_timing_field): what two runs of a plan share.
-std::vector<std::vector<std::string>> non_timing(const std::vector<std::vector<std::string>>& t) {
-  if (t.empty()) return t;
-  std::vector<bool> keep;
-  for (const std::string& h : t[0]) keep.push_back(!is_timing_field(h));
-  std::vector<std::vector<std::string>> out;
-  for (const auto& row : t) {
-    EXPECT_EQ(row.size(), keep.size());
-    std::vector<std::string> r;
-    for (std::size_t c = 0; c < row.size() && c < keep.size(); ++c)
-      if (keep[c]) r.push_back(row[c]);
-    out.push_back(r);
-  }
-  return out;
 }
 
 std::set<std::string> run_files(const fs::path& dir) {
@@ -150,7 +106,7 @@ TEST(Sweep, ASweepFliesEveryRunIntoItsFolderAndTheSecondTimeFliesNothing) {
   EXPECT_EQ(count_lines(said, "mixpilot sweep: \\[[0-9]+/8\\] "), kTrackingRuns) << said;
   EXPECT_NE(said.find("[8/8]"), std::string::npos) << said;
   ASSERT_EQ(run_files(ref.dir).size(), kTrackingRuns);
-  const auto table = read_csv(ref.dir / "table.csv");
+  const auto table = test::read_csv_table(ref.dir / "table.csv");
   ASSERT_EQ(table.size(), 1 + kTrackingRuns);
   // The parameters as columns, then the report's fields, the timing ones last.
   const std::vector<std::string>& h = table[0];
@@ -187,7 +143,7 @@ TEST(Sweep, ASweepFliesEveryRunIntoItsFolderAndTheSecondTimeFliesNothing) {
   EXPECT_NE(again.find("8 finished, 0 to fly"), std::string::npos) << again;
   EXPECT_EQ(count_lines(again, "mixpilot sweep: \\[[0-9]+/8\\] "), 0u) << again;
   for (const auto& [f, t] : times) EXPECT_EQ(fs::last_write_time(ref.dir / "runs" / f), t) << f;
-  EXPECT_EQ(read_csv(ref.dir / "table.csv"), table);
+  EXPECT_EQ(test::read_csv_table(ref.dir / "table.csv"), table);
 }
 
 TEST(Sweep, ARunFileThatIsNotThisPlansIsFlownAgainAndForceFliesAgain) {
@@ -219,7 +175,7 @@ TEST(Sweep, ARunFileThatIsNotThisPlansIsFlownAgainAndForceFliesAgain) {
   EXPECT_EQ(count_lines(said, "\\] 0005-rtt=0.03-compensation=false: "), 1u) << said;
   for (const auto& e : fs::directory_iterator(dir / "runs"))
     EXPECT_EQ(e.path().extension(), ".json") << e.path();
-  EXPECT_EQ(non_timing(read_csv(dir / "table.csv")), non_timing(read_csv(ref.dir / "table.csv")));
+  EXPECT_EQ(test::non_timing(test::read_csv_table(dir / "table.csv")), test::non_timing(test::read_csv_table(ref.dir / "table.csv")));
   // --force flies the selected runs whether finished or not.
   const auto before = fs::last_write_time(dir / "runs" / "0003-rtt=0.012-compensation=false.json");
   ASSERT_EQ(sweep(home, file.string() + " --out " + dir.string() + " --force --shard 4/8", "force.txt"), 0)
@@ -272,7 +228,7 @@ TEST(Sweep, KilledHalfwayItFliesOnlyTheMissingRunsAndTheTableEqualsAnUninterrupt
   // No temporary of a killed run is left.
   for (const auto& e : fs::directory_iterator(dir / "runs"))
     EXPECT_EQ(e.path().extension(), ".json") << e.path();
-  EXPECT_EQ(non_timing(read_csv(dir / "table.csv")), non_timing(read_csv(ref.dir / "table.csv")));
+  EXPECT_EQ(test::non_timing(test::read_csv_table(dir / "table.csv")), test::non_timing(test::read_csv_table(ref.dir / "table.csv")));
 }
 
 TEST(Sweep, TwoJobsGiveTheTableOfOne) {
@@ -282,12 +238,12 @@ TEST(Sweep, TwoJobsGiveTheTableOfOne) {
   ASSERT_EQ(sweep(home, file.string() + " --out " + (home / "results").string() + " --jobs 2"), 0)
       << test::read_file(home / "out.txt");
   EXPECT_NE(test::read_file(home / "out.txt").find("8 to fly on 2 jobs"), std::string::npos);
-  const auto two = read_csv(home / "results" / "table.csv");
-  const auto one = read_csv(ref.dir / "table.csv");
+  const auto two = test::read_csv_table(home / "results" / "table.csv");
+  const auto one = test::read_csv_table(ref.dir / "table.csv");
   ASSERT_EQ(two.size(), one.size());
-  EXPECT_EQ(non_timing(two), non_timing(one));
+  EXPECT_EQ(test::non_timing(two), test::non_timing(one));
   // The comparison has something to compare: the measured fields are there and differ by run.
-  const auto nt = non_timing(one);
+  const auto nt = test::non_timing(one);
   const std::size_t rms = std::size_t(std::find(nt[0].begin(), nt[0].end(), "tracking_rms_m") - nt[0].begin());
   ASSERT_LT(rms, nt[0].size());
   EXPECT_NE(nt[1][rms], nt[4][rms]);  // 0 ms against 12 ms without the predictor
@@ -318,8 +274,8 @@ TEST(Sweep, ShardsFlyTheirRunsOnlyAndTheMergeNamesWhatIsMissing) {
   EXPECT_EQ(run_files(dir).size(), kTrackingRuns);
   ASSERT_EQ(sweep(home, file.string() + " --out " + dir + " --merge", "m2.txt"), 0)
       << test::read_file(home / "m2.txt");
-  EXPECT_EQ(non_timing(read_csv(fs::path(dir) / "table.csv")),
-            non_timing(read_csv(ref.dir / "table.csv")));
+  EXPECT_EQ(test::non_timing(test::read_csv_table(fs::path(dir) / "table.csv")),
+            test::non_timing(test::read_csv_table(ref.dir / "table.csv")));
 }
 
 TEST(Sweep, AChangedSweepFileIsRefusedOnTheFolderOfAnother) {
@@ -449,8 +405,8 @@ TEST(Sweep, AFolderOfRecordingsIsScoredInShardsThatCoverEachRecordingOnce) {
             0)
       << test::read_file(home / "merge.txt");
   // One row per recording, its replay exact, its score the live flight's.
-  const auto table = read_csv(scores / "table.csv");
-  const auto flights = read_csv(flown / "table.csv");
+  const auto table = test::read_csv_table(scores / "table.csv");
+  const auto flights = test::read_csv_table(flown / "table.csv");
   ASSERT_EQ(table.size(), 5u);
   ASSERT_EQ(flights.size(), 5u);
   const auto col = [](const std::vector<std::string>& h, const std::string& n) {
