@@ -1,5 +1,7 @@
 #include "slurm_cluster.hpp"
 
+#include "daemon_process.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -34,7 +36,6 @@ namespace {
 
 constexpr const char* kNode = "localhost";
 constexpr const char* kPartition = "test";
-constexpr int kCannotExec = 121;
 
 // The executable `name` in PATH, or in the system folders where Debian puts daemons.
 std::string find_tool(const std::string& name) {
@@ -48,18 +49,6 @@ std::string find_tool(const std::string& name) {
     if (::access(p.c_str(), X_OK) == 0 && fs::is_regular_file(p)) return p.string();
   }
   return "";
-}
-
-std::string tail_of(const fs::path& file, std::size_t lines) {
-  std::ifstream in(file);
-  std::deque<std::string> last;
-  for (std::string line; std::getline(in, line);) {
-    last.push_back(line);
-    if (last.size() > lines) last.pop_front();
-  }
-  std::string out;
-  for (const auto& l : last) out += "\n  | " + l;
-  return out;
 }
 
 std::string read_all(const fs::path& file) {
@@ -89,34 +78,6 @@ std::vector<std::string> environment_with(
   }
   for (const auto& [k, v] : extra) out.push_back(k + "=" + v);
   return out;
-}
-
-// Starts a daemon: `argv` (argv[0] a full path) with exactly `env`, stdin /dev/null, stdout and
-// stderr appended to `log`, sent `death_signal` when this thread ends. The pid, or -1.
-pid_t spawn_daemon(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-                   const fs::path& log, int death_signal) {
-  std::vector<char*> args = c_strings(argv);
-  std::vector<char*> envp = c_strings(env);
-  const std::string log_path = log.string();
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  // The child: only async-signal-safe calls from here to exec.
-  const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
-  if (fd >= 0) {
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
-  }
-  const int null_in = ::open("/dev/null", O_RDONLY);
-  if (null_in >= 0) ::dup2(null_in, STDIN_FILENO);
-  // Its own process group: a ^C at the terminal reaches the test, which stops the cluster.
-  ::setpgid(0, 0);
-  ::prctl(PR_SET_PDEATHSIG, death_signal);
-  if (::getppid() != parent) ::_exit(1);
-  ::execve(args[0], args.data(), envp.data());
-  const char* what = "cannot exec the daemon\n";
-  (void)!::write(STDERR_FILENO, what, std::strlen(what));
-  ::_exit(kCannotExec);
 }
 
 // Whether `pid` (a child) has ended; reaps it.
@@ -179,7 +140,7 @@ int run_capture(const std::vector<std::string>& argv, const std::vector<std::str
     const int null_in = ::open("/dev/null", O_RDONLY);
     if (null_in >= 0) ::dup2(null_in, STDIN_FILENO);
     ::execve(args[0], args.data(), envp.data());
-    ::_exit(kCannotExec);
+    ::_exit(kDaemonCannotExec);
   }
   ::close(fds[1]);
   if (pid < 0) {
@@ -430,6 +391,8 @@ bool SlurmCluster::launch(std::string& reason, bool& port_taken) {
   const std::vector<std::string> daemon_env = {"PATH=/usr/sbin:/usr/bin:/sbin:/bin", "LC_ALL=C",
                                         "HOME=" + d, "SLURM_CONF=" + conf().string()};
   const auto alive = [](pid_t pid) { return !ended(pid); };
+  DaemonSettings daemon;
+  daemon.own_process_group = true;
 
   if (munged_ <= 0) {
     munged_ = spawn_daemon({find_tool("munged"), "--foreground", "--force",
@@ -437,7 +400,7 @@ bool SlurmCluster::launch(std::string& reason, bool& port_taken) {
                             "--pid-file=" + d + "/munge/munged.pid",
                             "--seed-file=" + d + "/munge/munged.seed",
                             "--log-file=" + d + "/log/munged.log", "--num-threads=2"},
-                           daemon_env, dir / "log" / "munged.out", SIGTERM);
+                           daemon_env, dir / "log" / "munged.out", daemon);
     const auto until = Clock::now() + std::chrono::seconds(30);
     while (!fs::exists(socket)) {
       if (!alive(munged_)) {
@@ -454,9 +417,9 @@ bool SlurmCluster::launch(std::string& reason, bool& port_taken) {
   }
 
   slurmctld_ = spawn_daemon({find_tool("slurmctld"), "-D", "-i", "-f", conf().string()},
-                            daemon_env, dir / "log" / "slurmctld.out", SIGTERM);
+                            daemon_env, dir / "log" / "slurmctld.out", daemon);
   slurmd_ = spawn_daemon({find_tool("slurmd"), "-D", "-N", kNode, "-f", conf().string()},
-                         daemon_env, dir / "log" / "slurmd.out", SIGTERM);
+                         daemon_env, dir / "log" / "slurmd.out", daemon);
   if (slurmctld_ < 0 || slurmd_ < 0) {
     reason = std::string("fork: ") + std::strerror(errno);
     return false;
