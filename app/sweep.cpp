@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
+#include <atomic>
+#include <optional>
 #include <thread>
 
 #include "app/cli.hpp"
@@ -236,15 +238,33 @@ namespace {
 
 // Every run's scenario and options checked as its flight will be set up, before anything is
 // flown: a sweep that cannot fly one of its runs flies none.
-bool check_runs(const SweepPlan& plan, std::string& error) {
+bool check_runs(const SweepPlan& plan, int jobs, std::string& error) {
+  // Every run assembled before any flies, on `jobs` threads (the only part of a sweep before
+  // the flights): each run's complaint, none when it assembles.
+  std::vector<std::optional<std::string>> why(plan.runs.size());
+  std::atomic<std::size_t> next{0};
+  const auto assemble = [&] {
+    for (std::size_t k = next++; k < plan.runs.size(); k = next++) {
+      std::string complaint;
+      int status = kExitOk;
+      if (!FlightRig::assemble(sweep_fly_options(plan, plan.runs[k]), complaint, status))
+        why[k] = std::move(complaint);
+    }
+  };
+  {
+    std::vector<std::thread> pool;
+    const int n = std::max(1, std::min<int>(jobs, int(plan.runs.size())));
+    for (int j = 1; j < n; ++j) pool.emplace_back(assemble);
+    assemble();
+    for (std::thread& t : pool) t.join();
+  }
   // Each complaint once, with the runs it concerns (a bad value of an axis spoils every run
-  // that flies it).
+  // that flies it), in the plan's order.
   std::vector<std::pair<std::string, std::vector<std::string>>> problems;
-  for (const SweepRun& run : plan.runs) {
-    std::string why;
-    int status = kExitOk;
-    if (FlightRig::assemble(sweep_fly_options(plan, run), why, status)) continue;
-    for (const std::string& line : explain_run_error(plan, run, why)) {
+  for (std::size_t k = 0; k < plan.runs.size(); ++k) {
+    if (!why[k]) continue;
+    const SweepRun& run = plan.runs[k];
+    for (const std::string& line : explain_run_error(plan, run, *why[k])) {
       auto it = std::find_if(problems.begin(), problems.end(),
                              [&](const auto& p) { return p.first == line; });
       if (it == problems.end()) it = problems.insert(problems.end(), {line, {}});
@@ -330,7 +350,7 @@ int sweep_command(int argc, char** argv) {
                 dir.c_str());
     return merge(*plan, folder);
   }
-  if (!check_runs(*plan, error)) {
+  if (!check_runs(*plan, a.jobs, error)) {
     std::fprintf(stderr, "%s\n", error.c_str());
     return kExitError;
   }

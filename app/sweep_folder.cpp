@@ -6,7 +6,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -275,10 +277,20 @@ PoolResult run_pool(const char* command, const ResultFolder& folder,
                     const std::vector<std::string>& ids, const std::vector<std::size_t>& todo,
                     std::size_t done_before, std::size_t total, int jobs,
                     const std::function<RunOutcome(std::size_t)>& fly) {
+  // The workers fly; one writer commits each finished run's file (an fsync each, which on a
+  // journalled file system waits for the others' commits) and says it, so that no worker waits
+  // on the disk. A run counts as finished once its file is committed.
+  struct Finished {
+    std::size_t k;
+    RunOutcome out;
+    double wall;  // [s] the flight's
+  };
   PoolResult result;
   std::atomic<std::size_t> next{0};
-  std::size_t completed = 0, finished = done_before;
-  std::mutex io;
+  std::mutex mutex;
+  std::condition_variable ready;
+  std::deque<Finished> queue;
+  std::size_t workers_left = 0;
   const auto t0 = std::chrono::steady_clock::now();
   const auto worker = [&] {
     for (std::size_t n = next++; n < todo.size() && !interrupted(); n = next++) {
@@ -287,13 +299,34 @@ PoolResult run_pool(const char* command, const ResultFolder& folder,
       RunOutcome out = fly(k);
       const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      std::string error = out.error;
-      if (out.ok && !folder.write_run(ids[k], out.json, error)) out.ok = false;
-      const std::lock_guard<std::mutex> lock(io);
+      {
+        const std::lock_guard<std::mutex> lock(mutex);
+        queue.push_back({k, std::move(out), wall});
+      }
+      ready.notify_one();
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      --workers_left;
+    }
+    ready.notify_one();
+  };
+  const auto writer = [&] {
+    std::size_t completed = 0, finished = done_before;
+    for (;;) {
+      std::unique_lock<std::mutex> lock(mutex);
+      ready.wait(lock, [&] { return !queue.empty() || workers_left == 0; });
+      if (queue.empty()) return;
+      Finished f = std::move(queue.front());
+      queue.pop_front();
+      lock.unlock();
+      RunOutcome& out = f.out;
       if (out.interrupted) {
         result.interrupted = true;
         continue;
       }
+      std::string error = out.error;
+      if (out.ok && !folder.write_run(ids[f.k], out.json, error)) out.ok = false;
       ++completed;
       ++result.flown;
       if (out.ok) ++finished;
@@ -305,18 +338,22 @@ PoolResult run_pool(const char* command, const ResultFolder& folder,
           left > 0 ? "; ETA " + duration_text(elapsed / double(completed) * double(left)) : "";
       if (out.ok) {
         std::fprintf(stderr, "mixpilot %s: [%zu/%zu] %s: %s (%s)%s\n", command, finished, total,
-                     ids[k].c_str(), out.said.c_str(), duration_text(wall).c_str(), eta.c_str());
+                     ids[f.k].c_str(), out.said.c_str(), duration_text(f.wall).c_str(),
+                     eta.c_str());
       } else {
         std::fprintf(stderr, "mixpilot %s: [%zu/%zu] %s FAILED: %s%s\n", command, finished, total,
-                     ids[k].c_str(), error.c_str(), eta.c_str());
+                     ids[f.k].c_str(), error.c_str(), eta.c_str());
       }
       std::fflush(stderr);
     }
   };
-  std::vector<std::thread> pool;
   const int n = std::max(1, std::min<int>(jobs, int(todo.size())));
+  workers_left = std::size_t(n);
+  std::thread committing(writer);
+  std::vector<std::thread> pool;
   for (int j = 0; j < n; ++j) pool.emplace_back(worker);
   for (std::thread& t : pool) t.join();
+  committing.join();
   if (interrupted()) result.interrupted = true;
   return result;
 }

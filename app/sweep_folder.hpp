@@ -90,10 +90,10 @@ struct RunOutcome {
   std::string error;
 };
 
-// Flies `todo` (plan indices) on `jobs` threads with fly(index), writing each finished run's
-// file as it ends. Progress on stderr, one line per run: "[done/total] id: said (wall s), ETA".
+// Flies `todo` (plan indices) on `jobs` threads with fly(index); one more thread writes each
+// finished run's file as it ends, so no flight waits on the disk. Progress on stderr, one line per run: "[done/total] id: said (wall s), ETA".
 // `done_before` runs of `total` were finished already. Stops taking runs at ^C or SIGTERM
-// (cli::interrupted(); fly() itself stops its flight). Returns the number of runs that failed.
+// (cli::interrupted(); fly() itself stops its flight). Returns the runs flown and failed.
 struct PoolResult {
   std::size_t flown = 0, failed = 0;
   bool interrupted = false;

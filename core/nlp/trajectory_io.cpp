@@ -1,5 +1,6 @@
 #include "core/nlp/trajectory_io.hpp"
 
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -16,10 +17,11 @@ namespace {
 // Splits a CSV line at commas (no quoting: the format has only numbers and plain names).
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();  // trailing empty cell
+  std::size_t from = 0;
+  for (std::size_t comma; (comma = line.find(',', from)) != std::string::npos; from = comma + 1)
+    cells.emplace_back(line, from, comma - from);
+  if (from < line.size() || (!line.empty() && line.back() == ','))
+    cells.emplace_back(line, from);  // the last cell, empty after a trailing comma
   return cells;
 }
 
@@ -33,11 +35,16 @@ std::string trim(const std::string& s) {
 bool parse_number(const std::string& cell, double& value) {
   const std::string s = trim(cell);
   if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size() && errno != ERANGE && std::isfinite(value) &&
-         std::abs(value) <= kMaxTrajectoryValue;
+  // std::from_chars and strtod both round correctly, so they agree where both read; strtod
+  // reads the rest (a leading '+', hexadecimal) and says what is out of range.
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (ec != std::errc() || ptr != s.data() + s.size()) {
+    char* end = nullptr;
+    errno = 0;
+    value = std::strtod(s.c_str(), &end);
+    if (end != s.c_str() + s.size() || errno == ERANGE) return false;
+  }
+  return std::isfinite(value) && std::abs(value) <= kMaxTrajectoryValue;
 }
 
 std::string where(const std::string& path, int line) {
