@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The README's two commands. Both install missing Debian packages and configure the release
-# preset, then:
+# The README's two commands. Both install the Debian packages they need and configure the
+# release preset, then:
 #   run   builds the mixpilot program only and runs the main job: the window (mixed initiative,
 #         emulated novice) where a display exists, else the headless demo
 #   test  builds everything and runs the whole test suite through CTest
@@ -11,13 +11,23 @@ usage() { echo "usage: packaging/quickstart.sh run|test" >&2; exit 2; }
 [ $# -eq 1 ] || usage
 case "$1" in run|test) ;; *) usage ;; esac
 
-bash packaging/setup-debian.sh
-cmake --preset release >/dev/null
-# `run` builds the one program it runs (the first flight comes before the test suite's build);
-# `test` builds everything.
+# `run` installs and builds only what the program needs, so the first flight comes before the
+# test suite's packages and build; `test` installs and builds everything.
 case "$1" in
-  run) cmake --build --preset release --target mixpilot ;;
-  test) cmake --build --preset release ;;
+  run)
+    bash packaging/setup-debian.sh --run
+    # The test suite is configured only where its packages are (a machine that ran `test`).
+    tests=OFF
+    if dpkg-query -W -f='${Status}\n' libgtest-dev libbenchmark-dev 2>/dev/null |
+        grep -c '^install ok installed$' | grep -qx 2; then
+      tests=ON
+    fi
+    cmake --preset release -DMIXPILOT_BUILD_TESTS=$tests >/dev/null
+    cmake --build --preset release --target mixpilot ;;
+  test)
+    bash packaging/setup-debian.sh
+    cmake --preset release -DMIXPILOT_BUILD_TESTS=ON >/dev/null
+    cmake --build --preset release ;;
 esac
 
 case "$1" in

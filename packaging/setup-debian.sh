@@ -1,8 +1,19 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package mixpilot needs to build, test and run. Idempotent: packages
-# already installed are left alone, and nothing is done when all are present.
-# As root it calls apt-get; otherwise sudo apt-get.
+# Installs the Debian 12 packages mixpilot needs. Idempotent: packages already installed are
+# left alone, and nothing is done when all are present. As root it calls apt-get; otherwise
+# sudo apt-get.
+#
+#   packaging/setup-debian.sh          everything: build, test, fuzz, package and run
+#   packaging/setup-debian.sh --run    only what building and running the program needs (the
+#                                      README's run command: the first flight sooner)
 set -euo pipefail
+
+case "${1:-}" in
+  "") only_run=0 ;;
+  --run) only_run=1 ;;
+  -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  *) echo "usage: packaging/setup-debian.sh [--run]" >&2; exit 2 ;;
+esac
 
 packages=(
   # toolchain
@@ -16,7 +27,7 @@ packages=(
   libsqlite3-dev sqlite3 libssl-dev libpq-dev
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
   libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
-  libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev xvfb xauth
+  libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev
   # videos of replays (mixpilot replay --video, the window's Export clip; ffprobe in the tests)
   ffmpeg
   # gamepads
@@ -24,6 +35,11 @@ packages=(
   # network peers (C API + idlc); openssl makes a training centre's DDS Security CA and
   # certificates (packaging/dds-security-ca.sh, and the security tests' test CA)
   cyclonedds-dev cyclonedds-tools openssl
+)
+# Beyond running: the tests, fuzzing and the Debian package.
+test_packages=(
+  # the tests' display for the window checks (xvfb-run)
+  xvfb xauth
   # tests and benchmarks; the PostgreSQL server the history tests start themselves
   libgtest-dev libgmock-dev libbenchmark-dev valgrind postgresql
   # the single-node Slurm cluster the sweep tests start themselves (tests/slurm_cluster.hpp).
@@ -39,7 +55,8 @@ packages=(
   help2man dpkg-dev lintian desktop-file-utils appstream
 )
 # Debian's npm conflicts with a nodejs that already bundles npm; ask for it only when missing.
-command -v npm >/dev/null 2>&1 || packages+=(npm)
+command -v npm >/dev/null 2>&1 || test_packages+=(npm)
+[ "$only_run" -eq 1 ] || packages+=("${test_packages[@]}")
 
 missing=()
 for p in "${packages[@]}"; do
@@ -49,7 +66,7 @@ for p in "${packages[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "setup-debian: all ${#packages[@]} packages already installed"
+  echo "setup-debian: all ${#packages[@]} packages$([ "$only_run" -eq 0 ] || echo " to run mixpilot") already installed"
   exit 0
 fi
 
