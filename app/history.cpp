@@ -548,7 +548,7 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
   }
   for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
     if (it->path().extension() == ".mcap" && it->is_regular_file(ec))
-      rows.push_back({it->path().string(), {}, ImportRow::State::failed, {}, {}});
+      rows.push_back({it->path().string(), {}, ImportRow::State::failed, {}, {}, {}});
   if (ec) {
     std::fprintf(stderr, "mixpilot history import: %s: %s\n", escape_controls(dir).c_str(),
                  ec.message().c_str());

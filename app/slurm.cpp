@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <deque>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -20,6 +19,7 @@
 
 #include "app/child_process.hpp"
 #include "app/cli.hpp"
+#include "core/base/input_file.hpp"
 
 namespace mixpilot::cli::slurm {
 
@@ -88,19 +88,6 @@ std::string escape_pattern(const std::string& s) {
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
-}
-
-// The last `lines` lines of a file, indented, or "".
-std::string tail_of(const fs::path& file, std::size_t lines) {
-  std::ifstream in(file);
-  std::deque<std::string> last;
-  for (std::string line; std::getline(in, line);) {
-    last.push_back(line);
-    if (last.size() > lines) last.pop_front();
-  }
-  std::string out;
-  for (const auto& l : last) out += "\n    | " + l;
-  return out;
 }
 
 // An array this folder submitted, as DIR/slurm/jobs remembers it.
@@ -634,7 +621,7 @@ ArrayOutcome run_array(const ArrayRequest& r) {
                              : t.word + (t.detail.empty() ? "" : " (" + t.detail + ")");
       std::fprintf(stderr, "slurm: task %d (shard %d of %d) of job %s: %s; its log: %s%s\n",
                    t.shard, t.shard, n, t.job.c_str(), what.c_str(), err.c_str(),
-                   tail_of(err, 5).c_str());
+                   last_lines(err, 5, "    | ").c_str());
     }
     if (missing.empty()) {
       outcome.end = ArrayEnd::complete;

@@ -7,8 +7,8 @@
 
 #include <cerrno>
 #include <cstring>
-#include <deque>
-#include <fstream>
+
+#include "core/base/input_file.hpp"
 
 namespace mixpilot::test {
 
@@ -64,15 +64,7 @@ pid_t spawn_daemon(const std::vector<std::string>& argv, const std::vector<std::
 }
 
 std::string tail_of(const std::filesystem::path& file, std::size_t lines) {
-  std::ifstream in(file);
-  std::deque<std::string> last;
-  for (std::string line; std::getline(in, line);) {
-    last.push_back(line);
-    if (last.size() > lines) last.pop_front();
-  }
-  std::string out;
-  for (const auto& l : last) out += "\n  | " + l;
-  return out;
+  return last_lines(file.string(), lines, "  | ");
 }
 
 }  // namespace mixpilot::test

@@ -975,6 +975,26 @@ TEST(OutputFile, DiscardAndAbandon) {
   EXPECT_FALSE(fs::exists(p));
 }
 
+// A child's log quoted in a message: its last lines in order, each after the prefix, a last
+// line without its newline included, control characters made printable; nothing for a file
+// that cannot be read.
+TEST(InputFile, LastLinesOfALog) {
+  const fs::path dir = temp_path("last_lines");
+  fs::create_directories(dir);
+  const auto log = [&](const std::string& text) {
+    std::ofstream(dir / "log") << text;
+    return (dir / "log").string();
+  };
+  EXPECT_EQ(last_lines(log("a\nb\nc\nd\ne\n"), 3, "| "), "\n| c\n| d\n| e");
+  EXPECT_EQ(last_lines(log("a\nb\nc\nd\ne"), 3, "| "), "\n| c\n| d\n| e");
+  EXPECT_EQ(last_lines(log("a\nb\n"), 3, "| "), "\n| a\n| b");
+  EXPECT_EQ(last_lines(log("a\nb\nc\n"), 3, ""), "\na\nb\nc");
+  EXPECT_EQ(last_lines(log("a\n\x1b[2Jb\n"), 1, "| "), "\n| \\x1B[2Jb");
+  EXPECT_EQ(last_lines(log(""), 3, "| "), "");
+  EXPECT_EQ(last_lines(log("a\n"), 0, "| "), "");
+  EXPECT_EQ(last_lines((dir / "missing").string(), 3, "| "), "");
+}
+
 // An output never replaces a file this process read as an input, by any name: the --force
 // that would turn the recording being scored into its own score is refused. A file read in order
 // to be rewritten (the user's settings) says so.

@@ -242,4 +242,36 @@ inline std::string escape_controls(std::string_view text, bool multiline = false
   return out;
 }
 
+// The last `lines` lines of the text file `path` (a log a child process wrote), each on a line
+// of its own after `prefix`, made printable; "" when it cannot be read.
+inline std::string last_lines(const std::string& path, std::size_t lines, std::string_view prefix) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return "";
+  std::vector<std::string> last;  // a ring of `lines` lines
+  std::size_t count = 0;
+  std::string line;
+  for (int c; lines > 0 && (c = std::getc(f)) != EOF;) {
+    if (c != '\n') {
+      line += char(c);
+      continue;
+    }
+    if (last.size() < lines) last.push_back(std::move(line));
+    else last[count % lines] = std::move(line);
+    ++count;
+    line.clear();
+  }
+  std::fclose(f);
+  if (!line.empty()) {
+    if (last.size() < lines) last.push_back(std::move(line));
+    else if (lines > 0) last[count % lines] = std::move(line);
+    ++count;
+  }
+  std::string out;
+  const std::size_t first = count > lines ? count % lines : 0;
+  for (std::size_t k = 0; k < last.size(); ++k)
+    out.append("\n").append(prefix).append(
+        input_file_detail::escaped(last[(first + k) % last.size()], 400, false));
+  return out;
+}
+
 }  // namespace mixpilot
