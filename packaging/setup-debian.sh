@@ -4,14 +4,14 @@
 # sudo apt-get.
 #
 #   packaging/setup-debian.sh          everything: build, test, fuzz, package and run
-#   packaging/setup-debian.sh --run    only what building and running the program needs (the
-#                                      README's run command: the first flight sooner)
+#   packaging/setup-debian.sh --run    only what building and running the program needs, videos
+#                                      aside (the README's run command: the first flight sooner)
 set -euo pipefail
 
 case "${1:-}" in
   "") only_run=0 ;;
   --run) only_run=1 ;;
-  -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "usage: packaging/setup-debian.sh [--run]" >&2; exit 2 ;;
 esac
 
@@ -28,16 +28,18 @@ packages=(
   # desktop app: ImGui 1.86 with backends, GLFW windows, EGL (Mesa surfaceless) headless rendering
   libimgui-dev libglfw3-dev libgl-dev libegl-dev libegl-mesa0 libgles-dev libepoxy-dev
   libgl1-mesa-dri libfontconfig-dev fonts-dejavu-core libstb-dev
-  # videos of replays (mixpilot replay --video, the window's Export clip; ffprobe in the tests)
-  ffmpeg
   # gamepads
   libsdl2-dev
   # network peers (C API + idlc); openssl makes a training centre's DDS Security CA and
   # certificates (packaging/dds-security-ca.sh, and the security tests' test CA)
   cyclonedds-dev cyclonedds-tools openssl
 )
-# Beyond running: the tests, fuzzing and the Debian package.
+# Beyond running: videos, the tests, fuzzing and the Debian package.
 test_packages=(
+  # videos of replays (mixpilot replay --video, the window's Export clip, which say how to
+  # install it where it is missing; ffprobe in the tests): a hundred packages a first flight
+  # does without
+  ffmpeg
   # the tests' display for the window checks (xvfb-run)
   xvfb xauth
   # tests and benchmarks; the PostgreSQL server the history tests start themselves
