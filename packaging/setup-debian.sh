@@ -11,7 +11,7 @@ set -euo pipefail
 case "${1:-}" in
   "") only_run=0 ;;
   --run) only_run=1 ;;
-  -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "usage: packaging/setup-debian.sh [--run]" >&2; exit 2 ;;
 esac
 
