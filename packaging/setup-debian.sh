@@ -18,8 +18,9 @@ esac
 packages=(
   # toolchain
   g++ cmake ninja-build pkgconf git
-  # core maths: linear algebra, offline NLPs (reference trajectories, converged baselines)
-  libeigen3-dev coinor-libipopt-dev
+  # core maths: linear algebra, offline NLPs (reference trajectories, converged baselines);
+  # Ipopt's pkg-config links -llapack -lblas, whose dev packages it does not pull in itself
+  libeigen3-dev coinor-libipopt-dev liblapack-dev libblas-dev
   # scenario files
   libtomlplusplus-dev
   # the trainee's history: SQLite (sqlite3: its shell, to look into a history), SHA-256 of
