@@ -483,6 +483,41 @@ TEST(QpDump, RoundTripIsExact) {
   EXPECT_FALSE(read_ocp_qp_json("{\"format\":\"other\"}", back, st2, name, err));
   EXPECT_FALSE(read_ocp_qp_json(line.substr(0, line.size() / 2), back, st2, name, err));
   EXPECT_FALSE(err.empty());
+
+  // A closed-loop record: the warm start goes with the QP, and the warm solve from the read
+  // record repeats the original one exactly.
+  std::stringstream ws;
+  write_ocp_qp_json(ws, qp, st, "warm", &r1, QpWarmStart::primal_dual);
+  std::getline(ws, line);
+  OcpQpSolution start;
+  QpWarmStart warm = QpWarmStart::cold;
+  ASSERT_TRUE(read_ocp_qp_json(line, back, st2, name, err, &start, &warm)) << err;
+  EXPECT_EQ(warm, QpWarmStart::primal_dual);
+  for (int i = 0; i <= qp.dims.N; ++i) {
+    EXPECT_TRUE(start.x[i] == r1.x[i] && start.u[i] == r1.u[i] && start.lam_l[i] == r1.lam_l[i] &&
+                start.lam_u[i] == r1.lam_u[i] && start.sl[i] == r1.sl[i] &&
+                start.su[i] == r1.su[i] && start.lam_sl[i] == r1.lam_sl[i] &&
+                start.lam_su[i] == r1.lam_su[i])
+        << i;
+    if (i < qp.dims.N) {
+      EXPECT_TRUE(start.pi[i] == r1.pi[i]) << i;
+    }
+  }
+  OcpQpSolution w1 = r1, w2 = start;
+  ASSERT_EQ(s1.solve(qp, w1, QpWarmStart::primal_dual), QpStatus::success);
+  ASSERT_EQ(s2.solve(back, w2, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_EQ(w1.iterations, w2.iterations);
+  EXPECT_EQ(w1.objective, w2.objective);
+  // Without a start member a warm record is refused; a cold record reads as cold.
+  const std::string no_start = line.substr(0, line.find(",\"start\"")) +
+                               line.substr(line.find(",\"x0\""));
+  EXPECT_FALSE(read_ocp_qp_json(no_start, back, st2, name, err, &start, &warm));
+  EXPECT_NE(err.find("start"), std::string::npos) << err;
+  std::stringstream cs;
+  write_ocp_qp_json(cs, qp, st, "cold", &r1, QpWarmStart::cold);
+  std::getline(cs, line);
+  ASSERT_TRUE(read_ocp_qp_json(line, back, st2, name, err, &start, &warm)) << err;
+  EXPECT_EQ(warm, QpWarmStart::cold);
 }
 
 // --- Condensing + dense IPM (core/qp_condensed_dense): the same contract on short horizons. ---

@@ -109,6 +109,54 @@ TEST(RtiClosedLoop, CrazyflieStepSettles) {
   EXPECT_NEAR(rti.settle_time, sqp.settle_time, 0.3);
 }
 
+// The QP observer sees each feedback phase's QP and warm start exactly as they are solved:
+// solving the observed QP from the observed start with a solver of the same kind gives the
+// loop's own solution bit for bit (what the closed-loop QP sets of mixpilot-bench rely on).
+TEST(RtiQpObserver, SeesEveryQpWithTheWarmStartTheLoopUsed) {
+  CrazyflieTracking problem(kN, kDt);
+  RtiSolver rti;
+  ASSERT_TRUE(rti.setup(problem.ocp()));
+  struct Seen final : RtiQpObserver {
+    std::vector<OcpQp> qps;
+    std::vector<OcpQpSolution> starts;
+    std::vector<QpWarmStart> warm;
+    void on_qp(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart w) override {
+      qps.push_back(qp);
+      starts.push_back(start);
+      warm.push_back(w);
+    }
+  } seen;
+  rti.set_qp_observer(&seen);
+  const OcpTrajectory& ref = smooth_step().trajectory;
+  problem.hover_guess(rti.trajectory(), {0, 0, 0.4});
+  Eigen::VectorXd x = problem.model().hover_state({0, 0, 0.4});
+  std::vector<OcpQpSolution> solved;
+  for (int k = 0; k < 6; ++k) {
+    problem.set_reference(rti.data(), ref, k);
+    rti.prepare();
+    ASSERT_EQ(rti.feedback(x), RtiStatus::success);
+    solved.push_back(rti.qp_solution());
+    x = plant_step(problem.integrator(), x, rti.control());
+    rti.shift();
+  }
+  rti.set_qp_observer(nullptr);
+  ASSERT_EQ(seen.qps.size(), 6u);
+  EXPECT_EQ(seen.warm.front(), QpWarmStart::cold);
+  EXPECT_EQ(seen.warm.back(), QpWarmStart::primal_dual);
+  ASSERT_EQ(rti.settings().qp_solver, QpSolverKind::riccati_ipm_pairs);  // the RTI default
+  QpRiccatiIpmPairs solver(seen.qps[0].dims, rti.settings().qp, rti.settings().qp_pair_levels);
+  for (std::size_t k = 0; k < seen.qps.size(); ++k) {
+    OcpQpSolution sol = seen.starts[k];
+    solver.prepare(seen.qps[k]);
+    ASSERT_EQ(solver.solve(seen.qps[k], sol, seen.warm[k]), QpStatus::success) << k;
+    EXPECT_EQ(sol.iterations, solved[k].iterations) << k;
+    for (int i = 0; i <= kN; ++i) {
+      ASSERT_EQ(sol.x[i], solved[k].x[i]) << k << " stage " << i;
+      ASSERT_EQ(sol.u[i], solved[k].u[i]) << k << " stage " << i;
+    }
+  }
+}
+
 // A hard 1.5 m step (the reference jumps to the target at once) is beyond what one Gauss-Newton
 // step per sample can follow, and the vehicle tumbles; its QPs must still all be solved. The
 // primal-dual warm start from a trajectory that swings between samples used to end in min_step

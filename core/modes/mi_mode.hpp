@@ -52,6 +52,7 @@ class MiMode final : public Mode {
   double lost_at() const override { return run_.lost_at; }
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
+  RtiSolver* rti_solver() override { return &controller_.rti(); }
   [[nodiscard]] bool set_authority_bounds(const AuthorityBounds& bounds) override {
     if (!bounds.valid()) return false;
     controller_.set_bounds(bounds);

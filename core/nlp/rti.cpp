@@ -254,7 +254,7 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
   RtiState& st = state_;
   if (!st.prepared) return RtiStatus::not_prepared;
   st.prepared = false;
-  const auto t0 = Clock::now();
+  auto t0 = Clock::now();
   qp_.x0 = x0 - st.trajectory.x[0];
 
   RtiStatus status = RtiStatus::fallback;
@@ -264,6 +264,11 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
     const QpWarmStart warm = settings_.qp_warm_start && st.have_qp_solution
                                  ? QpWarmStart::primal_dual
                                  : QpWarmStart::cold;
+    if (observer_) {  // a tool's time, not the feedback phase's
+      const auto o0 = Clock::now();
+      observer_->on_qp(qp_, st.qp_solution, warm);
+      t0 += Clock::now() - o0;
+    }
     stats.qp_status = qp_solver().solve(qp_, st.qp_solution, warm);
     stats.qp_iterations = st.qp_solution.iterations;
     const double elapsed_us = stats.integration_us + stats.linearization_us + micros_since(t0);
