@@ -936,6 +936,41 @@ TEST(QpCondensedDense, ActiveSetFallsBackToTheIpm) {
 
 // The benchmark QPs through partial condensing: the same solution as the plain Riccati IPM,
 // and a primal-dual warm start with a changed x0 as in the RTI feedback phase.
+// RTI's preparation phase (QpSolver::prepare with the warm start) factorizes the first Newton
+// system of stages N..1 before x0 is known: prepared on the QP with the previous x0, then solved
+// with the new one, the solve is the plain warm solve's bit for bit (stage 0 is initialized and
+// factorized again with the new x0), for the stage-wise solver and behind pair condensing (whose
+// first block's constraints do involve x0).
+TEST_P(ControllerQp, PreparedWarmStartSolvesAsThePlainWarmStart) {
+  const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
+                   : GetParam() == 1 ? testing_qp::crazyflie_qp()
+                                     : testing_qp::pendubot_qp();
+  QpRiccatiIpm plain(qp.dims, tight()), prepared(qp.dims, tight());
+  QpRiccatiIpmPairs pairs_plain(qp.dims, tight()), pairs_prepared(qp.dims, tight());
+  OcpQpSolution start(qp.dims);
+  ASSERT_EQ(plain.solve(qp, start), QpStatus::success);
+  OcpQp moved = qp;
+  moved.x0 += 1e-2 * Eigen::VectorXd::Ones(qp.x0.size());
+  for (auto [a, b] : {std::pair<QpSolver*, QpSolver*>{&plain, &prepared},
+                      std::pair<QpSolver*, QpSolver*>{&pairs_plain, &pairs_prepared}}) {
+    OcpQpSolution sa = start, sb = start;
+    ASSERT_EQ(a->solve(moved, sa, QpWarmStart::primal_dual), QpStatus::success);
+    OcpQp stale = moved;
+    stale.x0 = qp.x0;  // the preparation does not know x0 yet
+    b->prepare(stale, sb, QpWarmStart::primal_dual);
+    stale.x0 = moved.x0;
+    ASSERT_EQ(b->solve(stale, sb, QpWarmStart::primal_dual), QpStatus::success);
+    EXPECT_EQ(sa.iterations, sb.iterations);
+    EXPECT_GT(sa.iterations, 0);
+    for (int i = 0; i <= qp.dims.N; ++i) {
+      ASSERT_EQ(sa.x[i], sb.x[i]) << i;
+      ASSERT_EQ(sa.u[i], sb.u[i]) << i;
+      ASSERT_EQ(sa.lam_l[i], sb.lam_l[i]) << i;
+    }
+    EXPECT_LE(kkt_residuals(moved, sb).max(), 1e-8);
+  }
+}
+
 TEST_P(ControllerQp, PairsMatchThePlainSolverColdAndWarm) {
   const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
                    : GetParam() == 1 ? testing_qp::crazyflie_qp()

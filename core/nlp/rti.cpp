@@ -239,7 +239,9 @@ RtiStatus RtiSolver::prepare() {
     linearize_cost(i);
     linearize_constraints(i);
   }
-  qp_solver().prepare(qp_);  // the x̄_0-free part of the QP solver's work (condensing)
+  // The x̄_0-free part of the QP solver's work: its layout, condensing, and with the warm start
+  // the first factorization of every stage but the first.
+  qp_solver().prepare(qp_, state_.qp_solution, warm_start());
   RtiStats& stats = state_.stats;
   stats.integration_us = std::chrono::duration<double, std::micro>(t1 - t0).count();
   stats.linearization_us = micros_since(t1);
@@ -261,9 +263,7 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
   RtiStats& stats = st.stats;
   stats.qp_iterations = 0;
   if (stats.linearization_finite) {
-    const QpWarmStart warm = settings_.qp_warm_start && st.have_qp_solution
-                                 ? QpWarmStart::primal_dual
-                                 : QpWarmStart::cold;
+    const QpWarmStart warm = warm_start();
     if (observer_) {  // a tool's time, not the feedback phase's
       const auto o0 = Clock::now();
       observer_->on_qp(qp_, st.qp_solution, warm);

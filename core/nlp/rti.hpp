@@ -168,6 +168,11 @@ class RtiSolver {
   bool restore(const RtiState& state);
 
  private:
+  // How the next QP starts: from the previous (shifted) solution when there is one.
+  QpWarmStart warm_start() const {
+    return settings_.qp_warm_start && state_.have_qp_solution ? QpWarmStart::primal_dual
+                                                              : QpWarmStart::cold;
+  }
   void linearize_cost(int i);
   void linearize_constraints(int i);
 

@@ -196,51 +196,53 @@ static void eval_constraints(const QpRiccatiIpmWorkspace& w, int i, const Eigen:
 }
 
 void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm) {
+  for (int i = 0; i <= ws_.dims.N; ++i) initialize_stage(qp, sol, warm, i);
+}
+
+void QpRiccatiIpm::initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm,
+                                    int i) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   const bool primal = warm != QpWarmStart::cold;
   const bool dual = warm == QpWarmStart::primal_dual;
   const double thr = dual ? settings_.warm_start_floor : settings_.init_slack;
-  for (int i = 0; i <= d.N; ++i) {
-    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
-    const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
-    if (primal) {
-      w.v.segment(ov, nu) = sol.u[i];
-      w.v.segment(ov + nu, nx) = sol.x[i];
-      w.s.segment(os, ns) = sol.sl[i].cwiseMax(0.0);
-      w.s.segment(os + ns, ns) = sol.su[i].cwiseMax(0.0);
-    } else {
-      w.v.segment(ov, nu + nx).setZero();
-      w.s.segment(os, 2 * ns).setZero();
-    }
-    for (int j = 0; j < 2 * ns; ++j)
-      if (w.slive[os + j] == 0.0) w.s[os + j] = w.sfix[os + j];
-    if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
-    if (i < d.N) {
-      if (dual)
-        w.pi.segment(w.off_pi[i], d.nx[i + 1]) = sol.pi[i];
-      else
-        w.pi.segment(w.off_pi[i], d.nx[i + 1]).setZero();
-    }
-    eval_constraints(w, i, w.v, w.dd);
-    for (int k = 0; k < nc; ++k) {
-      const int j = w.soft_of[i][k];
-      const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
-      w.t[om + k] = w.dd[oc + k] - w.lbnd[oc + k] + sl;
-      w.t[om + nc + k] = w.ubnd[oc + k] - w.dd[oc + k] + su;
-      if (dual) {
-        w.lam[om + k] = sol.lam_l[i][k];
-        w.lam[om + nc + k] = sol.lam_u[i][k];
-      }
-    }
-    w.t.segment(om + 2 * nc, 2 * ns) = w.s.segment(os, 2 * ns);
+  const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
+  const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
+  if (primal) {
+    w.v.segment(ov, nu) = sol.u[i];
+    w.v.segment(ov + nu, nx) = sol.x[i];
+    w.s.segment(os, ns) = sol.sl[i].cwiseMax(0.0);
+    w.s.segment(os + ns, ns) = sol.su[i].cwiseMax(0.0);
+  } else {
+    w.v.segment(ov, nu + nx).setZero();
+    w.s.segment(os, 2 * ns).setZero();
+  }
+  for (int j = 0; j < 2 * ns; ++j)
+    if (w.slive[os + j] == 0.0) w.s[os + j] = w.sfix[os + j];
+  if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
+  if (i < d.N) {
+    if (dual)
+      w.pi.segment(w.off_pi[i], d.nx[i + 1]) = sol.pi[i];
+    else
+      w.pi.segment(w.off_pi[i], d.nx[i + 1]).setZero();
+  }
+  eval_constraints(w, i, w.v, w.dd);
+  for (int k = 0; k < nc; ++k) {
+    const int j = w.soft_of[i][k];
+    const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
+    w.t[om + k] = w.dd[oc + k] - w.lbnd[oc + k] + sl;
+    w.t[om + nc + k] = w.ubnd[oc + k] - w.dd[oc + k] + su;
     if (dual) {
-      w.lam.segment(om + 2 * nc, ns) = sol.lam_sl[i];
-      w.lam.segment(om + 2 * nc + ns, ns) = sol.lam_su[i];
+      w.lam[om + k] = sol.lam_l[i][k];
+      w.lam[om + nc + k] = sol.lam_u[i][k];
     }
   }
-  const int m = static_cast<int>(w.t.size());
-  for (int k = 0; k < m; ++k) {
+  w.t.segment(om + 2 * nc, 2 * ns) = w.s.segment(os, 2 * ns);
+  if (dual) {
+    w.lam.segment(om + 2 * nc, ns) = sol.lam_sl[i];
+    w.lam.segment(om + 2 * nc + ns, ns) = sol.lam_su[i];
+  }
+  for (int k = om; k < om + 2 * nc + 2 * ns; ++k) {
     if (w.mask[k] == 0.0) {
       w.t[k] = 1.0;
       w.lam[k] = 0.0;
@@ -256,18 +258,14 @@ void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmS
   // for Δs ≈ −z/W, only a tiny step fits, and Mehrotra's second-order term Δλ_aff∘Δt_aff ≈ −z²/W
   // then drives s and t_s up by orders of magnitude. With Z = 0 nothing pulls them back and the
   // solve ends in min_step (an ℓ2² weight Z > 0 had masked this).
-  for (int i = 0; i <= d.N; ++i) {
-    const OcpQpStage& st = qp.stage[i];
-    const int ns = d.ns[i], nc = w.nc[i], os = w.off_s[i], om = w.off_m[i];
-    for (int j = 0; j < ns; ++j) {
-      const int k = st.idxs[j];
-      const int ml = om + 2 * nc + j, mu = om + 2 * nc + ns + j;
-      if (w.mask[ml] != 0.0)
-        w.lam[ml] = std::max(w.lam[ml], st.Zl[j] * w.s[os + j] + st.zl[j] - w.lam[om + k]);
-      if (w.mask[mu] != 0.0)
-        w.lam[mu] =
-            std::max(w.lam[mu], st.Zu[j] * w.s[os + ns + j] + st.zu[j] - w.lam[om + nc + k]);
-    }
+  const OcpQpStage& st = qp.stage[i];
+  for (int j = 0; j < ns; ++j) {
+    const int k = st.idxs[j];
+    const int ml = om + 2 * nc + j, mu = om + 2 * nc + ns + j;
+    if (w.mask[ml] != 0.0)
+      w.lam[ml] = std::max(w.lam[ml], st.Zl[j] * w.s[os + j] + st.zl[j] - w.lam[om + k]);
+    if (w.mask[mu] != 0.0)
+      w.lam[mu] = std::max(w.lam[mu], st.Zu[j] * w.s[os + ns + j] + st.zu[j] - w.lam[om + nc + k]);
   }
 }
 
@@ -361,13 +359,16 @@ double QpRiccatiIpm::stationarity_norm(const Eigen::VectorXd& rv, const Eigen::V
   return r;
 }
 
-bool QpRiccatiIpm::factorize(const OcpQp& qp) {
+bool QpRiccatiIpm::factorize(const OcpQp& qp, int first, int last) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   // 1/t once per iteration: the directions below then multiply instead of divide.
-  w.inv_t = w.mask.cwiseQuotient(w.t);
-  w.w = w.lam.cwiseProduct(w.inv_t);
-  for (int i = d.N; i >= 0; --i) {
+  const int m0 = w.off_m[first];
+  const int m1 = last < d.N ? w.off_m[last + 1] : static_cast<int>(w.t.size());
+  w.inv_t.segment(m0, m1 - m0) = w.mask.segment(m0, m1 - m0).cwiseQuotient(w.t.segment(m0, m1 - m0));
+  w.w.segment(m0, m1 - m0) =
+      w.lam.segment(m0, m1 - m0).cwiseProduct(w.inv_t.segment(m0, m1 - m0));
+  for (int i = last; i >= first; --i) {
     const OcpQpStage& st = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
     const int nb = d.nbu[i] + d.nbx[i];
@@ -629,14 +630,36 @@ double step_length(const QpRiccatiIpmWorkspace& w, double eta, double tol_comp) 
 }
 }  // namespace
 
-QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
-  Workspace& w = ws_;
-  if (!ready_ || !ocp_qp_valid_for(qp, w.dims, settings_.check_data))
-    return sol.set_invalid_data();
+void QpRiccatiIpm::prepare(const OcpQp& qp) {
+  loaded_ = prefactored_ = false;
+  if (!ready_ || !ocp_qp_valid_for(qp, ws_.dims, settings_.check_data)) return;
   load(qp);
-  initialize(qp, sol, warm);
+  loaded_ = true;
+}
+
+void QpRiccatiIpm::prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
+  prepare(qp);
+  if (!loaded_ || warm != QpWarmStart::primal_dual || ws_.dims.N == 0) return;
+  // Stages 1..N start from `start` whatever x0 is; stage 0 (x_0 = x0) is initialized again in
+  // solve(). Their factorization needs W = λ/t and the Hessian only.
+  for (int i = 1; i <= ws_.dims.N; ++i) initialize_stage(qp, start, warm, i);
+  prefactored_ = factorize(qp, 1, ws_.dims.N);
+}
+
+QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
+  const bool loaded = loaded_;
+  const bool prefactored = prefactored_ && warm == QpWarmStart::primal_dual;
+  loaded_ = prefactored_ = false;
+  if (!ready_ || (!loaded && !ocp_qp_valid_for(qp, ws_.dims, settings_.check_data)) ||
+      (loaded && settings_.check_data && !qp.x0.allFinite()))  // prepare() checked the rest
+    return sol.set_invalid_data();
+  if (!loaded) load(qp);
+  if (prefactored)
+    initialize_stage(qp, sol, warm, 0);  // the rest is the prepared start
+  else
+    initialize(qp, sol, warm);
   int it = 0;
-  QpStatus status = iterate(qp, settings_.max_iterations, it);
+  QpStatus status = iterate(qp, settings_.max_iterations, it, prefactored);
   if (status == QpStatus::min_step && warm != QpWarmStart::cold) {
     int it_cold = 0;
     initialize(qp, sol, QpWarmStart::cold);
@@ -649,7 +672,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
   return status;
 }
 
-QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it) {
+QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, bool prefactored) {
   Workspace& w = ws_;
   const Settings& cfg = settings_;
   QpStatus status = QpStatus::max_iterations;
@@ -669,7 +692,9 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it) {
       status = QpStatus::max_iterations;
       break;
     }
-    if (!factorize(qp)) {
+    const bool factorized = it == 0 && prefactored ? factorize(qp, 0, 0)
+                                                   : factorize(qp, 0, w.dims.N);
+    if (!factorized) {
       status = QpStatus::factorization_failed;
       break;
     }

@@ -234,9 +234,10 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   t.zu.tail(ns1) = s1.zu;
 }
 
-void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
+bool QpRiccatiIpmPairs::condense(const OcpQp& qp) {
   prepared_ = false;
-  if (!ready_ || !ocp_qp_valid_for(qp, dims_, settings_.check_data)) return;
+  restricted_ = false;
+  if (!ready_ || !ocp_qp_valid_for(qp, dims_, settings_.check_data)) return false;
   for (std::size_t j = 0; j < first_.size(); ++j) {
     if (count_[j] == 2) {
       condense_pair(qp, static_cast<int>(j));
@@ -246,7 +247,23 @@ void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
     }
   }
   set_inner_settings();
+  return true;
+}
+
+void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
+  if (!condense(qp)) return;
   inner_->prepare(qpc_);  // a nested level condenses its pairs (x0 plays no part)
+  prepared_ = true;
+}
+
+void QpRiccatiIpmPairs::prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
+  if (!condense(qp)) return;
+  qpc_.x0 = qp.x0;  // not read by the preparation; set for a consistent QP
+  if (warm != QpWarmStart::cold) {
+    restrict_warm_start(start);
+    restricted_ = true;
+  }
+  inner_->prepare(qpc_, solc_, warm);
   prepared_ = true;
 }
 
@@ -340,7 +357,8 @@ QpStatus QpRiccatiIpmPairs::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmSta
   if (!prepared_) return sol.set_invalid_data();
   prepared_ = false;
   qpc_.x0 = qp.x0;
-  if (warm != QpWarmStart::cold) restrict_warm_start(sol);
+  if (warm != QpWarmStart::cold && !restricted_) restrict_warm_start(sol);
+  restricted_ = false;
   inner_->solve(qpc_, solc_, warm);
   expand(qp, sol);
   return sol.status;

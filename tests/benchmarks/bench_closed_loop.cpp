@@ -51,7 +51,7 @@ void BM_QpSolveClosed(benchmark::State& state, const QpSetSpec& spec) {
     qp = c.qp;  // same sizes: copies without allocating
     sol = c.start;
     const auto t0 = Clock::now();
-    solver->prepare(qp);
+    solver->prepare(qp, sol, c.warm);  // as the RTI's preparation phase
     const auto t1 = Clock::now();
     const QpStatus st = solver->solve(qp, sol, c.warm);
     const auto t2 = Clock::now();

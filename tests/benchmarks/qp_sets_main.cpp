@@ -1,9 +1,9 @@
 // mixpilot-qpsets: solves every QP of the closed-loop QP sets (tests/benchmarks/qp_sets.hpp)
 // once, as BM_QpSolve/closed_* does, and prints per set the QPs, their IPM iterations and how
 // many failed. Made for instruction counts, which are repeatable on a loaded machine:
-//   MIXPILOT_QP_SETS=/tmp/qpsets valgrind --tool=callgrind \
+//   MIXPILOT_QP_SETS=/tmp/qpsets valgrind --tool=callgrind
 //       --toggle-collect='mixpilot::bench::solve_set_once*' mixpilot-qpsets closed_mi_novice
-// gives the instructions of the whole set (÷ its QPs: per QP); the preparation (the
+// (one command line) gives the instructions of the whole set (÷ its QPs: per QP); the preparation (the
 // x̄_0-free part) and the solve are the inclusive costs of prepare_qp and solve_qp.
 // Arguments: set names (default: all).
 #include <algorithm>
@@ -15,8 +15,9 @@
 
 namespace mixpilot::bench {
 
-__attribute__((noinline)) void prepare_qp(QpSolver& solver, const OcpQp& qp) {
-  solver.prepare(qp);
+__attribute__((noinline)) void prepare_qp(QpSolver& solver, const OcpQp& qp,
+                                          const OcpQpSolution& start, QpWarmStart warm) {
+  solver.prepare(qp, start, warm);  // as the RTI's preparation phase
 }
 __attribute__((noinline)) QpStatus solve_qp(QpSolver& solver, const OcpQp& qp, OcpQpSolution& sol,
                                             QpWarmStart warm) {
@@ -33,7 +34,7 @@ __attribute__((noinline)) SetResult solve_set_once(const QpSet& set, QpSolver& s
   for (const ClosedLoopQp& c : set.qps) {
     qp = c.qp;
     sol = c.start;
-    prepare_qp(solver, qp);
+    prepare_qp(solver, qp, sol, c.warm);
     if (solve_qp(solver, qp, sol, c.warm) != QpStatus::success) ++r.failed;
     ++r.qps;
     r.iterations += sol.iterations;
