@@ -235,7 +235,9 @@ void write_ocp_qp_json(std::ostream& o, const OcpQp& qp, const QpRiccatiIpmSetti
       {"tol_stat", st.tol_stat}, {"tol_eq", st.tol_eq}, {"tol_ineq", st.tol_ineq},
       {"tol_comp", st.tol_comp}, {"step_fraction", st.step_fraction}, {"min_step", st.min_step},
       {"init_slack", st.init_slack}, {"init_mu", st.init_mu},
-      {"warm_start_floor", st.warm_start_floor}, {"psd_tol", st.psd_tol},
+      {"warm_start_floor", st.warm_start_floor},
+      {"warm_start_slack_floor", st.warm_start_slack_floor},
+      {"warm_start_violated", st.warm_start_violated}, {"psd_tol", st.psd_tol},
       {"refine_ratio", st.refine_ratio}, {"inf_bound", st.inf_bound}};
   for (const auto& [k, v] : tols) {
     o << ",\"" << k << "\":";
@@ -358,6 +360,15 @@ bool read_ocp_qp_json(const std::string& line, OcpQp& qp, QpRiccatiIpmSettings& 
        r.number(*settings, "psd_tol", st.psd_tol) &&
        r.number(*settings, "refine_ratio", st.refine_ratio) &&
        r.number(*settings, "inf_bound", st.inf_bound);
+  if (!ok) {
+    error = r.err;
+    return false;
+  }
+  // Written since version 2 (older dumps: the defaults).
+  if (settings->get("warm_start_slack_floor"))
+    ok = r.number(*settings, "warm_start_slack_floor", st.warm_start_slack_floor);
+  if (ok && settings->get("warm_start_violated"))
+    ok = r.number(*settings, "warm_start_violated", st.warm_start_violated);
   if (!ok) {
     error = r.err;
     return false;

@@ -205,7 +205,8 @@ void QpRiccatiIpm::initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, Q
   const OcpQpDims& d = w.dims;
   const bool primal = warm != QpWarmStart::cold;
   const bool dual = warm == QpWarmStart::primal_dual;
-  const double thr = dual ? settings_.warm_start_floor : settings_.init_slack;
+  const double thr = dual ? settings_.warm_start_slack_floor : settings_.init_slack;
+  const double lam_floor = settings_.warm_start_floor;
   const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
   const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
   if (primal) {
@@ -248,8 +249,17 @@ void QpRiccatiIpm::initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, Q
       w.lam[k] = 0.0;
       continue;
     }
-    w.t[k] = std::max(w.t[k], thr);
-    w.lam[k] = dual ? std::max(w.lam[k], thr) : settings_.init_mu / w.t[k];
+    // A warm start: a hard constraint the new data violate (t ≤ 0) starts with the violation's
+    // size, at least warm_start_violated, so that the first step has room to restore it
+    // (floored at the tiny warm_start_slack_floor it blocks the step, and the solve ends in
+    // min_step and a cold restart); a soft one's slack absorbs its violation instead.
+    const int kc = k - om;
+    const bool hard = kc < 2 * nc && w.soft_of[i][kc < nc ? kc : kc - nc] < 0;
+    if (dual && hard && w.t[k] <= 0.0)
+      w.t[k] = std::max(-w.t[k], settings_.warm_start_violated);
+    else
+      w.t[k] = std::max(w.t[k], thr);
+    w.lam[k] = dual ? std::max(w.lam[k], lam_floor) : settings_.init_mu / w.t[k];
   }
   if (dual) return;
   // Cold multipliers of s ≥ 0 on the slack's stationarity Z s + z − λ_b − λ_s = 0 (linear, and

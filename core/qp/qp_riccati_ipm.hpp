@@ -104,7 +104,7 @@ class QpRiccatiIpm final : public QpSolver {
   // as the warm start when requested). Never allocates, throws or prints. On any status other
   // than success, sol holds the last finite iterate (or zeros for invalid_data) and no NaN.
   // A warm start that ends in min_step (an iterate far from the new problem's central path: a
-  // large λ on a constraint the new data violate, its t clipped to warm_start_floor) is
+  // large λ on a constraint the new data violate, its t clipped to warm_start_slack_floor) is
   // restarted cold with the iterations left; sol.iterations counts both.
   QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
                  QpWarmStart warm = QpWarmStart::cold) override;

@@ -28,7 +28,9 @@ struct QpRiccatiIpmSettings {
   double min_step = qp_defaults::kMinStep;
   double init_slack = qp_defaults::kInitSlack;
   double init_mu = qp_defaults::kInitMu;
-  double warm_start_floor = qp_defaults::kWarmStartFloor;
+  double warm_start_floor = qp_defaults::kWarmStartFloor;              // λ
+  double warm_start_slack_floor = qp_defaults::kWarmStartSlackFloor;  // t
+  double warm_start_violated = qp_defaults::kWarmStartViolated;       // t of a violated hard row
   double psd_tol = qp_defaults::kPsdTol;
   double inf_bound = qp_defaults::kInfBound;
   // Iterative refinement of each iteration's final Newton direction: at most refinement_steps,
