@@ -146,6 +146,7 @@ QpSet closed_loop_set(const QpSetSpec& spec, int count, std::string& error) {
     return set;
   }
   set.rti = rti->settings();
+  if (std::getenv("XP_STAGEWISE")) set.rti.qp_solver = QpSolverKind::riccati_ipm;
   const char* dir = std::getenv("MIXPILOT_QP_SETS");
   const std::string cache =
       dir && *dir ? std::string(dir) + "/" + spec.name + ".qps" : std::string();
