@@ -146,7 +146,11 @@ QpSet closed_loop_set(const QpSetSpec& spec, int count, std::string& error) {
     return set;
   }
   set.rti = rti->settings();
-  if (std::getenv("XP_STAGEWISE")) set.rti.qp_solver = QpSolverKind::riccati_ipm;
+  if (const char* kind = std::getenv("MIXPILOT_QP_SET_SOLVER")) {  // compare the variants
+    const std::string k = kind;
+    if (k == "riccati_ipm") set.rti.qp_solver = QpSolverKind::riccati_ipm;
+    if (k == "riccati_ipm_pairs") set.rti.qp_solver = QpSolverKind::riccati_ipm_pairs;
+  }
   const char* dir = std::getenv("MIXPILOT_QP_SETS");
   const std::string cache =
       dir && *dir ? std::string(dir) + "/" + spec.name + ".qps" : std::string();

@@ -5,7 +5,8 @@
 // same build; MIXPILOT_QP_SETS=DIR keeps them in DIR/<set>.qps (a raw binary cache, not a
 // format: the build that wrote it reads it) so that two builds can be timed on identical QPs,
 // and MIXPILOT_DUMP_QP=FILE appends them to FILE as JSON lines with their warm starts
-// (docs/qp-dump-format.md) for other solvers.
+// (docs/qp-dump-format.md) for other solvers. MIXPILOT_QP_SET_SOLVER=riccati_ipm (or
+// riccati_ipm_pairs) solves the sets with that variant instead of the loop's, to compare them.
 #include <cstdint>
 #include <memory>
 #include <string>
