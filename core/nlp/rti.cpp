@@ -137,8 +137,6 @@ void RtiSolver::linearize_cost(int i) {
       const int z = zi(k);
       r(k) = (z < nx ? x(z) : traj.u[i](z - nx)) - data_.yref[i](k);
     }
-    auto wr = ws_.y.head(ny);
-    wr.noalias() = W * r;
     s.Q.setZero();
     s.q.setZero();
     if (!terminal) {
@@ -146,7 +144,29 @@ void RtiSolver::linearize_cost(int i) {
       s.R.setZero();
       s.r.setZero();
     }
+    // A diagonal W (the controllers' usual weights) contributes its diagonal only: one pass
+    // over the off-diagonal entries (contiguous runs, no branches) instead of a branch on each
+    // of the ny² entries. The same additions in the same order as the general loop below.
+    double off = 0.0;
     for (int l = 0; l < ny; ++l) {
+      const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
+      for (int k = 0; k < l; ++k) off += std::abs(col[k]);
+      for (int k = l + 1; k < ny; ++k) off += std::abs(col[k]);
+    }
+    const bool diagonal = off == 0.0;  // NaN or ∞ anywhere off the diagonal: the general loop
+    auto wr = ws_.y.head(ny);
+    if (diagonal)
+      wr = W.diagonal().cwiseProduct(r);
+    else
+      wr.noalias() = W * r;
+    for (int l = 0; diagonal && l < ny; ++l) {
+      const int z = zi(l);
+      const double w = W(l, l);
+      if (w == 0.0) continue;
+      if (z < nx) s.Q(z, z) += w;
+      else s.R(z - nx, z - nx) += w;
+    }
+    for (int l = 0; !diagonal && l < ny; ++l) {
       const int zl = zi(l);
       const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
       for (int k = 0; k < ny; ++k) {
