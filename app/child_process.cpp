@@ -1,6 +1,7 @@
 #include "app/child_process.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstring>
 
@@ -60,19 +62,21 @@ ChildProcess::~ChildProcess() {
 void ChildProcess::close_fds() {
   close_fd(in_);
   close_fd(err_);
+  close_fd(out_);
 }
 
 bool ChildProcess::start(const std::string& program, const std::vector<std::string>& args,
-                         Input input, std::string& error) {
+                         Input input, std::string& error, Output output) {
   if (pid_ > 0) {
     error = "a child process is running already";
     return false;
   }
   close_fds();  // a previous child's standard error
-  int in[2] = {-1, -1}, err[2] = {-1, -1};
-  if ((input == Input::pipe && ::pipe2(in, O_CLOEXEC) != 0) || ::pipe2(err, O_CLOEXEC) != 0) {
+  int in[2] = {-1, -1}, err[2] = {-1, -1}, out[2] = {-1, -1};
+  if ((input == Input::pipe && ::pipe2(in, O_CLOEXEC) != 0) || ::pipe2(err, O_CLOEXEC) != 0 ||
+      (output == Output::pipe && ::pipe2(out, O_CLOEXEC) != 0)) {
     error = std::string("cannot make a pipe: ") + std::strerror(errno);
-    for (int fd : {in[0], in[1], err[0], err[1]})
+    for (int fd : {in[0], in[1], err[0], err[1], out[0], out[1]})
       if (fd >= 0) ::close(fd);
     return false;
   }
@@ -83,7 +87,8 @@ bool ChildProcess::start(const std::string& program, const std::vector<std::stri
   posix_spawn_file_actions_init(&actions);
   if (input == Input::pipe) posix_spawn_file_actions_adddup2(&actions, in[0], STDIN_FILENO);
   else posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  if (output == Output::pipe) posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  else posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   posix_spawn_file_actions_adddup2(&actions, err[1], STDERR_FILENO);
   // Nothing else of this process reaches the child (a window's or a library's descriptors).
   posix_spawn_file_actions_addclosefrom_np(&actions, STDERR_FILENO + 1);
@@ -110,16 +115,19 @@ bool ChildProcess::start(const std::string& program, const std::vector<std::stri
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   if (in[0] >= 0) ::close(in[0]);
+  if (out[1] >= 0) ::close(out[1]);
   ::close(err[1]);
   if (rc != 0) {
     error = "cannot run " + program + ": " + std::strerror(rc);
     if (in[1] >= 0) ::close(in[1]);
+    if (out[0] >= 0) ::close(out[0]);
     ::close(err[0]);
     return false;
   }
   pid_ = pid;
   in_ = in[1];
   err_ = err[0];
+  out_ = out[0];
   return true;
 }
 
@@ -146,10 +154,13 @@ void ChildProcess::error_nonblocking() {
   if (err_ >= 0) ::fcntl(err_, F_SETFL, ::fcntl(err_, F_GETFL) | O_NONBLOCK);
 }
 
-bool ChildProcess::read_error(std::string& text) {
+namespace {
+
+// Reads what is there from `fd` into `text`; false at its end.
+bool read_some(int fd, std::string& text) {
   char buf[4096];
-  while (err_ >= 0) {
-    const ssize_t n = ::read(err_, buf, sizeof buf);
+  while (fd >= 0) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n > 0) {
       text.append(buf, std::size_t(n));
       return true;
@@ -160,6 +171,11 @@ bool ChildProcess::read_error(std::string& text) {
   }
   return false;
 }
+
+}  // namespace
+
+bool ChildProcess::read_error(std::string& text) { return read_some(err_, text); }
+bool ChildProcess::read_output(std::string& text) { return read_some(out_, text); }
 
 void ChildProcess::signal(int sig) {
   if (pid_ > 0) ::kill(pid_, sig);
@@ -195,6 +211,37 @@ ChildExit ChildProcess::wait() {
   pid_ = -1;
   close_fd(in_);
   return r < 0 ? ChildExit{false, 0} : exit_of(status);
+}
+
+bool run_program(const std::string& program, const std::vector<std::string>& args,
+                 double timeout_seconds, ProgramRun& run, std::string& error) {
+  run = ProgramRun{};
+  ChildProcess child;
+  if (!child.start(program, args, ChildProcess::Input::none, error, ChildProcess::Output::pipe))
+    return false;
+  // Both pipes drained as they fill (a child blocked on a full one would never end), until
+  // both end.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+  bool out_open = true, err_open = true;
+  while (out_open || err_open) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        until - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      run.timed_out = true;
+      child.signal(SIGKILL);
+      break;
+    }
+    // A negative descriptor is skipped by poll().
+    pollfd fds[2] = {{out_open ? child.output_fd() : -1, POLLIN, 0},
+                     {err_open ? child.error_fd() : -1, POLLIN, 0}};
+    const int r = ::poll(fds, 2, static_cast<int>(std::min<long long>(left.count(), 1000)));
+    if (r < 0 && errno != EINTR) break;
+    if (r <= 0) continue;
+    if (fds[0].revents != 0) out_open = child.read_output(run.out);
+    if (fds[1].revents != 0) err_open = child.read_error(run.err);
+  }
+  run.exit = child.wait();
+  return true;
 }
 
 }  // namespace mixpilot::cli

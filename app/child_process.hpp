@@ -1,7 +1,7 @@
 #pragma once
 // A program run as a child process without a shell (posix_spawn, its arguments a vector): its
-// standard input a pipe this process writes, or /dev/null; its standard output /dev/null; its
-// standard error a pipe this process reads. The child runs in a process group of its own, so a
+// standard input a pipe this process writes, or /dev/null; its standard output /dev/null, or a
+// pipe this process reads; its standard error a pipe this process reads. The child runs in a process group of its own, so a
 // ^C at the terminal reaches this process only, which decides what becomes of the child.
 #include <sys/types.h>
 
@@ -29,6 +29,7 @@ std::string to_string(const ChildExit& e);
 class ChildProcess {
  public:
   enum class Input { pipe, none };
+  enum class Output { none, pipe };
   enum class Write { done, closed, interrupted };
 
   ChildProcess() = default;
@@ -39,7 +40,7 @@ class ChildProcess {
 
   // Starts `program` (a path) with `args` (argv[1...]); false with the reason.
   [[nodiscard]] bool start(const std::string& program, const std::vector<std::string>& args,
-                           Input input, std::string& error);
+                           Input input, std::string& error, Output output = Output::none);
   bool running() const { return pid_ > 0; }
   pid_t pid() const { return pid_; }
 
@@ -57,6 +58,11 @@ class ChildProcess {
   // child closed it), true when there may be more (or, non-blocking, nothing yet).
   bool read_error(std::string& text);
 
+  // The read end of the child's standard output (Output::pipe; -1 otherwise or when closed),
+  // and what it has written there, as read_error() reads its standard error.
+  int output_fd() const { return out_; }
+  bool read_output(std::string& text);
+
   // Sends `sig` to the child (nothing once it is reaped).
   void signal(int sig);
   // Whether the child has ended, without waiting; reaps it when it has.
@@ -70,6 +76,19 @@ class ChildProcess {
   pid_t pid_ = -1;
   int in_ = -1;   // write end of the child's standard input
   int err_ = -1;  // read end of its standard error
+  int out_ = -1;  // read end of its standard output (Output::pipe)
 };
+
+// A program run to its end, its standard output and error read (standard input /dev/null).
+struct ProgramRun {
+  ChildExit exit;
+  std::string out;
+  std::string err;
+  bool timed_out = false;  // it ran longer than allowed and was killed (SIGKILL)
+};
+// Runs `program` (a path) with `args` for at most `timeout_seconds`; false with the reason when
+// it could not be started.
+[[nodiscard]] bool run_program(const std::string& program, const std::vector<std::string>& args,
+                               double timeout_seconds, ProgramRun& run, std::string& error);
 
 }  // namespace mixpilot::cli

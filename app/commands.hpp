@@ -17,6 +17,8 @@ int vehicle_command(int argc, char** argv);
 int history_command(int argc, char** argv);
 int instruct_command(int argc, char** argv);
 int lesson_command(int argc, char** argv);
+int sweep_command(int argc, char** argv);
+int figures_command(int argc, char** argv);
 // A flight as `fly` flies it (the window, or headless), from its options.
 int run_fly(const FlyOptions& o);
 

@@ -52,7 +52,8 @@ std::optional<Flight> load_flight(const FlyOptions& o, std::string& error, int& 
     if (!embedded_scenario(*f.recording, o.pilot, error)) return std::nullopt;
   }
   if (!o.scenario_path.empty()) {
-    if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
+    if (!o.scenario_text.empty()) f.scenario_text = o.scenario_text;
+    else if (!read_text_file(o.scenario_path, f.scenario_text, error)) return std::nullopt;
     f.scenario_source = o.scenario_path;
     f.scenario_file = std::filesystem::absolute(o.scenario_path).lexically_normal().string();
     if (f.recording && *embedded_scenario(*f.recording, o.pilot, error) != f.scenario_text &&

@@ -53,6 +53,11 @@ struct LessonTag {
 
 struct FlyOptions {
   std::string scenario_path;
+  // The scenario's text when it is not the file's own: a variant of it with some keys set to
+  // other values (core/scenario/scenario_keys.hpp: a sweep's run, a figure's flight), which a
+  // recording embeds as flown; scenario_path then names it in messages and anchors its
+  // relative paths.
+  std::string scenario_text;
   std::string pilot;
   bool headless = false;
   std::optional<double> duration;

@@ -152,6 +152,8 @@ bool FlightRig::publish(std::string& error) {
     error = "--publish: " + error;
     return false;
   }
+  // READY announces what the flight will start with (λ within its bounds), not a λ of 0.
+  instructor_->ready(mode.telemetry());
   session_->add_sink(&*publisher_);
   session_->add_sink(&*instructor_);
   return true;

@@ -29,6 +29,8 @@
 //   take over     TakeOver's worker (app/take_over.hpp): flies   the window's Trainer, while
 //                 a recording to the moment flown on from        it makes that moment ready
 //   score jobs    score's worker pool (app/score.cpp)            `mixpilot score`
+//   sweep jobs    run_pool (app/sweep_folder.hpp): one flight or  `mixpilot sweep`, `mixpilot
+//                 replay per thread, each its own rig            score DIR`
 //   history       HistoryWriter (app/history_writer.hpp): opens  the window's Trainer, or
 //                 the store, hashes recordings, writes rows,    `fly --headless` (which waits
 //                 loads what the window shows of the history    for it at the end)

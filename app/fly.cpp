@@ -93,7 +93,7 @@ constexpr const char* kFlyUsage =
     "                     dds_security for every flight that publishes (the options win)\n"
     "  --dds-security FOLDER  with --publish: authenticate with this identity's DDS Security\n"
     "                     files (identity_ca.pem, cert.pem, key.pem, permissions_ca.pem,\n"
-    "                     governance.p7s, permissions.p7s; packaging/dds-security-ca.sh)\n"
+    "                     governance.p7s, permissions.p7s; mixpilot-security-ca DIR)\n"
     "  --allow-unauthenticated-commands  with --instructor: obey commands without DDS\n"
     "                     Security; accepted only while CYCLONEDDS_URI keeps DDS on loopback\n"
     "  --vehicle sim|dds  sim (default): the plant is simulated in this process; dds: the\n"

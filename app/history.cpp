@@ -22,6 +22,7 @@
 #include "app/flight_rig.hpp"
 #include "app/progress.hpp"
 #include "app/progress_html.hpp"
+#include "core/base/json.hpp"
 #include "core/base/output_file.hpp"
 #include "core/base/input_file.hpp"
 #include "core/base/content_hash.hpp"
@@ -29,6 +30,7 @@
 #include "core/history/postgres_history.hpp"
 #include "core/history/push.hpp"
 #include "core/recording/replay.hpp"
+#include "core/scenario/lesson.hpp"
 
 namespace mixpilot::cli {
 
@@ -40,7 +42,8 @@ constexpr const char* kHistoryUsage =
     "usage: mixpilot history [--trainee NAME] [--scenario NAME] [--since DATE] [--limit N]\n"
     "                        [--csv | --json] [--history LOCATION]\n"
     "       mixpilot history --trainee NAME --html OUT.html [--force] [--scenario NAME] ...\n"
-    "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--history LOCATION]\n"
+    "       mixpilot history import DIR [--jobs N] [--trainee NAME] [--lesson FILE]...\n"
+    "                               [--history LOCATION]\n"
     "       mixpilot history push postgresql://[USER@]HOST[:PORT]/DATABASE [--history LOCATION]\n"
     "\n"
     "The flights mixpilot remembers (SPEC §10): every flight of the window and of `fly`, one\n"
@@ -73,13 +76,22 @@ constexpr const char* kHistoryUsage =
     "twice adds nothing). The trainee is the recording's; --trainee names one for recordings\n"
     "without (default: the login name). The start time is the file's modification time minus\n"
     "the flight's duration. Progress on stderr; a file that cannot be read or replayed is named\n"
-    "with the reason, and the others are still imported.\n"
+    "with the reason, and the others are still imported. A lesson step's recording (its\n"
+    "metadata names the lesson, its SHA-256 and the step) is imported with its verdict, judged\n"
+    "again against that lesson: a shipped one or a --lesson FILE whose SHA-256 is the\n"
+    "recording's (else the flight alone is imported, and said). Where each trainee is in a\n"
+    "lesson is left as it is (mixpilot lesson --status says it; --reset starts over).\n"
     "  --jobs N           replay N recordings in parallel (default: the number of cores)\n"
+    "  --lesson FILE      a lesson file to judge lesson steps' recordings against, besides the\n"
+    "                     shipped lessons (repeatable)\n"
     "\n"
-    "history push URL: copies this station's flights (--history, default the SQLite file above)\n"
-    "into a training centre's PostgreSQL database, every flight once: a recorded flight is\n"
-    "matched by its recording's SHA-256, a flight without a recording by its trainee, station\n"
-    "and start time (to the millisecond). Pushing again adds only the flights flown since.\n"
+    "history push URL: copies this station's history (--history, default the SQLite file above)\n"
+    "into a training centre's PostgreSQL database: every flight once, with its score fields and,\n"
+    "for a lesson step's attempt, its verdict: a recorded flight is matched by its recording's\n"
+    "SHA-256, a flight without a recording by its trainee, station and start time (to the\n"
+    "millisecond); then where each trainee is in each lesson, the row updated last winning.\n"
+    "Pushing again adds only what changed since (a flight already there gains its lesson\n"
+    "verdict if an older mixpilot pushed it without).\n"
     "The URL is libpq's (options such as ?sslmode=require after it); keep the password out of\n"
     "it, where other users' `ps` would see it: PGPASSWORD or ~/.pgpass. No message repeats a\n"
     "password. The connection gives up after 5 s unless the URL sets connect_timeout.\n"
@@ -349,25 +361,6 @@ void print_csv(const std::vector<history::StoredFlight>& rows) {
   }
 }
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c == '"') out += "\\\"";
-    else if (c == '\\') out += "\\\\";
-    else if (c == '\n') out += "\\n";
-    else if (c == '\t') out += "\\t";
-    else if (c < 0x20 || c == 0x7F) {
-      char u[8];
-      std::snprintf(u, sizeof u, "\\u%04x", c);
-      out += u;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
 void print_json(const std::vector<history::StoredFlight>& rows) {
   std::string out = "[";
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -376,7 +369,7 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
     out += i ? ",\n  {" : "\n  {";
     for (std::size_t k = 0; k < values.size(); ++k) {
       const std::string_view name = kFields[k];
-      out += (k ? ", " : "") + json_string(name) + ": ";
+      out += (k ? ", " : "") + json_quote(name) + ": ";
       if (name == "id" || name == "started_unix_ms")
         out += values[k];
       else if (name == "duration_s" || name == "parent_step")
@@ -392,12 +385,12 @@ void print_json(const std::vector<history::StoredFlight>& rows) {
       else if (name == "probe")
         out += f.probe ? "true" : "false";
       else
-        out += json_string(values[k]);
+        out += json_quote(values[k]);
     }
     out += ", \"metrics\": {";
     for (std::size_t m = 0; m < f.metrics.size(); ++m) {
       const std::string v = number(f.metrics[m].second);
-      out += (m ? ", " : "") + json_string(f.metrics[m].first) + ": " + (v.empty() ? "null" : v);
+      out += (m ? ", " : "") + json_quote(f.metrics[m].first) + ": " + (v.empty() ? "null" : v);
     }
     out += "}}";
   }
@@ -418,12 +411,72 @@ struct ImportRow {
   std::string file;
   std::string hash;
   enum class State { failed, known, scored } state = State::failed;
-  std::optional<history::FlightRecord> record;
+  std::optional<history::StoredFlight> record;  // with its lesson attempt's fields, if any
   std::string error;
+  std::string note;  // what was imported short of the whole (a lesson attempt without verdict)
 };
 
+// A lesson step's recording (its metadata: lesson, lesson_hash, lesson_step 1-based,
+// lesson_steps, lesson_step_title): its attempt's verdict, judged again against the lesson of
+// that name and hash among `lessons`, onto `row`; else why not in `note` (not a lesson's flight:
+// nothing).
+void judge_for_import(const RecordingContents& rec, const std::vector<Lesson>& lessons,
+                      const Metrics& metrics, bool completed, history::StoredFlight& row,
+                      std::string& note) {
+  const auto meta = [&rec](const char* key) {
+    const auto it = rec.metadata.find(key);
+    return it == rec.metadata.end() ? std::string() : it->second;
+  };
+  const std::string name = meta("lesson"), hash = meta("lesson_hash");
+  if (name.empty()) return;
+  const std::string step_text = meta("lesson_step");
+  char* end = nullptr;
+  const long step = std::strtol(step_text.c_str(), &end, 10);
+  const auto lesson = std::find_if(lessons.begin(), lessons.end(), [&](const Lesson& l) {
+    return l.name == name && l.hash == hash;
+  });
+  if (lesson == lessons.end()) {
+    note = "its lesson attempt (" + name + ", step " + step_text +
+           ") is not: no lesson file here has its SHA-256 (--lesson FILE names one)";
+    return;
+  }
+  if (end == step_text.c_str() || *end != '\0' || step < 1 || step > long(lesson->steps.size())) {
+    note = "its lesson attempt is not: its metadata's lesson_step '" + step_text +
+           "' is not a step of " + name;
+    return;
+  }
+  const LessonStep& s = lesson->steps[std::size_t(step - 1)];
+  const auto field = [&metrics](const char* key) {
+    for (const auto& [k, v] : metrics)
+      if (k == key) return v;
+    return 0.0;
+  };
+  LessonScore score;
+  score.skill = field("skill");
+  score.time_in_ball = field("time_in_ball");
+  score.collisions = field("collisions");
+  score.completed = completed;
+  const LessonVerdict verdict = judge(s, score);
+  row.lesson = lesson->name;
+  row.lesson_hash = lesson->hash;
+  row.lesson_step = int(step - 1);
+  row.lesson_step_title = s.title;
+  row.lesson_ceiling = s.flown_ceiling();
+  row.lesson_passed = verdict.passed;
+  row.lesson_failed = verdict.failed;
+  // In words as the flight's own verdict was (app/flight_rig.cpp).
+  row.lesson_detail.clear();
+  if (verdict.passed) {
+    for (const CriterionResult& r : verdict.results)
+      row.lesson_detail += (row.lesson_detail.empty() ? "" : "; ") + r.text;
+  } else {
+    row.lesson_detail = verdict.detail;
+  }
+}
+
 // The recording flown again and checked (as score does), as the history's row.
-void score_for_import(ImportRow& row, const std::string& trainee) {
+void score_for_import(ImportRow& row, const std::string& trainee,
+                      const std::vector<Lesson>& lessons) {
   FlyOptions o;
   o.pilot = row.file;
   o.replay = true;
@@ -463,12 +516,29 @@ void score_for_import(ImportRow& row, const std::string& trainee) {
           ? std::int64_t(st.st_mtim.tv_sec) * 1000 + st.st_mtim.tv_nsec / 1'000'000
           : 0;
   r->started_unix_ms = std::max<std::int64_t>(0, mtime_ms - std::int64_t(r->duration_s * 1000));
-  row.record = std::move(r);
+  history::StoredFlight stored;
+  static_cast<history::FlightRecord&>(stored) = std::move(*r);
+  judge_for_import(rec, lessons, rig->metrics(), !early && !rig->mode().lost(), stored, row.note);
+  row.record = std::move(stored);
   row.state = ImportRow::State::scored;
 }
 
+// The lessons a lesson step's recording may name: the shipped ones and `files` (--lesson);
+// false with the reason when one of `files` is no lesson.
+bool import_lessons(const std::vector<std::string>& files, std::vector<Lesson>& out,
+                    std::string& error) {
+  for (const std::string& f : shipped_lessons())
+    if (std::string why; auto l = load_lesson(f, why)) out.push_back(std::move(*l));
+  for (const std::string& f : files) {
+    auto l = load_lesson(f, error);
+    if (!l) return error = "--lesson " + error, false;
+    out.push_back(std::move(*l));
+  }
+  return true;
+}
+
 int import_command(history::HistoryStore& store, const std::string& dir, int jobs,
-                   const std::string& trainee) {
+                   const std::string& trainee, const std::vector<Lesson>& lessons) {
   std::vector<ImportRow> rows;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
@@ -514,8 +584,14 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
       ++added;
       const auto skill = std::find_if(r.record->metrics.begin(), r.record->metrics.end(),
                                       [](const auto& m) { return m.first == "skill"; });
-      say(r, skill != r.record->metrics.end() ? "added (skill " + number(skill->second, "%.1f") + ")"
-                                              : "added (" + r.record->mode + ")");
+      std::string what = skill != r.record->metrics.end()
+                             ? "added (skill " + number(skill->second, "%.1f") + ")"
+                             : "added (" + r.record->mode + ")";
+      if (r.record->attempt())
+        what += ", " + r.record->lesson + " step " + std::to_string(r.record->lesson_step + 1) +
+                (r.record->lesson_passed ? " passed" : " not passed");
+      if (!r.note.empty()) what += "; " + r.note;
+      say(r, what);
     } else {
       ++failed;
       say(r, "not imported: " + r.error);
@@ -527,16 +603,17 @@ int import_command(history::HistoryStore& store, const std::string& dir, int job
     for (std::size_t i = next++; i < rows.size(); i = next++) {
       ImportRow& r = rows[i];
       if (r.state == ImportRow::State::known || r.hash.empty()) continue;
-      score_for_import(r, trainee);
+      score_for_import(r, trainee, lessons);
       // One writer at a time in this process; other processes wait on the database's lock.
       const std::lock_guard<std::mutex> lock(io);
       if (r.state == ImportRow::State::scored) {
+        // The flight with its lesson attempt's verdict, the trainee's place left as it is.
         std::string why;
-        const auto a = store.add(*r.record, why);
-        if (!a) {
+        const auto c = store.copy_flight(*r.record, why);
+        if (!c) {
           r.state = ImportRow::State::failed;
           r.error = why;
-        } else if (*a == history::HistoryStore::Added::already_known) {
+        } else if (!c->flight) {
           r.state = ImportRow::State::known;
         }
       }
@@ -611,9 +688,10 @@ int push_command(int argc, char** argv) {
   });
   if (!ok)
     std::fprintf(stderr, "mixpilot history push: %s\n", escape_controls(error).c_str());
-  std::printf("mixpilot history push: %zu added, %zu already there (%s -> %s)\n", counts.added,
-              counts.already_there, escape_controls(from->where()).c_str(),
-              escape_controls(to->where()).c_str());
+  std::printf("mixpilot history push: %zu added, %zu already there; lessons: %zu attempts "
+              "added, %zu progress rows updated (%s -> %s)\n",
+              counts.added, counts.already_there, counts.attempts, counts.progress,
+              escape_controls(from->where()).c_str(), escape_controls(to->where()).c_str());
   return ok ? kExitOk : kExitError;
 }
 
@@ -623,6 +701,7 @@ int history_command(int argc, char** argv) {
   const char* cmd = "history";
   history::Query q;
   std::string location, import_dir, trainee_for_import;
+  std::vector<std::string> lesson_files;  // import's --lesson
   std::string html;
   bool as_csv = false, as_json = false, importing = false, force = false;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -680,6 +759,8 @@ int history_command(int argc, char** argv) {
         usage_error(cmd, "--jobs expects a whole number from 1 to 256, got '" +
                              escape_controls(v) + "'");
       jobs = int(n);
+    } else if (importing && a == "--lesson") {
+      lesson_files.push_back(file_argument(cmd, "a lesson file", value()));
     } else if (importing && (a.empty() || a[0] != '-') && import_dir.empty()) {
       import_dir = file_argument(cmd, "a folder of recordings", a);
     } else {
@@ -742,13 +823,20 @@ int history_command(int argc, char** argv) {
                                                                : location;
     if (no_file_yet(file)) return print();
   }
+  // The lessons to judge lesson steps' recordings against, before the history is opened (a
+  // bad --lesson makes none).
+  std::vector<Lesson> lessons;
+  if (importing && !import_lessons(lesson_files, lessons, error)) {
+    std::fprintf(stderr, "mixpilot history import: %s\n", escape_controls(error).c_str());
+    return kExitError;
+  }
   const auto store = history::open_history(location, error);
   if (!store) {
     report.discard();
     std::fprintf(stderr, "mixpilot history: %s\n", escape_controls(error).c_str());
     return kExitError;
   }
-  if (importing) return import_command(*store, import_dir, jobs, trainee_for_import);
+  if (importing) return import_command(*store, import_dir, jobs, trainee_for_import, lessons);
   // The table shows one score field: reading the others (twenty a flight) is what would make a
   // long history slow to list.
   if (!as_csv && !as_json && html.empty()) q.metrics = {"skill"};

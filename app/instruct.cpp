@@ -18,6 +18,7 @@
 #include "core/history/history.hpp"
 #include "input/net/dds.hpp"
 #include "input/net/instructor_client.hpp"
+#include "ui/instructor_hud.hpp"
 
 namespace mixpilot::cli {
 
@@ -68,7 +69,7 @@ constexpr const char* kUsage =
     "  --domain N         DDS domain (0-232, default 0; 0-230 with DDS Security)\n"
     "  --dds-security FOLDER  authenticate as the identity in FOLDER (identity_ca.pem,\n"
     "                     cert.pem, key.pem, permissions_ca.pem, governance.p7s,\n"
-    "                     permissions.p7s; packaging/dds-security-ca.sh makes a test set)\n"
+    "                     permissions.p7s; mixpilot-security-ca DIR makes a test set)\n"
     "  --issuer NAME      who commands (default: login@host); a station keeps each issuer's\n"
     "                     commands in order\n"
     "  --count N          --list: stop as soon as N stations, their telemetry and a fresh\n"
@@ -110,6 +111,12 @@ void print_station(const net::StationView& v) {
               v.station.c_str(), v.trainee.c_str(), v.scenario.c_str(), v.mode.c_str(),
               net::to_string(v.state), v.t, v.duration, v.lambda, v.deviation,
               100.0 * v.time_in_ball, v.mean_lambda);
+  // What the instructor's commands keep in force there, as its HUD says it.
+  std::string in_force;
+  for (const std::string& item :
+       ui::instructor_in_force(v.in_force, v.state == net::StationState::paused))
+    in_force += in_force.empty() ? item.substr(item.find(": ") + 2) : " " + item;
+  if (!in_force.empty()) std::printf("  in force: %s\n", in_force.c_str());
   const std::string refused = refused_words(v);
   std::printf("  instructor: %s; commands %llu accepted, %llu refused%s%s\n",
               net::to_string(v.security), (unsigned long long)v.accepted,

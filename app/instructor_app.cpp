@@ -150,6 +150,7 @@ void InstructorApp::round() {
     x.q[3] = v.orientation.z();
     x.lambda = v.lambdas > 0 ? v.telemetry_lambda : v.lambda;
     x.deviation = v.deviation;
+    x.bounds = v.in_force.bounds;
     s.samples.push_back(x);
     const auto old = std::find_if(s.samples.begin(), s.samples.end(),
                                   [&](const Sample& a) { return a.t >= t - kKeptS; });
@@ -285,6 +286,14 @@ std::shared_ptr<const ui::InstructorView> InstructorApp::make_view(double now) {
     t.deviation = v.deviation;
     t.time_in_ball = v.time_in_ball;
     t.mean_lambda = v.mean_lambda;
+    // What is in force, its times run down since the announcement while the station flies (an
+    // announcement comes twice a second, and at once when something starts or ends).
+    t.in_force = v.in_force;
+    if (v.state == net::StationState::flying) {
+      const double since = std::max(0.0, double(system_now - v.heard_ns) * 1e-9);
+      t.in_force.gust_left = std::max(0.0, t.in_force.gust_left - since);
+      t.in_force.input_loss_left = std::max(0.0, t.in_force.input_loss_left - since);
+    }
     t.accepted = v.accepted;
     t.refused = v.refused_total();
     t.last_refusal = v.last_refusal;
@@ -314,6 +323,7 @@ std::shared_ptr<const ui::InstructorView> InstructorApp::make_view(double now) {
           x.reference << ref(0), ref(1), ref(2);
         }
         x.lambda = a.lambda;
+        x.instructor.bounds = a.bounds;
         x.set_channel(0, "lambda", "", a.lambda);
         x.set_channel(1, "deviation", "m", a.deviation);
         x.set_channel(2, "ball radius r", "m", r);

@@ -68,6 +68,7 @@ class InstructorApp {
     double t = 0.0;  // [s] the station's flight time (estimated between announcements)
     double p[3] = {}, q[4] = {1, 0, 0, 0};  // position [m], attitude (w, x, y, z)
     double lambda = 0.0, deviation = 0.0;
+    AuthorityBounds bounds;  // the instructor's bounds as announced then
   };
   struct Station {
     std::uint64_t poses = 0, lambdas = 0;  // the telemetry counts last seen

@@ -23,7 +23,7 @@ constexpr const char* kUsage =
     "  fly     fly a session in the window (real time), or headless as fast as possible\n"
     "  replay  show a recording (any mode) in the window, or headless screenshots or a\n"
     "          video of it\n"
-    "  score   replay and score recorded sessions\n"
+    "  score   replay and score recorded sessions (or a folder of them, sharded)\n"
     "  recover rebuild a recording cut short by a crash or kill -9\n"
     "  gamepad-script  a recording's pilot commands as a virtual gamepad's script\n"
     "  joy-publish     a recording's sticks as sensor_msgs/msg/Joy over DDS\n"
@@ -31,6 +31,8 @@ constexpr const char* kUsage =
     "  instruct        the instructor: list the stations (fly --publish), command one\n"
     "  history the flights remembered (table, CSV, JSON); import recordings into it\n"
     "  lesson  fly a trainee's current step of a lesson, judged and remembered\n"
+    "  sweep   fly a sweep file's grid of runs on every core (or one shard) into a table\n"
+    "  figures the thesis's figures from flights of the shipped scenarios (PNG, CSV, index)\n"
     "  demo    fly scenarios/mi_helix.toml with the emulated novice pilot and print its score\n"
     "  models  open-loop check of each dynamic model\n"
     "\n"
@@ -148,6 +150,8 @@ int dispatch(int argc, char** argv) {
   if (cmd == "history") return history_command(argc, argv);
   if (cmd == "instruct") return instruct_command(argc, argv);
   if (cmd == "lesson") return lesson_command(argc, argv);
+  if (cmd == "sweep") return sweep_command(argc, argv);
+  if (cmd == "figures") return figures_command(argc, argv);
   if (cmd == "demo" || cmd == "models") {
     if (argc > 2) {
       if (std::strcmp(argv[2], "--help") == 0 || std::strcmp(argv[2], "-h") == 0) {

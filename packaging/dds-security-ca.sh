@@ -1,45 +1,58 @@
 #!/usr/bin/env bash
 # A complete DDS Security test setup for mixpilot's instructor (SPEC §10, docs/instructor-security.md),
-# made with openssl into DIR: a training centre's identity CA and permissions CA, the signed
-# governance, and one folder per identity that `--dds-security FOLDER` takes:
-#
-#   DIR/ca/                      the CAs' keys and certificates (keep the keys off the stations)
-#   DIR/governance.xml           the rules of the domain (signed copy in each identity folder)
-#   DIR/instructor/              may publish instructor commands, reads every station
-#   DIR/trainee-a/, trainee-b/   stations: publish telemetry and announcements, read commands
-#   DIR/other-ca/                an "instructor" of a CA the centre does not know (its own
-#                                identity CA, permissions CA and signed documents)
-#   DIR/expired/                 an instructor whose certificate expired yesterday
-#
-# Each identity folder holds identity_ca.pem, cert.pem, key.pem, permissions_ca.pem,
-# governance.p7s, permissions.xml, permissions.p7s and cyclonedds.xml (the loopback-only
-# configuration with its Security section, for CYCLONEDDS_URI). Keys are EC prime256v1.
-# Everything is bound to loopback: interface lo, multicast off, the peer 127.0.0.1.
-#
-#   packaging/dds-security-ca.sh DIR [--force] [--days N]
-#
-# --force replaces an existing setup in DIR; --days sets how long the certificates and
-# permissions are valid (default 365).
+# made with openssl into DIR. Installed by the Debian package as /usr/bin/mixpilot-security-ca;
+# in the source tree packaging/dds-security-ca.sh. --help says what it makes.
 set -euo pipefail
 
-usage() { echo "usage: packaging/dds-security-ca.sh DIR [--force] [--days N]" >&2; exit 2; }
+me=$(basename "$0")
+help() {
+  cat <<EOF
+usage: $me DIR [--force] [--days N]
+
+A complete DDS Security test setup for mixpilot's instructor (mixpilot fly --instructor,
+mixpilot instruct; docs/instructor-security.md in mixpilot's source says how a training
+centre makes its own), made with openssl into DIR: a training centre's identity CA and
+permissions CA, the signed governance, and one folder per identity that --dds-security
+FOLDER takes:
+
+  DIR/ca/                      the CAs' keys and certificates (keep the keys off the stations)
+  DIR/governance.xml           the rules of the domain (signed copy in each identity folder)
+  DIR/instructor/              may publish instructor commands, reads every station
+  DIR/trainee-a/, trainee-b/   stations: publish telemetry and announcements, read commands
+  DIR/other-ca/                an "instructor" of a CA the centre does not know (its own
+                               identity CA, permissions CA and signed documents)
+  DIR/expired/                 an instructor whose certificate expired yesterday
+
+Each identity folder holds identity_ca.pem, cert.pem, key.pem, permissions_ca.pem,
+governance.p7s, permissions.xml, permissions.p7s and cyclonedds.xml (the loopback-only
+configuration with its Security section, for CYCLONEDDS_URI). Keys are EC prime256v1.
+Everything is bound to loopback: interface lo, multicast off, the peer 127.0.0.1.
+
+  --force     replace an existing setup in DIR
+  --days N    how long the certificates and permissions are valid (default 365)
+  -h, --help  this text
+
+exit status: 0 made, 1 failure (openssl missing, DIR already holds a setup), 2 usage
+EOF
+}
+usage() { echo "usage: $me DIR [--force] [--days N] (--help says more)" >&2; exit 2; }
 dir= force=0 days=365
 while [ $# -gt 0 ]; do
   case "$1" in
     --force) force=1 ;;
     --days) [ $# -ge 2 ] || usage; days="$2"; shift ;;
-    -h|--help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) help; exit 0 ;;
     -*) usage ;;
     *) [ -z "$dir" ] || usage; dir="$1" ;;
   esac
   shift
 done
 [ -n "$dir" ] || usage
-case "$days" in ''|*[!0-9]*) echo "dds-security-ca: --days expects a whole number of days, got '$days'" >&2; exit 2 ;; esac
-[ "$days" -ge 1 ] || { echo "dds-security-ca: --days expects at least 1" >&2; exit 2; }
-command -v openssl >/dev/null || { echo "dds-security-ca: openssl is missing (apt-get install openssl)" >&2; exit 1; }
+case "$days" in ''|*[!0-9]*) echo "$me: --days expects a whole number of days, got '$days'" >&2; exit 2 ;; esac
+[ "$days" -ge 1 ] || { echo "$me: --days expects at least 1" >&2; exit 2; }
+command -v openssl >/dev/null || { echo "$me: openssl is missing (apt-get install openssl)" >&2; exit 1; }
 if [ -e "$dir/ca" ] && [ "$force" -ne 1 ]; then
-  echo "dds-security-ca: $dir already holds a setup (--force replaces it)" >&2
+  echo "$me: $dir already holds a setup (--force replaces it)" >&2
   exit 1
 fi
 mkdir -p "$dir"
@@ -54,7 +67,7 @@ org="mixpilot training centre"
 plugins=/usr/lib/x86_64-linux-gnu/libddsc0debian
 for p in auth ac crypto; do
   [ -f "$plugins/libdds_security_$p.so" ] ||
-    echo "dds-security-ca: warning: $plugins/libdds_security_$p.so is missing (package libddsc0debian)" >&2
+    echo "$me: warning: $plugins/libdds_security_$p.so is missing (package libddsc0debian)" >&2
 done
 
 key() { openssl ecparam -name prime256v1 -genkey -noout -out "$1" 2>/dev/null; chmod 600 "$1"; }
@@ -236,7 +249,7 @@ finish() {  # NAME IDENTITY_CA PERMISSIONS_CA RULES
   cat >"$f/cyclonedds.xml" <<EOF
 <?xml version="1.0" encoding="UTF-8"?>
 <!-- mixpilot's loopback-only configuration (assets/dds-loopback.xml) with DDS Security for the
-     identity "$name" (made by packaging/dds-security-ca.sh). -->
+     identity "$name" (made by mixpilot-security-ca). -->
 <CycloneDDS xmlns="https://cdds.io/config">
   <Domain Id="any">
     <General>
@@ -281,6 +294,6 @@ finish other-ca other_ca other_permissions "$instructor_rules"
 rm -f "$ca"/*.csr
 
 for name in instructor trainee-a trainee-b other-ca expired; do
-  printf 'dds-security-ca: %-11s %s (valid until %s)\n' "$name" "$dir/$name" \
+  printf '%s: %-11s %s (valid until %s)\n' "$me" "$name" "$dir/$name" \
     "$(openssl x509 -in "$dir/$name/cert.pem" -noout -enddate | sed 's/notAfter=//')"
 done

@@ -26,6 +26,11 @@ packages=(
   cyclonedds-dev cyclonedds-tools openssl
   # tests and benchmarks; the PostgreSQL server the history tests start themselves
   libgtest-dev libgmock-dev libbenchmark-dev valgrind postgresql
+  # the single-node Slurm cluster the sweep tests start themselves (tests/slurm_cluster.hpp).
+  # Installing them starts no Slurm daemon: Debian's units and init scripts wait for an
+  # /etc/slurm/slurm.conf, which nothing here writes; munge's postinst starts munged (on a
+  # machine with an init system), which listens on a Unix socket only.
+  slurm-wlm munge
   # fuzzing: clang++ and its libFuzzer/sanitizer runtimes (tests/fuzz)
   clang libclang-rt-dev
   # tooling: independent MCAP reader in the recording tests

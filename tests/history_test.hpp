@@ -231,7 +231,10 @@ inline void progress_round_trip(history::HistoryStore& store) {
   EXPECT_EQ(rows[5].lesson_step, -1);
   // A reset: step 1 again, the attempts kept.
   ASSERT_TRUE(store.reset_lesson("Ada", "beginner", "h1", error)) << error;
-  EXPECT_EQ(progress_of(store, "Ada").steps, 0);  // no row: step 0
+  p = progress_of(store, "Ada");  // the row stays (a push carries the reset), at step 0
+  EXPECT_EQ(p.steps, 3);
+  EXPECT_EQ(p.step, 0);
+  EXPECT_EQ(p.failed_attempts, 0);
   ASSERT_TRUE(store.lesson_attempts("Ada", "beginner", "h1", attempts, error)) << error;
   EXPECT_EQ(attempts.size(), 4u);
   ASSERT_EQ(store.add_attempt(flight("Ada", 9990, 80.0), attempt(0, true), error), Added::added)

@@ -8,7 +8,8 @@ Inputs (each through every command that reads it):
   ($XDG_CONFIG_HOME/mixpilot/; fly --pilot gamepad, gamepad-script), --gamepad-script (fly),
   the reference CSVs a scenario names (fly), recordings (score, replay, replay --video, fly
   --pilot, gamepad-script, joy-publish, recover), a ghost's recording (fly --ghost, replay
-  --ghost), a lesson (lesson --check, lesson --status) and MIXPILOT_DATA_DIR (demo); replay --video's
+  --ghost), a lesson (lesson --check, lesson --status), a sweep file (sweep --check) and
+  MIXPILOT_DATA_DIR (demo); replay --video's
   --from, --to, --fps and --size values out of range or no numbers.
 File types: a regular file, an empty one, a directory, a FIFO, /dev/zero, /dev/full, a
 symbolic-link loop, a dangling link, an unreadable file (as root, which reads mode-000 files,
@@ -184,6 +185,10 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("lesson --status", ["lesson", "{X}", "--trainee", "t", "--status", "--history",
                                  "{D}/h.sqlite"], "refused"),
         ], {}),
+        # A sweep file (docs/sweeps.md): read, its plan expanded and every run checked.
+        ("sweep", file_input("sw.toml", (scen_dir / "sweeps" / "tracking_rtt.toml").read_bytes()), [
+            ("sweep --check", ["sweep", "{X}", "--check"], "refused"),
+        ], {}),
         # A ghost (SPEC §10): a recording of the scenario flown, read beside the flight.
         ("--ghost", file_input("g.mcap", rec.read_bytes()), [
             ("fly", ["fly", "--scenario", str(scen_dir / "mi_helix.toml"), "--pilot", "novice",
@@ -292,6 +297,10 @@ def build_cases(base, binary, scen_dir, setpriv):
             cases.append(Case(f"nesting {label} in a lesson via lesson --check",
                               ["lesson", "{X}", "--check"], "toml", None, {}, "regular",
                               file_input("deep_lesson.toml", ltext)))
+            wtext = (scen_dir / "sweeps" / "tracking_rtt.toml").read_bytes() + b"\n" + extra.encode()
+            cases.append(Case(f"nesting {label} in a sweep file via sweep --check",
+                              ["sweep", "{X}", "--check"], "toml", None, {}, "regular",
+                              file_input("deep_sweep.toml", wtext)))
             stext = settings_text + extra.encode()
             cases.append(Case(f"nesting {label} in --input-settings via gamepad-script",
                               ["gamepad-script", str(rec), "-o", "{D}/out.csv",
@@ -365,12 +374,20 @@ def build_cases(base, binary, scen_dir, setpriv):
             ("history --history", ["history", "--history", ""], "--history"),
             ("history import DIR", ["history", "import", ""], "empty"),
             ("lesson FILE", ["lesson", "", "--check"], "empty"),
+            ("sweep FILE", ["sweep", "", "--check"], "empty"),
+            ("sweep --out", ["sweep", str(scen_dir / "sweeps" / "tracking_rtt.toml"), "--out", ""],
+             "--out"),
+            ("sweep --shard", ["sweep", str(scen_dir / "sweeps" / "tracking_rtt.toml"), "--shard",
+                               ""], "--shard"),
+            ("score --out", ["score", "{D}", "--out", ""], "--out"),
             ("lesson --trainee", ["lesson", "beginner", "--trainee", "", "--status"],
              "--trainee"),
             ("lesson --record-dir", ["lesson", "beginner", "--trainee", "t", "--headless",
                                      "--record-dir", ""], "--record-dir"),
             ("lesson --history", ["lesson", "beginner", "--trainee", "t", "--status",
-                                  "--history", ""], "--history")):
+                                  "--history", ""], "--history"),
+            ("figures --out", ["figures", "--out", ""], "--out"),
+            ("figures --only", ["figures", "--out", "{D}/figures", "--only", ""], "--only")):
         cases.append(Case(f"empty path {label}", argv, "usage", option))
 
     # replay --video's values: out of range, not numbers, not finite; each a usage error

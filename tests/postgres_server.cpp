@@ -1,5 +1,7 @@
 #include "postgres_server.hpp"
 
+#include "daemon_process.hpp"
+
 #include <fcntl.h>
 #include <grp.h>
 #include <libpq-fe.h>
@@ -31,13 +33,8 @@ namespace {
 
 constexpr const char* kSuperuser = "mixpilot";
 constexpr const char* kPort = "5432";  // only names the socket file: nothing listens on TCP
-constexpr int kCannotDrop = 120;       // exit codes of a child that never reached exec
-constexpr int kCannotExec = 121;
 
-struct Account {
-  uid_t uid;
-  gid_t gid;
-};
+using Account = DaemonSettings::Account;
 
 std::string random_password() {
   static const char alphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
@@ -61,63 +58,6 @@ std::string percent_encode(const std::string& s) {
   return out;
 }
 
-std::string tail_of(const fs::path& file, std::size_t lines) {
-  std::ifstream in(file);
-  std::deque<std::string> last;
-  for (std::string line; std::getline(in, line);) {
-    last.push_back(line);
-    if (last.size() > lines) last.pop_front();
-  }
-  std::string out;
-  for (const auto& l : last) out += "\n  | " + l;
-  return out;
-}
-
-// Runs `argv` (argv[0] a full path) with exactly `env`, its output appended to `log`, as
-// `account` when given; the child gets `death_signal` when this thread ends. Returns the pid,
-// or -1 if fork failed.
-pid_t spawn(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-            const fs::path& log, const std::optional<Account>& account, int death_signal) {
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  std::vector<char*> envp;
-  for (const auto& e : env) envp.push_back(const_cast<char*>(e.c_str()));
-  envp.push_back(nullptr);
-  const std::string log_path = log.string();
-  const pid_t parent = ::getpid();
-
-  const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  // The child: only async-signal-safe calls from here to exec.
-  const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
-  if (fd >= 0) {
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
-  }
-  const int null_in = ::open("/dev/null", O_RDONLY);
-  if (null_in >= 0) ::dup2(null_in, STDIN_FILENO);
-  auto say = [](const char* what) { (void)!::write(STDERR_FILENO, what, std::strlen(what)); };
-  if (account) {
-    if (::setgroups(0, nullptr) != 0 || ::setgid(account->gid) != 0 ||
-        ::setuid(account->uid) != 0 || ::getuid() != account->uid) {
-      say("cannot become the unprivileged user: ");
-      say(std::strerror(errno));
-      say("\n");
-      ::_exit(kCannotDrop);
-    }
-  }
-  // After the change of user, which clears the parent-death signal.
-  ::prctl(PR_SET_PDEATHSIG, death_signal);
-  if (::getppid() != parent) ::_exit(1);
-  ::execve(args[0], args.data(), envp.data());
-  say("cannot run ");
-  say(args[0]);
-  say(": ");
-  say(std::strerror(errno));
-  say("\n");
-  ::_exit(kCannotExec);
-}
 
 // Waits for `pid` at most `timeout`; its status, or nullopt if it still runs.
 std::optional<int> wait_for(pid_t pid, std::chrono::milliseconds timeout) {
@@ -216,10 +156,10 @@ std::unique_ptr<PostgresServer> PostgresServer::start(Start& status, std::string
 
   const std::vector<std::string> env = {"LC_ALL=C", "LANG=C", "TZ=UTC", "PATH=/usr/bin:/bin",
                                         "HOME=" + dir.string()};
-  const pid_t initdb = spawn({(bin / "initdb").string(), "-D", (dir / "data").string(), "-U",
+  const pid_t initdb = spawn_daemon({(bin / "initdb").string(), "-D", (dir / "data").string(), "-U",
                               kSuperuser, "--auth=scram-sha-256", "--pwfile=" + pwfile.string(),
                               "--no-sync", "--encoding=UTF8", "--locale=C", "--no-instructions"},
-                             env, log, account, SIGKILL);
+                             env, log, {.account = account, .own_process_group = false, .death_signal = SIGKILL});
   if (initdb < 0) {
     reason = std::string("fork: ") + std::strerror(errno);
     return nullptr;
@@ -233,7 +173,7 @@ std::unique_ptr<PostgresServer> PostgresServer::start(Start& status, std::string
     return nullptr;
   }
   if (!WIFEXITED(*initdb_status) || WEXITSTATUS(*initdb_status) != 0) {
-    if (WIFEXITED(*initdb_status) && WEXITSTATUS(*initdb_status) == kCannotDrop)
+    if (WIFEXITED(*initdb_status) && WEXITSTATUS(*initdb_status) == kDaemonCannotDrop)
       status = Start::unavailable;
     reason = "initdb failed:" + tail_of(log, 20);
     return nullptr;
@@ -254,11 +194,11 @@ bool PostgresServer::launch(std::string& reason) {
   std::optional<Account> account;
   if (account_) account = Account{account_->first, account_->second};
   // Only the Unix socket in the folder; durability is not what these tests measure.
-  postmaster_ = spawn(
+  postmaster_ = spawn_daemon(
       {(bin_ / "postgres").string(), "-D", (dir / "data").string(), "-k", dir.string(), "-p", kPort,
        "-c", "listen_addresses=", "-c", "fsync=off", "-c", "full_page_writes=off", "-c",
        "max_connections=60", "-c", "shared_buffers=16MB", "-c", "logging_collector=off"},
-      env, log, account, SIGQUIT);
+      env, log, {.account = account, .own_process_group = false, .death_signal = SIGQUIT});
   if (postmaster_ < 0) {
     reason = std::string("fork: ") + std::strerror(errno);
     return false;

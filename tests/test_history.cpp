@@ -29,9 +29,11 @@
 #include "app/trainer.hpp"
 #include "core/base/content_hash.hpp"
 #include "core/history/history.hpp"
+#include "core/history/push.hpp"
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
 #include "core/numerics/version.hpp"
+#include "history_dump.hpp"
 #include "history_test.hpp"
 #include "run_mixpilot.hpp"
 #include "temp_files.hpp"
@@ -601,6 +603,96 @@ TEST(HistoryStore, AWriterKilledMidTransactionLosesNothingCommitted) {
 }
 
 
+// ---- history push: every table, once --------------------------------------------------------
+
+// A station's whole history pushed into a centre's (here SQLite; the Postgres.* tests push into
+// PostgreSQL): every row of every table the schema has, ids aside, arrives — flights with every
+// column (a branch, the instructor's end, a probe, unrecorded ones), their metrics, the lesson
+// attempts and each trainee's place in each lesson — beside what the centre held (another
+// station's flight, and a lesson flight an older mixpilot pushed without its verdict, which
+// gains it); pushing again changes nothing.
+TEST(HistoryPush, EveryTableArrivesOnceAndTwiceAddsNothing) {
+  std::string error;
+  const fs::path station_file = test::fresh_path("history", "push_station.sqlite");
+  auto station = open_store(station_file);
+  ASSERT_TRUE(station);
+  ASSERT_NO_FATAL_FAILURE(test::fill_every_column(*station));
+  const test::HistoryDump mine = test::dump_history(station_file);
+  test::expect_every_column_varies(mine);
+  for (const char* table : {"trainees", "flights", "metrics", "lesson_attempts", "lesson_progress"})
+    EXPECT_FALSE(mine.rows.at(table).empty()) << table;
+
+  const fs::path other_file = test::fresh_path("history", "push_other.sqlite");
+  const fs::path centre_file = test::fresh_path("history", "push_centre.sqlite");
+  auto other = open_store(other_file);
+  auto centre = open_store(centre_file);
+  ASSERT_TRUE(other && centre);
+  FlightRecord elsewhere = sample_flight("Zoe", 1'600'000'000'000);
+  elsewhere.station = "station-9";
+  ASSERT_EQ(other->add(elsewhere, error), HistoryStore::Added::added) << error;
+  ASSERT_EQ(centre->add(elsewhere, error), HistoryStore::Added::added) << error;
+  const std::vector<StoredFlight> flights = all(*station);
+  const auto lesson_flight = std::find_if(flights.begin(), flights.end(),
+                                          [](const StoredFlight& f) { return f.attempt(); });
+  ASSERT_NE(lesson_flight, flights.end());
+  ASSERT_EQ(centre->add(*lesson_flight, error), HistoryStore::Added::added) << error;
+
+  history::PushCounts counts;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.flights, flights.size());
+  EXPECT_EQ(counts.added, flights.size() - 1);
+  EXPECT_EQ(counts.already_there, 1u);
+  EXPECT_EQ(counts.attempts, mine.rows.at("lesson_attempts").size());
+  EXPECT_EQ(counts.progress, mine.rows.at("lesson_progress").size());
+  const test::HistoryDump want = test::union_of(mine, test::dump_history(other_file));
+  test::expect_same_history(test::dump_history(centre_file), want, "after a push");
+
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 0u);
+  EXPECT_EQ(counts.already_there, flights.size());
+  EXPECT_EQ(counts.attempts, 0u);
+  EXPECT_EQ(counts.progress, 0u);
+  test::expect_same_history(test::dump_history(centre_file), want, "after a second push");
+}
+
+// Where a trainee is in a lesson, pushed: the row updated last wins. A centre whose row is newer
+// (the trainee flew there since) keeps it; a station's newer row (a reset there) replaces it.
+TEST(HistoryPush, TheNewestProgressWins) {
+  std::string error;
+  auto station = open_store(test::fresh_path("history", "newest_station.sqlite"));
+  auto centre = open_store(test::fresh_path("history", "newest_centre.sqlite"));
+  ASSERT_TRUE(station && centre);
+  using Added = HistoryStore::Added;
+  const auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(3)); };
+  ASSERT_EQ(station->add_attempt(test::flight("Ada", 1000, 80.0), test::attempt(0, true), error),
+            Added::added)
+      << error;
+  history::PushCounts counts;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.progress, 1u);
+  EXPECT_EQ(test::progress_of(*centre, "Ada").step, 1);
+  pause();
+  ASSERT_EQ(centre->add_attempt(test::flight("Ada", 2000, 40.0), test::attempt(1, false), error),
+            Added::added)
+      << error;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.progress, 0u);
+  history::LessonProgress p = test::progress_of(*centre, "Ada");
+  EXPECT_EQ(p.step, 1);
+  EXPECT_EQ(p.failed_attempts, 1);
+  pause();
+  ASSERT_TRUE(station->reset_lesson("Ada", "beginner", "h1", error)) << error;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.progress, 1u);
+  p = test::progress_of(*centre, "Ada");
+  EXPECT_EQ(p.step, 0);
+  EXPECT_EQ(p.failed_attempts, 0);
+  // The attempts of both stores are all at the centre.
+  std::vector<history::StoredAttempt> attempts;
+  ASSERT_TRUE(centre->lesson_attempts("Ada", "beginner", "h1", attempts, error)) << error;
+  EXPECT_EQ(attempts.size(), 2u);
+}
+
 // ---- Every front end's flight, once ----------------------------------------------------------
 
 const std::string kSrc = MIXPILOT_SOURCE_DIR;
@@ -843,6 +935,68 @@ TEST(HistoryFrontEnds, ImportAddsEachRecordingOnce) {
   EXPECT_NE(test::read_file(home / "out.txt").find("0 added, 2 already known"), std::string::npos)
       << test::read_file(home / "out.txt");
   EXPECT_EQ(rows_in(db), 2);
+}
+
+// history import of a lesson step's recording: the flight and its attempt's verdict, judged
+// again against the lesson its metadata names (the shipped one by its SHA-256), row for row as
+// the station that flew it wrote them; where the trainee is in the lesson is left alone. A
+// recording of a lesson no file here has is imported as a flight and said; with --lesson FILE
+// its verdict comes too.
+TEST(HistoryFrontEnds, ImportKeepsALessonAttemptsVerdict) {
+  const fs::path home = fresh_home("import_lesson");
+  const fs::path recs = home / "recs", flown = home / "flown.sqlite";
+  fs::create_directories(recs / "mine");
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "lesson beginner --trainee Ada --headless --pilot "
+                                          "experienced --record-dir " + recs.string() +
+                                          " --history " + flown.string(), home),
+            0)
+      << test::read_file(home / "out.txt");
+  // The same course, edited (another SHA-256), flown once too.
+  {
+    std::ifstream in(kSrc + "/scenarios/lessons/beginner.toml");
+    std::ofstream out(home / "mine.toml");
+    out << in.rdbuf() << "# edited: another lesson\n";
+  }
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "lesson " + (home / "mine.toml").string() +
+                                          " --trainee Ada --headless --pilot experienced "
+                                          "--record-dir " + (recs / "mine").string() +
+                                          " --history " + (home / "mine.sqlite").string(), home),
+            0)
+      << test::read_file(home / "out.txt");
+
+  const fs::path imported = home / "imported.sqlite";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history import " + recs.string() + " --history " +
+                                          imported.string(), home),
+            0);
+  const std::string out = test::read_file(home / "out.txt");
+  EXPECT_NE(out.find("added (skill"), std::string::npos) << out;
+  EXPECT_NE(out.find("beginner step 1 passed"), std::string::npos) << out;
+  EXPECT_NE(out.find("its lesson attempt (beginner, step 1) is not: no lesson file here has its "
+                     "SHA-256"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(rows_in(imported), 2);
+  // The shipped lesson's attempt: the same row as the station's (flight by recording hash).
+  const test::HistoryDump a = test::dump_history(flown), b = test::dump_history(imported);
+  ASSERT_EQ(a.rows.at("lesson_attempts").size(), 1u);
+  EXPECT_EQ(b.rows.at("lesson_attempts"), a.rows.at("lesson_attempts"));
+  EXPECT_TRUE(b.rows.at("lesson_progress").empty());
+  // The edited lesson's recording, into a fresh history with its file named.
+  const fs::path with_file = home / "with_file.sqlite";
+  ASSERT_EQ(test::run_mixpilot(kMixpilot, "history import " + (recs / "mine").string() +
+                                          " --lesson " + (home / "mine.toml").string() +
+                                          " --history " + with_file.string(), home),
+            0);
+  EXPECT_EQ(test::dump_history(with_file).rows.at("lesson_attempts"),
+            test::dump_history(home / "mine.sqlite").rows.at("lesson_attempts"));
+  // A --lesson that is no lesson: said, nothing imported.
+  EXPECT_EQ(test::run_mixpilot(kMixpilot, "history import " + recs.string() + " --lesson " +
+                                          (home / "out.txt").string() + " --history " +
+                                          (home / "none.sqlite").string(), home),
+            1);
+  EXPECT_NE(test::read_file(home / "out.txt").find("--lesson " + (home / "out.txt").string()),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(home / "none.sqlite"));
 }
 
 // A history that cannot be used: fly says so once on stderr, and still flies, records and

@@ -87,6 +87,59 @@ TEST(InstructorBounds, CeilingAndFloorHoldFromTheNextStep) {
   EXPECT_GT(raised_by_floor, 20);
 }
 
+// READY (before the first step) says what the flight starts with: the telemetry's λ is the one
+// the first step uses — the initial λ within the bounds (a ceiling below it, a floor above it),
+// 1 for a probe — with the bound or the probe as its reason and the bounds in force; without
+// bounds it is the initial λ. The first step then flies with exactly that λ (the emulated
+// pilot's input is never lost), and bounds set at READY move it at once.
+TEST(InstructorBounds, ReadyShowsTheLambdaTheFirstStepUses) {
+  struct Case {
+    AuthorityBounds bounds;
+    Assistance assist;
+    double lambda;
+    LambdaCap cap;
+  };
+  const double initial = ph_defaults::kInitialLambda;
+  ASSERT_GT(initial, 0.3);
+  ASSERT_LT(initial, 0.7);
+  const Case cases[] = {{{}, Assistance::on, initial, LambdaCap::none},
+                        {{0.0, 0.3}, Assistance::on, 0.3, LambdaCap::instructor_ceiling},
+                        {{0.7, 1.0}, Assistance::on, 0.7, LambdaCap::instructor_floor},
+                        {{0.0, 0.9}, Assistance::on, initial, LambdaCap::none},
+                        {{}, Assistance::off, 1.0, LambdaCap::probe}};
+  for (const Case& c : cases) {
+    ModeRequest r = novice(1.0, c.bounds);
+    r.assist = c.assist;
+    auto mode = load(std::move(r));
+    ASSERT_TRUE(mode);
+    const Telemetry ready = mode->telemetry();
+    const std::string what = "bounds " + std::to_string(c.bounds.floor) + ".." +
+                             std::to_string(c.bounds.ceiling) +
+                             (c.assist == Assistance::off ? " (probe)" : "");
+    EXPECT_FALSE(ready.solved) << what;
+    EXPECT_EQ(ready.lambda, c.lambda) << what;
+    EXPECT_EQ(ready.reason.cap, c.cap) << what;
+    EXPECT_EQ(ready.instructor.bounds, c.bounds) << what;
+    ASSERT_GE(ready.num_channels, 1);
+    EXPECT_EQ(ready.channels[0].value, c.lambda) << what << ": the λ plot's first point";
+    ASSERT_TRUE(mode->step());
+    EXPECT_EQ(mode->telemetry().lambda, ready.lambda) << what << ": the first step's λ";
+    EXPECT_EQ(mode->telemetry().reason.cap, ready.reason.cap) << what;
+  }
+  // Bounds set at READY (a lesson step, an instructor's command before the start) show at once.
+  auto mode = load(novice(1.0));
+  ASSERT_TRUE(mode);
+  ASSERT_TRUE(mode->set_authority_bounds({0.0, 0.25}));
+  EXPECT_EQ(mode->telemetry().lambda, 0.25);
+  EXPECT_EQ(mode->telemetry().instructor.bounds, (AuthorityBounds{0.0, 0.25}));
+  ASSERT_TRUE(mode->step());
+  EXPECT_EQ(mode->telemetry().lambda, 0.25);
+  // After the first step, bounds take effect from the next one: the telemetry is that step's.
+  const double flown = mode->telemetry().lambda;
+  ASSERT_TRUE(mode->set_authority_bounds({0.0, 0.1}));
+  EXPECT_EQ(mode->telemetry().lambda, flown);
+}
+
 // A ceiling holds λ down by the instructor's choice: the debrief does not call that a takeover.
 TEST(InstructorBounds, ACeilingIsNoTakeoverInTheDebrief) {
   auto mode = load(novice(4.0, {0.0, 0.2}));

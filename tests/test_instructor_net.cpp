@@ -9,6 +9,7 @@
 // ones). Processes are waited for on conditions with generous timeouts, never timed.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -271,6 +272,88 @@ TEST_F(InstructorNet, ALinkTakesCheckedCommandsIntoTheFlightsRing) {
   EXPECT_EQ(teacher.result("A", 3), CommandRefusal::stale);
   EXPECT_EQ(teacher.result("A", 4), CommandRefusal::bad_value);
   EXPECT_NE(v.last_refusal.find("bad value"), std::string::npos) << v.last_refusal;
+  link.stop();
+}
+
+// What a station announces of its flight's state for an instructor's tile: READY gives the λ
+// the first step will use and the bounds (not a λ of 0), and while it flies, what the
+// instructor's commands keep in force — bounds, a gust and its time left, an extra delay, an
+// input loss — and the instructor's pause, each announced once it starts and once it ends (a
+// gust of half a second falls between two of the twice-a-second announcements).
+TEST_F(InstructorNet, TheAnnouncementSaysWhatIsInForce) {
+  SpscRing<InstructorCommand> ring;
+  ring.setup(8, InstructorCommand{});
+  InstructorLink link;
+  InstructorLink::Options lo;
+  lo.domain = domain_;
+  lo.station = {"A", "trainee", "mi_helix", "mixed_initiative", 30.0, 0.175};
+  lo.security = CommandSecurity::unauthenticated_loopback;
+  // Announcements far apart: what is seen soon came from a change, not from the period.
+  lo.announce_period_s = 3600.0;
+  std::atomic<bool> paused{false};
+  lo.paused = [&paused] { return paused.load(); };
+  std::string error;
+  ASSERT_TRUE(link.start(lo, &ring, error)) << error;
+  Telemetry s;
+  s.mode = ModeKind::mixed_initiative;
+  s.lambda = 0.3;
+  s.instructor.bounds = {0.0, 0.3};
+  link.ready(s);
+  InstructorClient teacher;
+  ASSERT_TRUE(teacher.open({domain_, "teacher", nullptr, false}, error)) << error;
+  const auto heard = [&](auto done) {
+    return eventually([&] {
+      teacher.poll(0.01);
+      const std::optional<StationView> v = teacher.station("A");
+      return v && done(*v);
+    }, 30);
+  };
+  // The first announcement (at start) came before ready(); a change announces again.
+  ASSERT_TRUE(heard([](const StationView& v) {
+    return v.in_force.bounds == AuthorityBounds{0.0, 0.3};
+  }));
+  StationView v = *teacher.station("A");
+  EXPECT_EQ(v.state, StationState::ready);
+  EXPECT_EQ(v.lambda, 0.3);
+  EXPECT_EQ(v.mean_lambda, 0.0);  // READY is no sample
+
+  // Flying, a gust starts: announced at once, with its force and time left.
+  s.t = 1.0;
+  s.lambda = 0.25;
+  s.x = Eigen::VectorXd::Zero(16);
+  s.reference = Eigen::VectorXd::Zero(3);
+  s.instructor.gust = {2.0, 0.0, 0.0};
+  s.instructor.gust_left = 0.5;
+  link.on_sample(s);
+  ASSERT_TRUE(heard([](const StationView& v) { return v.in_force.gust_left > 0.0; }));
+  v = *teacher.station("A");
+  EXPECT_EQ(v.state, StationState::flying);
+  EXPECT_EQ(v.in_force.gust, Eigen::Vector3d(2.0, 0.0, 0.0));
+  EXPECT_EQ(v.in_force.gust_left, 0.5);
+  EXPECT_EQ(v.in_force.bounds, (AuthorityBounds{0.0, 0.3}));
+  // Its time running down is no news; its end, an extra delay and an input loss are.
+  const std::uint64_t announced = v.announcements;
+  s.t = 1.2;
+  s.instructor.gust_left = 0.3;
+  link.on_sample(s);
+  s.t = 1.6;
+  s.instructor.gust = Eigen::Vector3d::Zero();
+  s.instructor.gust_left = 0.0;
+  s.instructor.extra_delay = 0.1;
+  s.instructor.input_loss_left = 0.8;
+  s.instructor.bounds = {};
+  link.on_sample(s);
+  ASSERT_TRUE(heard([](const StationView& v) { return v.in_force.extra_delay > 0.0; }));
+  v = *teacher.station("A");
+  EXPECT_EQ(v.in_force.gust_left, 0.0);
+  EXPECT_EQ(v.in_force.extra_delay, 0.1);
+  EXPECT_EQ(v.in_force.input_loss_left, 0.8);
+  EXPECT_EQ(v.in_force.bounds, AuthorityBounds{});
+  EXPECT_EQ(v.t, 1.6);
+  EXPECT_EQ(v.announcements, announced + 1);  // not one for the gust running down at 1.2 s
+  // The instructor's pause.
+  paused = true;
+  ASSERT_TRUE(heard([](const StationView& v) { return v.state == StationState::paused; }));
   link.stop();
 }
 

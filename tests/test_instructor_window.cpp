@@ -1,9 +1,11 @@
 // The instructor's window (SPEC §10, `mixpilot instruct`): its screen from a view made here
-// (tiles, the list past four stations, the layout at 100 % and 150 %), and the whole window —
-// app/instructor_app.hpp through the headless renderer — with two station processes (headless,
-// real time, loopback, this test's own domain): both listed with their tiles, a ceiling sent to
-// one from the command pane and shown accepted, commands to a station that obeys no instructor
-// and a bad marker shown refused with the station's reason.
+// (tiles, the list past four stations, what the instructor keeps in force on a tile, the layout
+// at 100 % and 150 %); a trainee's window READY under a ceiling, as it shows it and announces
+// it; and the whole window — app/instructor_app.hpp through the headless renderer — with two
+// station processes (headless, real time, loopback, this test's own domain): both listed with
+// their tiles, a ceiling sent to one from the command pane and shown accepted and in force on
+// its tile, a gust shown on the tile while it acts, commands to a station that obeys no
+// instructor and a bad marker shown refused with the station's reason.
 //
 // Processes are waited for on conditions with generous timeouts, never timed.
 #include <gtest/gtest.h>
@@ -26,6 +28,8 @@
 
 #include "app/instructor_app.hpp"
 #include "app/offscreen.hpp"
+#include "app/trainer.hpp"
+#include "input/net/instructor_client.hpp"
 #include "net_test.hpp"
 #include "spawned.hpp"
 #include "temp_files.hpp"
@@ -202,6 +206,122 @@ TEST_F(InstructorWindow, TilesTheListAndTheLargeViewFitAt100And150Percent) {
   }
 }
 
+// What the instructor's commands keep in force at a station shows on its tile while it acts,
+// as the trainee's HUD says it: over the top of the arena (a window of its own) side by side,
+// on a line under the header of a small tile while another is large; the λ strip draws the
+// bounds. A station with nothing in force shows nothing. Nothing overlaps or is cut at 100 %
+// and 150 %.
+TEST_F(InstructorWindow, TilesShowWhatIsInForceAtTheStation) {
+  ui::InstructorView v = fake_view(3);
+  ui::StationTile& gusted = v.stations[0];
+  gusted.in_force.bounds = {0.0, 0.3};
+  gusted.in_force.gust = {2.0, 0.0, 0.0};
+  gusted.in_force.gust_left = 0.35;
+  gusted.in_force.extra_delay = 0.1;
+  gusted.in_force.input_loss_left = 0.8;
+  auto h = std::make_shared<ui::History>(gusted.history->size());
+  for (std::size_t i = 0; i < gusted.history->size(); ++i) {
+    Telemetry s = (*gusted.history)[i];
+    s.instructor.bounds = {0.0, 0.3};
+    h->push(s);
+  }
+  gusted.history = h;
+  ASSERT_EQ(v.stations[1].state, "paused");  // sim2: paused by the instructor, nothing else
+  EXPECT_EQ(ui::tile_in_force(gusted),
+            (std::vector<std::string>{"instructor: ceiling 0.30", "· gust 2.0 N, 0.3 s left",
+                                      "· delay +0.100 s", "· input lost, 0.8 s left"}));
+  EXPECT_EQ(ui::tile_in_force(v.stations[1]), std::vector<std::string>{"instructor: paused"});
+  EXPECT_TRUE(ui::tile_in_force(v.stations[2]).empty());
+  for (const float scale : {1.0f, 1.5f}) {
+    const std::string tag = scale == 1.0f ? "100" : "150";
+    cli::Offscreen screen;
+    std::string error;
+    if (!screen.open(1280, 720, error, scale)) GTEST_SKIP() << "no EGL device: " << error;
+    ui::InstructorUi ui;
+    std::vector<ui::InstructorRequest> out;
+    Driver d{screen, [&] { ui::draw_instructor(v, ui, out); }};
+    d.frame();
+    d.frame();
+    EXPECT_TRUE(shown("##in force sim1")) << tag;
+    EXPECT_TRUE(shown("##in force sim2")) << tag;
+    EXPECT_FALSE(shown("##in force sim3")) << tag;
+    // Over its own tile's arena, under the header, inside the tile.
+    const ImGuiWindow* over = ImGui::FindWindowByName("##in force sim1");
+    const ImGuiWindow* tile = ImGui::FindWindowByName("##tile sim1");
+    ASSERT_TRUE(over && tile);
+    EXPECT_GE(over->Pos.x, tile->Pos.x) << tag;
+    EXPECT_LE(over->Pos.x + over->Size.x, tile->Pos.x + tile->Size.x) << tag;
+    EXPECT_GT(over->Pos.y, tile->Pos.y + 2.0f * ImGui::GetTextLineHeight()) << tag;
+    // Above the λ strip and the figures (two lines each) at the tile's bottom.
+    EXPECT_LE(over->Pos.y + over->Size.y,
+              tile->Pos.y + tile->Size.y - 4.0f * ImGui::GetTextLineHeight())
+        << tag;
+    for (const std::string& p : test::layout_problems()) ADD_FAILURE() << tag << " %: " << p;
+    save(screen, "in_force_" + tag);
+    // sim2 large: sim1 small, its line under the header; sim2's pause over its arena.
+    d.key(ui::Key::digit2);
+    d.frame();
+    EXPECT_TRUE(shown("##mini sim1")) << tag;
+    EXPECT_FALSE(shown("##in force sim1")) << tag;
+    EXPECT_TRUE(shown("##in force sim2")) << tag;
+    for (const std::string& p : test::layout_problems()) ADD_FAILURE() << tag << " % large: " << p;
+    save(screen, "in_force_large_" + tag);
+  }
+}
+
+// READY shows what the flight starts with. A trainee's window flown with an instructor's
+// ceiling of 0.3 (fly --ceiling 0.3) and published as a station: before its first step its
+// telemetry — what the authority bar, the λ plot and the reason line draw — holds λ 0.3 (the
+// initial 0.5 under the ceiling) with the ceiling in force and as the reason, and the station
+// is announced READY at λ 0.3 under that ceiling, so the instructor's tile says the same.
+// Nothing overlaps or is cut at 100 % and 150 %.
+TEST_F(InstructorWindow, ReadyShowsTheCeilingToTheTraineeAndTheInstructor) {
+  const fs::path dir = test::fresh_path("instructor_window", "ready");
+  fs::create_directories(dir);
+  setenv("XDG_CONFIG_HOME", (dir / "config").c_str(), 1);
+  setenv("XDG_DATA_HOME", (dir / "data").c_str(), 1);
+  std::string error;
+  net::InstructorClient teacher;
+  ASSERT_TRUE(teacher.open({domain_, "teacher", nullptr, false}, error)) << error;
+  for (const float scale : {1.0f, 1.5f}) {
+    const std::string tag = scale == 1.0f ? "100" : "150";
+    cli::Offscreen screen;
+    if (!screen.open(1280, 720, error, scale)) GTEST_SKIP() << "no EGL device: " << error;
+    cli::FlyOptions o;
+    o.scenario_path = kSrc + "/scenarios/mi_helix.toml";
+    o.pilot = "novice";
+    o.duration = 2.0;
+    o.bounds = {0.0, 0.3};
+    o.publish = true;
+    o.domain = domain_;
+    o.station = "ready" + tag;
+    o.trainee = "Ada";
+    o.history = "off";
+    o.ghost = "off";
+    cli::Trainer app(o);
+    int status = 0;
+    ASSERT_TRUE(app.open_live(error, status)) << error;
+    for (int i = 0; i < 3; ++i) screen.frame([&] { app.build_frame(0.0); }, 1e-4f);
+    ASSERT_EQ(app.run_info().state, ui::RunState::ready) << tag;
+    const Telemetry& ready = app.live()->mode().telemetry();
+    EXPECT_FALSE(ready.solved) << tag;
+    EXPECT_EQ(ready.lambda, 0.3) << tag;
+    EXPECT_EQ(ready.instructor.bounds, (AuthorityBounds{0.0, 0.3})) << tag;
+    EXPECT_EQ(ready.reason.cap, LambdaCap::instructor_ceiling) << tag;
+    for (const std::string& p : test::layout_problems()) ADD_FAILURE() << tag << " %: " << p;
+    save(screen, "ready_ceiling_" + tag);
+    ASSERT_TRUE(eventually([&] {
+      teacher.poll(0.01);
+      const std::optional<StationView> v = teacher.station(o.station);
+      return v && v->in_force.bounds == AuthorityBounds{0.0, 0.3};
+    }, 30)) << tag;
+    const StationView v = *teacher.station(o.station);
+    EXPECT_EQ(v.state, StationState::ready) << tag;
+    EXPECT_EQ(v.lambda, 0.3) << tag;
+    EXPECT_EQ(v.trainee, "Ada") << tag;
+  }
+}
+
 // --- With station processes ------------------------------------------------------------------------
 
 std::vector<std::pair<std::string, std::string>> user_dirs(const fs::path& dir) {
@@ -320,6 +440,39 @@ TEST_F(InstructorWindow, TwoStationsACeilingAcceptedAndRefusalsShown) {
   d.frame();
   for (const std::string& p : test::layout_problems()) ADD_FAILURE() << p;
   save(*screen, "accepted");
+  // What the ceiling keeps in force shows on A's tile, once A flies with it (the slider's
+  // float, as sent).
+  ASSERT_TRUE(frames_until([&] {
+    const ui::StationTile* t = tile_of(*app.view(), "A");
+    return t && t->in_force.bounds == AuthorityBounds{0.0, double(0.3f)};
+  }, 60));
+  // Ctrl+G: a gust of 2 N (for its longest, so a loaded machine still sees it act), on A's tile
+  // while it acts, with its force and time left.
+  app.ui_state().draft.gust_s = float(kMaxCommandDuration);
+  d.key(ui::Key::g, true);
+  ASSERT_TRUE(frames_until([&] {
+    const auto c = newest("A");
+    return c && c->kind == InstructorCommandKind::gust && answered("A")();
+  }, 60));
+  EXPECT_EQ(newest("A")->outcome, ui::CommandOutcome::accepted) << newest("A")->why;
+  ASSERT_TRUE(frames_until([&] {
+    const ui::StationTile* t = tile_of(*app.view(), "A");
+    return t && t->in_force.gust_left > 0.0;
+  }, 60));
+  {
+    const ui::StationTile& ta = *tile_of(*app.view(), "A");
+    EXPECT_EQ(ta.in_force.gust, Eigen::Vector3d(2.0, 0.0, 0.0));
+    EXPECT_LE(ta.in_force.gust_left, kMaxCommandDuration);
+    const std::vector<std::string> said = ui::tile_in_force(ta);
+    ASSERT_EQ(said.size(), 2u);
+    EXPECT_EQ(said[0], "instructor: ceiling 0.30");
+    EXPECT_EQ(said[1].rfind("· gust 2.0 N, ", 0), 0u) << said[1];
+  }
+  d.frame();
+  EXPECT_TRUE(shown("##in force A"));
+  EXPECT_FALSE(shown("##in force B"));
+  for (const std::string& p : test::layout_problems()) ADD_FAILURE() << p;
+  save(*screen, "gust");
 
   // Ctrl+M with no text: A refuses it as a bad value, and the window says so.
   d.key(ui::Key::m, true);
@@ -346,7 +499,7 @@ TEST_F(InstructorWindow, TwoStationsACeilingAcceptedAndRefusalsShown) {
   d.frame();
   for (const std::string& p : test::layout_problems()) ADD_FAILURE() << p;
   save(*screen, "refused");
-  EXPECT_EQ(app.asked(), 3u);
+  EXPECT_EQ(app.asked(), 4u);
 
   // The same window at 150 %: nothing overlaps or is cut.
   screen.reset();
@@ -364,7 +517,7 @@ TEST_F(InstructorWindow, TwoStationsACeilingAcceptedAndRefusalsShown) {
   ASSERT_GE(a.wait(60), 0);
   ASSERT_GE(b.wait(60), 0);
   const std::string sa = read_file(dir / "a.txt"), sb = read_file(dir / "b.txt");
-  EXPECT_NE(sa.find("1 accepted, 1 refused (1 bad value)"), std::string::npos) << sa;
+  EXPECT_NE(sa.find("2 accepted, 1 refused (1 bad value)"), std::string::npos) << sa;
   EXPECT_NE(sb.find("0 accepted, 1 refused (1 instructor not allowed)"), std::string::npos) << sb;
 }
 

@@ -682,9 +682,20 @@ TEST_P(LessonPicker, ShowsTheTraineesStepOfTheCourse) {
   EXPECT_EQ(app.live()->mode().authority_bounds(), (AuthorityBounds{0.0, 0.65}));
   EXPECT_EQ(c.scenarios[std::size_t(c.scenario)], "lesson_helix_slow");
   EXPECT_FALSE(c.assist_choosable && c.lesson == 0);
+  // READY says what the step starts with: the initial λ 0.5 under the step's ceiling 0.65.
+  EXPECT_EQ(app.live()->mode().telemetry().lambda, 0.5);
+  EXPECT_EQ(app.live()->mode().telemetry().instructor.bounds, (AuthorityBounds{0.0, 0.65}));
   for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
   const ImGuiWindow* panel = ImGui::FindWindowByName("Session");
   ASSERT_TRUE(panel && panel->Active);
+  // The five steps, the step's rule, attempts and verdict (the panel's choices) and the start
+  // button under them all show on the default window without scrolling.
+  EXPECT_FALSE(panel->ScrollbarY) << "the session panel scrolls";
+  EXPECT_LE(panel->DC.CursorMaxPos.y, panel->InnerClipRect.Max.y + 1.0f)
+      << "the start button is under the panel's bottom";
+  for (const ImGuiWindow* w : GImGui->Windows)
+    if (w->ParentWindow == panel && (w->Flags & ImGuiWindowFlags_ChildWindow) && w->Active)
+      EXPECT_FALSE(w->ScrollbarY) << "the session panel's choices scroll";
   save_shot("lesson_picker_" + std::to_string(int(std::lround(GetParam() * 100))));
 }
 

@@ -28,6 +28,7 @@
 #include "core/history/schema.hpp"
 #include "core/history/sqlite_history.hpp"
 #include "postgres_server.hpp"
+#include "history_dump.hpp"
 #include "history_test.hpp"
 #include "run_mixpilot.hpp"
 #include "temp_files.hpp"
@@ -774,6 +775,72 @@ TEST(Postgres, PushTwiceAddsNothingTheSecondTime) {
   ASSERT_TRUE(history::push_history(*station2, *centre, counts, error)) << error;
   EXPECT_EQ(counts.added, 0u);
   EXPECT_EQ(sql(*server, "centre", "SELECT count(*) FROM flights"), "8");
+}
+
+// A station's whole history pushed into PostgreSQL: every table of the schema holds what the
+// station's does, once, after two pushes (row counts on the server; the server's tables have
+// the same columns as SQLite's), and pushing the centre back into a fresh SQLite file gives a
+// history equal to the station's, row for row, ids aside. A history written into PostgreSQL
+// directly comes out through a push with every column still set (what the backend reads).
+TEST(Postgres, PushCarriesEveryTable) {
+  MIXPILOT_REQUIRE_POSTGRES(server);
+  std::string error;
+  const fs::path station_file = fresh_path("postgres", "every_table.sqlite");
+  auto station = history::open_sqlite(station_file.string(), error);
+  ASSERT_TRUE(station) << error;
+  ASSERT_NO_FATAL_FAILURE(fill_every_column(*station));
+  const HistoryDump mine = dump_history(station_file);
+  expect_every_column_varies(mine);
+
+  const std::string url = fresh_database(*server, "centre_every_table");
+  auto centre = open_store(url);
+  ASSERT_TRUE(centre);
+  history::PushCounts counts;
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, mine.rows.at("flights").size());
+  EXPECT_EQ(counts.attempts, mine.rows.at("lesson_attempts").size());
+  EXPECT_EQ(counts.progress, mine.rows.at("lesson_progress").size());
+  ASSERT_TRUE(history::push_history(*station, *centre, counts, error)) << error;
+  EXPECT_EQ(counts.added, 0u);
+  EXPECT_EQ(counts.attempts, 0u);
+  EXPECT_EQ(counts.progress, 0u);
+  for (const auto& [table, columns] : mine.schema) {
+    std::string sqlite_columns;
+    for (const std::string& c : columns) sqlite_columns += (sqlite_columns.empty() ? "" : ",") + c;
+    EXPECT_EQ(sql(*server, "centre_every_table",
+                  "SELECT string_agg(column_name, ',' ORDER BY ordinal_position) FROM "
+                  "information_schema.columns WHERE table_schema = current_schema() AND "
+                  "table_name = '" + table + "'"),
+              sqlite_columns)
+        << table;
+    if (table == "schema_version") continue;
+    EXPECT_EQ(sql(*server, "centre_every_table", "SELECT count(*) FROM " + table),
+              std::to_string(mine.rows.at(table).size()))
+        << table;
+  }
+  const fs::path back_file = fresh_path("postgres", "every_table_back.sqlite");
+  {
+    auto back = history::open_sqlite(back_file.string(), error);
+    ASSERT_TRUE(back) << error;
+    ASSERT_TRUE(history::push_history(*centre, *back, counts, error)) << error;
+  }
+  expect_same_history(dump_history(back_file), mine, "station -> PostgreSQL -> SQLite");
+
+  const std::string direct_url = fresh_database(*server, "written_directly");
+  auto direct = open_store(direct_url);
+  ASSERT_TRUE(direct);
+  ASSERT_NO_FATAL_FAILURE(fill_every_column(*direct));
+  const fs::path out_file = fresh_path("postgres", "written_directly.sqlite");
+  {
+    auto out = history::open_sqlite(out_file.string(), error);
+    ASSERT_TRUE(out) << error;
+    ASSERT_TRUE(history::push_history(*direct, *out, counts, error)) << error;
+  }
+  const HistoryDump theirs = dump_history(out_file);
+  expect_every_column_varies(theirs);
+  for (const auto& [table, rows] : mine.rows)
+    if (table != "schema_version")
+      EXPECT_EQ(theirs.rows.at(table).size(), rows.size()) << table;
 }
 
 // `mixpilot history push` as a user runs it: twice, the second adds nothing; the password

@@ -16,6 +16,7 @@
 #include "temp_files.hpp"
 #include "core/scenario/obstacle_scenario.hpp"
 #include "core/scenario/pendubot_scenario.hpp"
+#include "core/scenario/scenario_keys.hpp"
 #include "core/scenario/scenario_toml.hpp"
 #include "core/scenario/tracking_scenario.hpp"
 
@@ -678,6 +679,138 @@ TEST(DataFiles, FoundBesideTheExecutableOrWhereTheOverrideSays) {
             std::string::npos) << why;
   EXPECT_EQ(data_file("scenarios/mi_helix.toml"), "");
   unsetenv("MIXPILOT_DATA_DIR");
+}
+
+
+// ---- Scenario keys set to other values (core/scenario/scenario_keys.hpp) -----------------
+
+namespace keys_test {
+
+std::string set(const std::string& text, std::vector<ScenarioKey> keys, std::string& error) {
+  const auto out = set_scenario_keys(text, "t.toml", keys, error);
+  return out ? *out : std::string();
+}
+
+}  // namespace keys_test
+
+// A key the file gives changes where it stands: every other byte (comments, order, other
+// keys) is kept, and the loader reads the new value.
+TEST(ScenarioKeys, AValueIsReplacedWhereItStands) {
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/tracking_smooth_step.toml";
+  std::string text, error;
+  ASSERT_TRUE(read_text_file(path, text, error)) << error;
+  const std::string edited = keys_test::set(text, {{"plant.rtt", "0.012"}, {"controller.compensation", "false"}}, error);
+  ASSERT_FALSE(edited.empty()) << error;
+  std::string expected = text;
+  expected.replace(expected.find("rtt = 0.06 "), 10, "rtt = 0.012");
+  expected.replace(expected.find("compensation = true"), 19, "compensation = false");
+  EXPECT_EQ(edited, expected);
+  const auto sc = parse_tracking_scenario(edited, path, error);
+  ASSERT_TRUE(sc) << error;
+  EXPECT_EQ(sc->plant.rtt, 0.012);
+  EXPECT_FALSE(sc->controller.compensation);
+  // Code points before the value on its line (toml++ counts columns in code points), arrays,
+  // strings; the later setting of a key wins.
+  const std::string t = "a = \"\u00e9\u2192\"  # \u00fc\n[b]\nc = [\"\u00e9\u00e9\", 5]  # \u2192\n";
+  EXPECT_EQ(keys_test::set(t, {{"a", "\"x\""}, {"b.c", "[1, 2]"}, {"b.c", "[3]"}}, error),
+            "a = \"x\"  # \u00fc\n[b]\nc = [3]  # \u2192\n") << error;
+}
+
+// A key the file leaves to its default is added under its table's header (the root's at the
+// top); then the loader checks it as any key.
+TEST(ScenarioKeys, AMissingKeyIsAddedUnderItsTable) {
+  std::string error;
+  const std::string t = "# c\nname = \"n\"\n\n[controller]  # the NMPC\nN = 50\n\n[plant]\nrtt = 0.06";
+  EXPECT_EQ(keys_test::set(t, {{"controller.kind", "\"lqr\""}, {"plant.seed", "3"}, {"duration", "2.0"}}, error),
+            "duration = 2.0\n# c\nname = \"n\"\n\n[controller]  # the NMPC\nkind = \"lqr\"\nN = 50\n\n"
+            "[plant]\nseed = 3\nrtt = 0.06")
+      << error;
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/tracking_smooth_step.toml";
+  std::string text;
+  ASSERT_TRUE(read_text_file(path, text, error)) << error;
+  const std::string edited = keys_test::set(text, {{"plant.typo", "1.0"}}, error);
+  ASSERT_FALSE(edited.empty()) << error;
+  EXPECT_FALSE(parse_tracking_scenario(edited, path, error));
+  EXPECT_NE(error.find("plant.typo"), std::string::npos) << error;
+}
+
+// An element of an array is a key too: a value of an array of tables' element, an element of
+// a value array, a key an element leaves out (under its [[header]]); a table the file lacks, or
+// has no header of its own, is appended with its header; an inline table takes a key inside its
+// braces.
+TEST(ScenarioKeys, ArrayElementsInlineAndMissingTables) {
+  std::string error;
+  const std::string t = "[a]\nv = [1.0, 2.0]  # x\nin = { p = 1 }\n[[e]]\nf = 3\n[[e]]\nf = 4\n[g.h]\ni = 4\n";
+  EXPECT_EQ(keys_test::set(t, {{"e[1].f", "5"}, {"a.v[1]", "-0.5"}, {"e[0].k", "true"},
+                               {"a.in.q", "\"s\""}, {"g.z", "1"}, {"x.y.w", "[1, 2]"}},
+                           error),
+            "[a]\nv = [1.0, -0.5]  # x\nin = { p = 1 , q = \"s\" }\n[[e]]\nk = true\nf = 3\n[[e]]\n"
+            "f = 5\n[g.h]\ni = 4\n\n[g]\nz = 1\n\n[x.y]\nw = [1, 2]\n")
+      << error;
+  // A shipped scenario's obstacle: the loader reads the new radius, every other byte is kept.
+  const std::string path = std::string(MIXPILOT_SOURCE_DIR) + "/scenarios/mi_helix.toml";
+  std::string text;
+  ASSERT_TRUE(read_text_file(path, text, error)) << error;
+  const auto before = parse_scenario(text, path, error);
+  ASSERT_TRUE(before) << error;
+  const std::string edited = keys_test::set(text, {{"arena.obstacles[1].radius", "0.125"}}, error);
+  ASSERT_FALSE(edited.empty()) << error;
+  const auto after = parse_scenario(edited, path, error);
+  ASSERT_TRUE(after) << error;
+  ASSERT_GT(before->arena.obstacles.size(), 2u);
+  EXPECT_NE(before->arena.obstacles[1].radius, 0.125);
+  EXPECT_EQ(after->arena.obstacles[1].radius, 0.125);
+  EXPECT_EQ(after->arena.obstacles[0].radius, before->arena.obstacles[0].radius);
+  EXPECT_EQ(after->arena.obstacles[2].radius, before->arena.obstacles[2].radius);
+  // Only that value changed: the second obstacle's "radius = 0.2" line.
+  const std::size_t second = text.find("[[arena.obstacles]]", text.find("[[arena.obstacles]]") + 1);
+  const std::size_t at = text.find("radius = 0.2\n", second);
+  ASSERT_NE(at, std::string::npos);
+  std::string expected = text;
+  expected.replace(at, 12, "radius = 0.125");
+  EXPECT_EQ(edited, expected);
+}
+
+// What cannot be set is refused with the setting and the file named.
+TEST(ScenarioKeys, RefusalsNameTheSetting) {
+  const std::string t = "name = \"n\"\n[a]\nb = 1\nv = [1.0, 2.0]\n[a.c]\nd = 2\n[[e]]\nf = 3\n";
+  const struct {
+    ScenarioKey key;
+    const char* says;
+  } cases[] = {
+      {{"a", "1"}, "a table in the scenario: expected the key of a value inside it"},
+      {{"e", "1"}, "an array of tables in the scenario: expected the key of a value inside it"},
+      {{"e.f", "1"}, "e is an array of tables in the scenario: expected an element of it, e[index].f"},
+      {{"e[1].f", "1"}, "has 1 elements: index 1 is out of range"},
+      {{"a.v[2]", "1.0"}, "has 2 elements: index 2 is out of range"},
+      {{"a.b[0]", "1"}, "b is 1 in the scenario, not an array"},
+      {{"x[0].y", "1"}, "the scenario has no x"},
+      {{"a.b.z", "1"}, "a.b is 1 in the scenario, not a table"},
+      {{"a.b", "\"s\""}, "expected an integer like the scenario's value 1, got \"s\""},
+      {{"a.v", "1.0"}, "expected an array"},
+      {{"name", "true"}, "expected a string"},
+      {{"a.b", "lcl"}, "not one TOML value"},
+      {{"a.b", "1\nc = 2"}, "on one line"},
+      {{"a..b", "1"}, "expected a key path of the scenario"},
+      {{"a.\"b\"", "1"}, "expected a key path of the scenario"},
+      {{"a.v[x]", "1"}, "expected [index] with a whole number after \"v\""},
+  };
+  for (const auto& c : cases) {
+    std::string error;
+    EXPECT_FALSE(set_scenario_keys(t, "t.toml", {c.key}, error)) << c.key.key;
+    EXPECT_NE(error.find(c.says), std::string::npos) << error;
+    EXPECT_NE(error.find("setting " + c.key.key + " = "), std::string::npos) << error;
+    EXPECT_NE(error.find("t.toml"), std::string::npos) << error;
+  }
+  std::string error;
+  EXPECT_FALSE(set_scenario_keys("a = [", "t.toml", {{"a", "1"}}, error));
+  EXPECT_NE(error.find("not TOML"), std::string::npos) << error;
+  const auto k = parse_scenario_key(" plant.rtt = 0.012 ", error);
+  ASSERT_TRUE(k);
+  EXPECT_EQ(k->key, "plant.rtt");
+  EXPECT_EQ(k->value, "0.012");
+  EXPECT_FALSE(parse_scenario_key("plant.rtt", error));
+  EXPECT_FALSE(parse_scenario_key("=1", error));
 }
 
 }  // namespace

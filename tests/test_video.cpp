@@ -210,12 +210,17 @@ TEST_F(Video, DecodedFrameMatchesScreenshot) {
   const auto screenshot = rgba_of(shot);
   ASSERT_EQ(frame.size(), std::size_t(1280 * 720 * 4));
   ASSERT_EQ(screenshot.size(), frame.size());
+  // x264's quantisation and 4:2:0 chroma on thin lines and small text: about 2/255 on
+  // average, more when the RTI-time plot (which follows the machine's load while the recording
+  // was flown) is jagged.
   const double difference = mean_abs_difference(frame, screenshot);
-  EXPECT_LE(difference, 2.0);
+  EXPECT_LE(difference, 3.0);
   RecordProperty("mean_abs_difference", std::to_string(difference));
   // The neighbouring frames show other times: the comparison can tell frames apart.
   const auto other = rgba_of(out, kFrame + 5);
-  EXPECT_GT(mean_abs_difference(other, screenshot), mean_abs_difference(frame, screenshot));
+  const double other_difference = mean_abs_difference(other, screenshot);
+  RecordProperty("neighbour_mean_abs_difference", std::to_string(other_difference));
+  EXPECT_GT(other_difference, difference);
 }
 
 // Bad values are usage errors naming the option and what was expected; nothing is written.

@@ -53,6 +53,10 @@ struct StationTile {
   std::string security;         // how it treats commands, in words
   double t = 0, duration = 0;   // [s] the flight's time and planned length
   double lambda = 0, deviation = 0, time_in_ball = 0, mean_lambda = 0;  // announced
+  // What the instructor's commands keep in force there now (bounds, a gust, an extra delay, an
+  // input loss; the times left as announced, run down since while it flies); a pause is the
+  // state "paused".
+  InstructorInForce in_force;
   std::uint64_t accepted = 0, refused = 0;
   std::string last_refusal;     // the station's newest refusal in words
   double heard_ago = 0.0;       // [s] since its newest announcement
@@ -108,6 +112,12 @@ struct InstructorRequest {
 
 inline constexpr int kMaxTiles = 4;
 
+// What a tile says is in force at its station, item by item as the trainee's HUD says it:
+// {"instructor: paused", "· ceiling 0.30", "· gust 2.0 N, 0.3 s left", ...}; empty when
+// nothing is. The tile shows them over the top of its arena (a window "##in force NAME"), a
+// small tile on a line under its header.
+std::vector<std::string> tile_in_force(const StationTile& t);
+
 // The stations the tiles show: ui.shown's that are announced, completed up to four with the
 // others in name order.
 std::vector<const StationTile*> shown_tiles(const InstructorView& v, const InstructorUi& ui);
@@ -119,7 +129,8 @@ void draw_instructor(const InstructorView& v, InstructorUi& ui,
 
 // The λ strip: the recent λ of `h` (its last `seconds`) as a filled strip over [min, max): the
 // pilot's share λ from the bottom in the pilot's colour, the planner's 1 − λ above it in the
-// planner's (hatched, so the two read apart in greyscale), the λ line between them.
+// planner's (hatched, so the two read apart in greyscale), the λ line between them, and the
+// instructor's bounds of each sample (Telemetry::instructor) as lines in the caution colour.
 void draw_lambda_strip(const History& h, double seconds, ImVec2 min, ImVec2 max);
 
 }  // namespace mixpilot::ui

@@ -21,12 +21,16 @@ std::vector<std::string> instructor_banners(const History& h, std::size_t most) 
 }
 
 std::vector<std::string> instructor_in_force(const Telemetry& s) {
-  const InstructorInForce& f = s.instructor;
+  return instructor_in_force(s.instructor);
+}
+
+std::vector<std::string> instructor_in_force(const InstructorInForce& f, bool paused) {
   std::vector<std::string> out;
   char buf[64];
   const auto add = [&](const char* text) {
     out.push_back(out.empty() ? std::string("instructor: ") + text : std::string("· ") + text);
   };
+  if (paused) add("paused");
   if (f.bounds != AuthorityBounds{}) {
     InstructorCommand b;
     b.kind = InstructorCommandKind::bounds;

@@ -18,8 +18,11 @@ inline constexpr double kInstructorBannerS = 3.0;
 std::vector<std::string> instructor_banners(const History& h, std::size_t most);
 
 // What is in force during step `s`, item by item (the HUD wraps between them), the first one
-// saying whose: {"instructor: ceiling 0.30", "gust 2.0 N, 0.3 s left", "delay +0.030 s",
-// "input lost, 0.6 s left"}; empty when nothing is.
+// saying whose: {"instructor: ceiling 0.30", "· gust 2.0 N, 0.3 s left", "· delay +0.030 s",
+// "· input lost, 0.6 s left"}; empty when nothing is.
 std::vector<std::string> instructor_in_force(const Telemetry& s);
+// The same of what a station announces (the instructor's tiles), "paused" first when the
+// instructor holds the flight.
+std::vector<std::string> instructor_in_force(const InstructorInForce& f, bool paused = false);
 
 }  // namespace mixpilot::ui

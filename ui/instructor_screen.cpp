@@ -8,11 +8,16 @@
 #include <iterator>
 
 #include "ui/instructor.hpp"
+#include "ui/instructor_hud.hpp"
 #include "ui/keys.hpp"
 #include "ui/panels.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
+
+std::vector<std::string> tile_in_force(const StationTile& t) {
+  return instructor_in_force(t.in_force, t.state == "paused");
+}
 
 const char* to_string(CommandOutcome o) {
   switch (o) {
@@ -124,8 +129,13 @@ UiState& arena_state(InstructorUi& ui, const std::string& name) {
   return it->second;
 }
 
-// The tile's header: its key, name and state; who flies what; whether it obeys an instructor.
-void tile_header(const StationTile& t, int index, bool selected) {
+// What is in force at `t` on one line, shortened at its end to the window's width ("" none).
+std::string in_force_line(const StationTile& t);
+
+// The tile's header: its key, name and state; who flies what; whether it obeys an instructor,
+// or (`in_force`, a small tile with no room for more) what the instructor keeps in force there
+// when anything is.
+void tile_header(const StationTile& t, int index, bool selected, bool in_force = false) {
   char key[16] = "-";  // a station shown large from the list has no key
   if (index >= 0) std::snprintf(key, sizeof key, "%d", index + 1);
   ImGui::PushFont(mono_font());
@@ -148,7 +158,9 @@ void tile_header(const StationTile& t, int index, bool selected) {
                                                                       : state_colour(t.state)),
                      "%s", state.c_str());
   fitted_text(t.trainee + " · " + t.scenario, colour::kText);
-  if (t.accepts_instructor)
+  if (const std::string line = in_force ? in_force_line(t) : std::string(); !line.empty())
+    fitted_text(line, colour::kCaution);
+  else if (t.accepts_instructor)
     fitted_text("obeys an instructor (" + t.security + ")", colour::rgb(0xB8, 0xB8, 0xB8));
   else
     fitted_text("obeys no instructor: commands refused", colour::kCaution);
@@ -179,6 +191,71 @@ bool clicked_in(ImVec2 min, ImVec2 max) {
     return false;
   if (io.MouseDragMaxDistanceSqr[0] > io.MouseDragThreshold * io.MouseDragThreshold) return false;
   return ImGui::IsMouseHoveringRect(min, max);
+}
+
+// `text` shortened at its end ("…") to `width`, whole UTF-8 code points cut.
+std::string elide_end(const std::string& text, float width);
+
+std::string in_force_line(const StationTile& t) {
+  std::string line;
+  for (const std::string& item : tile_in_force(t)) line += (line.empty() ? "" : " ") + item;
+  return elide_end(line, ImGui::GetContentRegionAvail().x);
+}
+
+std::string elide_end(const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
+  std::string s = text;
+  while (!s.empty()) {
+    do s.pop_back();
+    while (!s.empty() && (static_cast<unsigned char>(s.back()) & 0xC0) == 0x80);
+    if (!s.empty()) s.pop_back();  // the lead byte of the code point cut (or one ASCII byte)
+    if (ImGui::CalcTextSize((s + "\u2026").c_str()).x <= width) break;
+  }
+  return s + "\u2026";
+}
+
+// What is in force at the station over the top of its arena [min, max) (its own window, drawn
+// over the tile's, which mouse clicks pass through to), as the trainee's HUD says it, on a
+// translucent backing: the items packed into lines of the arena's width; where the arena has
+// fewer lines than that takes, the last line holds the rest, shortened at its end.
+void in_force_overlay(const StationTile& t, ImVec2 min, ImVec2 max) {
+  const std::vector<std::string> items = tile_in_force(t);
+  if (items.empty()) return;
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const ImVec2 pad(scaled(4.0f), scaled(2.0f));  // a thin backing: the arena keeps its room
+  const float width = max.x - min.x - 2.0f * st.ItemSpacing.x;
+  const float inner = width - 2.0f * pad.x;
+  const float line = ImGui::GetTextLineHeightWithSpacing();
+  const int most = int((max.y - min.y - 2.0f * st.ItemSpacing.y - 2.0f * pad.y +
+                        st.ItemSpacing.y) / line);
+  if (most < 1 || inner < 4.0f * ImGui::GetFontSize()) return;
+  std::vector<std::string> lines;
+  for (const std::string& item : items) {
+    if (!lines.empty() && ImGui::CalcTextSize((lines.back() + " " + item).c_str()).x <= inner)
+      lines.back() += " " + item;
+    else
+      lines.push_back(item);
+  }
+  if (int(lines.size()) > most) {
+    for (std::size_t i = std::size_t(most); i < lines.size(); ++i)
+      lines[std::size_t(most) - 1] += " " + lines[i];
+    lines.resize(std::size_t(most));
+  }
+  ImGui::SetNextWindowPos(ImVec2(min.x + st.ItemSpacing.x, min.y + st.ItemSpacing.y));
+  ImGui::SetNextWindowSize(ImVec2(width, 0.0f));
+  ImGui::SetNextWindowBgAlpha(0.7f);
+  const std::string name = "##in force " + t.name;
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, pad);
+  ImGui::Begin(name.c_str(), nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                   ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoNav |
+                   ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::PushStyleColor(ImGuiCol_Text, colour::kCaution);
+  for (const std::string& l : lines) ImGui::TextUnformatted(elide_end(l, inner).c_str());
+  ImGui::PopStyleColor();
+  ImGui::End();
+  ImGui::PopStyleVar();
 }
 
 // One station's tile in [min, max): header, arena, λ strip, numbers; `large` adds the plots to
@@ -237,6 +314,9 @@ void tile(const StationTile& t, int index, ImVec2 min, ImVec2 max, bool large, I
     ui.large = true;
   }
   ImGui::End();
+  // (Not over the list or the help, which would come under it.)
+  if (arena_bottom - at.y > 2.0f * line && !ui.show_list && !ui.show_help)
+    in_force_overlay(t, at, ImVec2(arena_right, arena_bottom));
 }
 
 // A small tile (the others while one is large): header and strip, a click selects it.
@@ -248,7 +328,7 @@ void mini_tile(const StationTile& t, int index, ImVec2 min, ImVec2 max, Instruct
   ImGui::GetWindowDrawList()->AddRect(ImVec2(min.x + 1, min.y + 1), ImVec2(max.x - 1, max.y - 1),
                                       colour::rgb(0x40, 0x44, 0x4C), scaled(4.0f), 0,
                                       scaled(1.0f));
-  tile_header(t, index, false);
+  tile_header(t, index, false, true);
   const ImVec2 at = ImGui::GetCursorScreenPos();
   const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
   const float bottom = ImGui::GetWindowPos().y + ImGui::GetWindowContentRegionMax().y;
@@ -603,6 +683,18 @@ void draw_lambda_strip(const History& h, double seconds, ImVec2 min, ImVec2 max)
   for (std::size_t i = first + 1; i < h.size(); ++i)
     dl->AddLine(ImVec2(x_of(h[i - 1].t), y_of(h[i - 1].lambda)), ImVec2(x_of(h[i].t), y_of(h[i].lambda)),
                 colour::kText, scaled(1.5f));
+  // The instructor's bounds while they held: λ stays under the ceiling, over the floor.
+  for (std::size_t i = first; i < h.size(); ++i) {
+    const AuthorityBounds& b = h[i].instructor.bounds;
+    const float xa = x_of(h[i].t);
+    const float xb = std::max(i + 1 < h.size() ? x_of(h[i + 1].t) : max.x, xa + 1.0f);
+    if (b.ceiling < 1.0)
+      dl->AddLine(ImVec2(xa, y_of(b.ceiling)), ImVec2(xb, y_of(b.ceiling)), colour::kCaution,
+                  scaled(2.0f));
+    if (b.floor > 0.0)
+      dl->AddLine(ImVec2(xa, y_of(b.floor)), ImVec2(xb, y_of(b.floor)), colour::kCaution,
+                  scaled(2.0f));
+  }
   // 0.5, and the names of the shares on a dark backing.
   const float mid = y_of(0.5);
   for (float x = min.x; x < max.x; x += scaled(8.0f))

@@ -26,16 +26,21 @@ void draw_pendubot(const Scene& scene, const History& history, ImVec2 min, ImVec
                    ImVec2 frame);
 // The authority bar: planner 0 … 1 pilot, the fill up to λ in the authority colour; with
 // `names`, the shares' names under it (a text line below max.y). A probe flight's bar says
-// PROBE in its label and "assistance off" where the planner's share is named.
+// PROBE in its label and "assistance off" where the planner's share is named. The instructor's
+// `bounds` (SPEC §10), when not [0, 1]: the share λ cannot reach is shaded, a tick in the
+// caution colour marks each bound, and "ceiling 0.30" (or "floor 0.20 · ceiling 0.80") is said
+// under its tick between the names, or in the label where there is no room there.
 void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names = true,
-                        bool probe = false);
+                        bool probe = false, const AuthorityBounds& bounds = {});
 // Pilot command (filled dot) and MPC applied (diamond) on roll/pitch and thrust/yaw gimbals.
 // The thrust stick is centred on the hover rotor speed `hover`.
 void draw_sticks(const Telemetry& s, double hover, ImVec2 min, ImVec2 max);
 // Rolling plots of the mode's channels (frozen while ui.plots_paused).
 void draw_plots(const Scene& scene, const History& history, UiState& ui);
-// The session panel: scenario, pilot, trainee, record, start / restart (run.session).
-void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out);
+// The session panel: scenario, pilot, trainee, record, start / restart (run.session); at most
+// `max_height` tall, the start or restart button always in sight under the choices (which
+// scroll when they do not fit).
+void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float max_height);
 // A replay's transport bar: timeline with event ticks, play / pause, events, speeds (run.replay).
 void draw_transport(const RunInfo& run, Requests& out);
 // The colour of a debrief event's kind, and its mark (shape and colour, `size` its half width)

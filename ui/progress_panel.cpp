@@ -8,6 +8,7 @@
 
 #include "ui/panels.hpp"
 #include "ui/progress.hpp"
+#include "ui/plot.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -105,32 +106,14 @@ void skill_plot(const ProgressView& v, float height) {
   // D first, under the skills: dashed, in the planner's colour (told from the skills in
   // greyscale too).
   if (v.has_dependence) {
-    const float on = scaled(6.0f), off = scaled(4.0f);
-    ImVec2 last(0, 0);
-    bool have = false;
-    float phase = 0.0f;  // along the dash pattern, carried from one segment to the next
+    std::vector<ImVec2> line;
     for (int i = 0; i < n; ++i) {
       const double d = fl[std::size_t(i)].dependence;
       if (!std::isfinite(d)) continue;
-      const ImVec2 p(x_of(i), y_of(100.0 * d));
-      if (have) {
-        const float dx = p.x - last.x, dy = p.y - last.y, len = std::sqrt(dx * dx + dy * dy);
-        for (float at = 0.0f; at < len;) {
-          const float in = std::fmod(phase, on + off);
-          const float step = std::min(len - at, in < on ? on - in : on + off - in);
-          if (in < on) {
-            const float a = at / len, b = (at + step) / len;
-            dl->AddLine(ImVec2(last.x + a * dx, last.y + a * dy),
-                        ImVec2(last.x + b * dx, last.y + b * dy), kDependence, line_w);
-          }
-          at += step;
-          phase += step;
-        }
-      }
-      dl->AddCircleFilled(p, 0.6f * r, kDependence);
-      last = p;
-      have = true;
+      line.emplace_back(x_of(i), y_of(100.0 * d));
     }
+    stroke_dashed(dl, line, kDependence, line_w, scaled(6.0f), scaled(4.0f));
+    for (const ImVec2& p : line) dl->AddCircleFilled(p, 0.6f * r, kDependence);
   }
   for (const bool probe : {false, true}) {
     const ImU32 c = probe ? kProbe : kAssisted;

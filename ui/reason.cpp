@@ -7,9 +7,9 @@
 namespace mixpilot::ui {
 
 bool reason_matters(const Telemetry& s) {
-  if (s.mode != ModeKind::mixed_initiative || !s.solved) return false;
+  if (s.mode != ModeKind::mixed_initiative) return false;
   if (s.reason.cap != LambdaCap::none) return true;
-  return s.reason.node >= 0 && s.lambda < kReasonLambda;
+  return s.solved && s.reason.node >= 0 && s.lambda < kReasonLambda;
 }
 
 std::optional<std::size_t> shown_reason(const History& h) {

@@ -15,9 +15,10 @@ inline constexpr double kReasonLambda = 0.9;
 // [s] the words stay this long after they stop mattering, so they do not flicker.
 inline constexpr double kReasonHoldS = 0.5;
 
-// Whether step `s`'s λ needs explaining: a solved mixed-initiative step whose λ is below
-// kReasonLambda or was held down by a cap. The first step's initial λ, before any prediction,
-// does not (nothing decided it).
+// Whether step `s`'s λ needs explaining: a mixed-initiative step whose λ was held by a cap
+// (before the first step too: READY says the instructor's ceiling, a probe), or a solved one
+// whose λ is below kReasonLambda. The initial λ, before any prediction, does not (nothing
+// decided it).
 bool reason_matters(const Telemetry& s);
 
 // The index in `h` of the step whose reason the screen shows: the newest step when it matters,

@@ -187,11 +187,12 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
   const Telemetry* s = h.empty() ? nullptr : &h.newest();
   const float w = ImGui::GetContentRegionAvail().x;
   if (sc.shared_authority) {
-    // Before the first solve (the initial state) the pilot has the authority.
+    // Before the first step (READY) the telemetry holds what the first step will use: the
+    // initial λ within the instructor's bounds (core/modes/mi_mode.cpp).
     const ImVec2 bar_min = ImGui::GetCursorScreenPos();
     const float bar_h = (compact ? 1.4f : 2.0f) * ImGui::GetFontSize();
-    draw_authority_bar(s && s->solved ? s->lambda : 1.0, bar_min,
-                       ImVec2(bar_min.x + w, bar_min.y + bar_h), !compact, sc.probe);
+    draw_authority_bar(s ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + w, bar_min.y + bar_h),
+                       !compact, sc.probe, s ? s->instructor.bounds : AuthorityBounds{});
     ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
     // Why λ fell, while it matters and a moment after (ui/reason.hpp); the safe hold has its
     // own line below.
@@ -658,14 +659,14 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   ImVec2 panel_max(vmin.x, vmin.y);  // its bottom right corner
   if (panel) {
     const float panel_w = session_panel_width(view_w);
+    const float panel_h = std::max(0.0f, vmax.y - top - 2 * m);
     ImGui::SetNextWindowPos(ImVec2(vmin.x + m, top + m));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(panel_w, 0),
-                                        ImVec2(panel_w, std::max(0.0f, vmax.y - top - 2 * m)));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(panel_w, 0), ImVec2(panel_w, panel_h));
     ImGui::Begin("Session", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                      ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                      ImGuiWindowFlags_AlwaysAutoResize);
-    draw_session_panel(run, ui, out);
+    draw_session_panel(run, ui, out, panel_h);
     panel_max = ImVec2(ImGui::GetWindowPos().x + ImGui::GetWindowWidth(),
                        ImGui::GetWindowPos().y + ImGui::GetWindowHeight());
     ImGui::End();

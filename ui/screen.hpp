@@ -207,6 +207,7 @@ struct UiState {
   bool show_settings = false;        // the input settings panel (I)
   input::InputSettings draft;        // the settings being edited there
   bool draft_loaded = false;
+  float session_choices_h = 0.0f;    // [px] the session panel's choices, as last drawn
 };
 
 // The index of the next (direction +1) or previous (−1) event starting after / before `t`,

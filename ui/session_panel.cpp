@@ -121,10 +121,19 @@ void lesson_section(const SessionChoices& c, float fields, Requests& out) {
 
 }  // namespace
 
-void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
+void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float max_height) {
   const SessionChoices& c = *run.session;
   // Choices apply to the next flight: fixed while one flies.
   const bool flying = run.state == RunState::flying || run.state == RunState::paused;
+  // The start (or restart) button stays in sight under the choices: when they were taller last
+  // frame than the panel's height leaves above the button, they go in a region of their own
+  // that scrolls.
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const float top = ImGui::GetCursorPosY();
+  const float room = std::max(ImGui::GetFrameHeight(), max_height - top - st.WindowPadding.y -
+                                                           ImGui::GetFrameHeightWithSpacing());
+  const bool scrolls = ui.session_choices_h > room;
+  if (scrolls) ImGui::BeginChild("##choices", ImVec2(0.0f, room));
   ImGui::BeginDisabled(flying);
   // The fields take what their labels leave (the longest label, "scenario", and its gap).
   const float fields = -(ImGui::CalcTextSize("scenario").x + ImGui::GetStyle().ItemInnerSpacing.x);
@@ -186,23 +195,26 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out) {
   if (!c.ghosts.empty()) {
     ImGui::SetNextItemWidth(fields);
     if (combo("ghost", c.ghosts, c.ghost, chosen)) out.push_back(PickGhost{chosen});
+    // What the choice means (its note) on hover, so the panel keeps its height; what went
+    // wrong in plain sight.
+    const bool note = !c.ghost_note.empty() && !c.ghost_note_is_error;
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
       ImGui::SetTooltip("A recorded flight of this scenario flies along as a translucent\n"
                         "lavender vehicle with a dashed trail, in step by time. The HUD says\n"
-                        "how far ahead or behind it you are along the reference.");
-    if (!c.ghost_note.empty()) {
-      if (c.ghost_note_is_error)
-        ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s",
-                           c.ghost_note.c_str());
-      else
-        ImGui::TextDisabled("%s", c.ghost_note.c_str());
-    }
+                        "how far ahead or behind it you are along the reference.%s%s",
+                        note ? "\n\n" : "", note ? c.ghost_note.c_str() : "");
+    if (c.ghost_note_is_error)
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s",
+                         c.ghost_note.c_str());
   }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());
   ImGui::PopTextWrapPos();
   ImGui::EndDisabled();
+  // Their height (the cursor is past the last item and its spacing; scrolling included).
+  ui.session_choices_h = ImGui::GetCursorPosY() - st.ItemSpacing.y - (scrolls ? 0.0f : top);
+  if (scrolls) ImGui::EndChild();
   const bool lesson_closed = lesson && (c.lesson_view.closed || c.lesson_view.step < 0 ||
                                         c.lesson_view.step >= int(c.lesson_view.steps.size()));
   if (run.state == RunState::ready) {

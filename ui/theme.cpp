@@ -9,13 +9,16 @@ namespace mixpilot::ui {
 namespace {
 
 ImFont* g_mono = nullptr;
+ImFont* g_heading = nullptr;
 float g_scale = 1.0f;
 
-// The file fontconfig matches for `pattern` ("DejaVu Sans"), or "" when it is not DejaVu.
-std::string find_font(const char* family) {
+// The file fontconfig matches for `family` ("DejaVu Sans") in `style` ("" regular, ":bold"),
+// or "" when it is not that family.
+std::string find_font(const char* family, const char* style = "") {
   std::string path;
   if (!FcInit()) return path;
-  FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(family));
+  const std::string pattern = std::string(family) + style;
+  FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(pattern.c_str()));
   FcConfigSubstitute(nullptr, pat, FcMatchPattern);
   FcDefaultSubstitute(pat);
   FcResult result = FcResultNoMatch;
@@ -59,9 +62,10 @@ void apply_style(float scale) {
 std::string load_fonts(float scale) {
   ImGuiIO& io = ImGui::GetIO();
   io.Fonts->Clear();
-  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x2212,
-                                   0x2264, 0x2265,  // ≤ ≥
-                                   0x25A0, 0x25FF, 0};  // + geometric shapes (● ▶ ◆)
+  // Latin-1, Greek, then punctuation, sub- and superscripts, arrows and the mathematical
+  // operators (‖ ₁ → √ ≤ ≥), and the geometric shapes (● ▶ ◆).
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x22FF,
+                                   0x25A0, 0x25FF, 0};
   const float px = std::round(15.0f * scale);
   const std::string sans = find_font("DejaVu Sans");
   const std::string mono = find_font("DejaVu Sans Mono");
@@ -73,6 +77,7 @@ std::string load_fonts(float scale) {
     io.Fonts->AddFontDefault(&built_in);
   }
   g_mono = nullptr;
+  g_heading = nullptr;
   if (main && !mono.empty())
     g_mono = io.Fonts->AddFontFromFileTTF(mono.c_str(), px, nullptr, ranges);
   return main ? sans : std::string();
@@ -81,5 +86,16 @@ std::string load_fonts(float scale) {
 float ui_scale() { return g_scale; }
 
 ImFont* mono_font() { return g_mono ? g_mono : ImGui::GetFont(); }
+
+ImFont* add_heading_font(float scale, float factor) {
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x22FF, 0};
+  const std::string sans = find_font("DejaVu Sans", ":bold");
+  g_heading = sans.empty() ? nullptr
+                           : ImGui::GetIO().Fonts->AddFontFromFileTTF(
+                                 sans.c_str(), std::round(15.0f * scale * factor), nullptr, ranges);
+  return g_heading;
+}
+
+ImFont* heading_font() { return g_heading; }
 
 }  // namespace mixpilot::ui

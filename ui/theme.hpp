@@ -51,4 +51,10 @@ std::string load_fonts(float scale);
 // The monospace font for numbers (the default font when none was loaded).
 ImFont* mono_font();
 
+// Adds DejaVu Sans at `factor` times the text's size for headings (a printed figure's title),
+// after load_fonts() and before the first frame; nullptr when it cannot (then there is none).
+ImFont* add_heading_font(float scale, float factor);
+// The heading font added, or nullptr.
+ImFont* heading_font();
+
 }  // namespace mixpilot::ui

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ui/panels.hpp"
+#include "ui/plot.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -45,21 +46,62 @@ std::string elide_middle(const std::string& text, float width) {
   return cut(lo);
 }
 
-void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool probe) {
+void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool probe,
+                        const AuthorityBounds& bounds) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const double l = std::clamp(lambda, 0.0, 1.0);
   // The pilot's share λ fills from the left in the pilot's colour, the planner's share 1 − λ
   // the rest in the planner's colour; the needle sits at λ.
-  const float x = float(min.x + l * (max.x - min.x));
+  const auto x_of = [&](double v) { return float(min.x + std::clamp(v, 0.0, 1.0) * (max.x - min.x)); };
+  const float x = x_of(l);
   const float round = scaled(4.0f);
   dl->AddRectFilled(min, max, colour::kPlanner, round);
   dl->AddRectFilled(min, ImVec2(x, max.y), colour::kPilot, round, ImDrawFlags_RoundCornersLeft);
+  // The instructor's bounds: what λ cannot reach shaded and hatched, each bound a tick.
+  const bool ceiling = bounds.ceiling < 1.0, floor = bounds.floor > 0.0;
+  const auto out_of_reach = [&](float a, float b) {
+    if (b - a < 1.0f) return;
+    dl->AddRectFilled(ImVec2(a, min.y), ImVec2(b, max.y), colour::rgb(0x10, 0x12, 0x15, 120));
+    dl->PushClipRect(ImVec2(a, min.y), ImVec2(b, max.y), true);
+    const float h = max.y - min.y;
+    for (float s = a - h; s < b; s += scaled(7.0f))
+      dl->AddLine(ImVec2(s, max.y), ImVec2(s + h, min.y), colour::rgb(0x10, 0x12, 0x15, 110),
+                  scaled(1.5f));
+    dl->PopClipRect();
+  };
+  if (ceiling) out_of_reach(x_of(bounds.ceiling), max.x);
+  if (floor) out_of_reach(min.x, x_of(bounds.floor));
+  const auto bound_tick = [&](double v) {
+    const float bx = x_of(v);
+    dl->AddLine(ImVec2(bx, min.y - scaled(4)), ImVec2(bx, max.y + scaled(4)), colour::kCaution,
+                scaled(2.5f));
+  };
+  if (ceiling) bound_tick(bounds.ceiling);
+  if (floor) bound_tick(bounds.floor);
   const float mid = 0.5f * (min.x + max.x);  // the 0.5 tick
   dl->AddLine(ImVec2(mid, min.y - scaled(3)), ImVec2(mid, max.y + scaled(3)), colour::kText, scaled(1.0f));
   dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));  // the needle
-  char label[64];
-  std::snprintf(label, sizeof label, "%s%s %.2f", probe ? "PROBE · " : "",
-                l >= 0.5 ? "PILOT" : "PLANNER", l);
+  char bound_text[64] = "";
+  if (floor && ceiling)
+    std::snprintf(bound_text, sizeof bound_text, "floor %.2f · ceiling %.2f", bounds.floor,
+                  bounds.ceiling);
+  else if (ceiling)
+    std::snprintf(bound_text, sizeof bound_text, "ceiling %.2f", bounds.ceiling);
+  else if (floor)
+    std::snprintf(bound_text, sizeof bound_text, "floor %.2f", bounds.floor);
+  // Under the ticks, between the shares' names, where it fits; else in the label.
+  const float below = max.y + scaled(4);
+  const char* planner = probe ? "assistance off" : "planner share 1 − λ";
+  const float gap = ImGui::CalcTextSize("  ").x;
+  const float left_end = min.x + scaled(2) + ImGui::CalcTextSize("pilot share λ").x + gap;
+  const float right_start = max.x - scaled(2) - ImGui::CalcTextSize(planner).x - gap;
+  const float bw = ImGui::CalcTextSize(bound_text).x;
+  const bool bound_below = names && bound_text[0] != '\0' && right_start - left_end >= bw;
+  char label[128];
+  std::snprintf(label, sizeof label, "%s%s %.2f%s%s", probe ? "PROBE · " : "",
+                l >= 0.5 ? "PILOT" : "PLANNER", l,
+                bound_text[0] != '\0' && !bound_below ? " · " : "",
+                bound_below ? "" : bound_text);
   const ImVec2 ts = ImGui::CalcTextSize(label);
   const ImVec2 at(mid - 0.5f * ts.x, 0.5f * (min.y + max.y) - 0.5f * ts.y);
   dl->AddRectFilled(ImVec2(at.x - scaled(6), at.y - scaled(1)),
@@ -67,13 +109,19 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool 
                     colour::rgb(0x10, 0x12, 0x15, 200), scaled(3.0f));
   dl->AddText(at, colour::kText, label);
   if (!names) return;
-  const float below = max.y + scaled(4);
   dl->AddText(ImVec2(min.x + scaled(2), below), colour::kPilot, "pilot share λ");
   // A probe: the planner's reference has no weight in the cost (SPEC §10).
-  const char* planner = probe ? "assistance off" : "planner share 1 − λ";
   const ImVec2 ps = ImGui::CalcTextSize(planner);
   dl->AddText(ImVec2(max.x - ps.x - scaled(2), below), probe ? colour::kCaution : colour::kPlanner,
               planner);
+  if (bound_below) {
+    // Centred under its tick (between both ticks), kept between the names.
+    const double centre = floor && ceiling ? 0.5 * (bounds.floor + bounds.ceiling)
+                          : ceiling        ? bounds.ceiling
+                                           : bounds.floor;
+    const float bx = std::clamp(x_of(centre) - 0.5f * bw, left_end, right_start - bw);
+    dl->AddText(ImVec2(bx, below), colour::kCaution, bound_text);
+  }
 }
 
 namespace {
@@ -205,44 +253,22 @@ void plot(const History& h, const char* title, std::span<const Series> named, do
   const double pad = 0.08 * (hi - lo);
   lo -= pad;
   hi += pad;
-  const auto to_px = [&](double t, double v) {
-    return ImVec2(float(min.x + (t - t0) / window * (max.x - min.x)),
-                  float(max.y - (v - lo) / (hi - lo) * (max.y - min.y)));
-  };
-  // One polyline per series through each pixel column's extremes, in the order they occur:
-  // thousands of samples cost a few hundred points, and no spike is lost.
+  const PlotFrame frame{min, max, t0, t1, lo, hi};
+  // One polyline per series through each pixel column's extremes (ui/plot.hpp).
   // An integer width lets ImGui draw the line from its anti-aliased texture: a third of the
   // triangles of a fractional width, which a software rasterizer feels.
   const float line_width = std::max(1.0f, std::round(scaled(2.0f)));
   for (int k = 0; k < count; ++k) {
     const Indexed& s = series[k];
-    int column = -1;
-    float y_lo = 0, y_hi = 0;
-    bool lo_first = true;
-    const auto flush = [&] {
-      if (column < 0) return;
-      const float a = lo_first ? y_lo : y_hi, b = lo_first ? y_hi : y_lo;
-      dl->PathLineTo(ImVec2(float(column), a));
-      if (b != a) dl->PathLineTo(ImVec2(float(column), b));
-    };
-    for (std::size_t i = first; i < end; ++i) {
-      if (s.channel >= h[i].num_channels) continue;
-      const ImVec2 p = to_px(h[i].t, h[i].channels[std::size_t(s.channel)].value);
-      const int c = int(p.x);
-      if (c != column) {
-        flush();
-        column = c;
-        y_lo = y_hi = p.y;
-        lo_first = true;
-      } else if (p.y < y_lo) {
-        y_lo = p.y;
-        lo_first = false;
-      } else if (p.y > y_hi) {
-        y_hi = p.y;
-      }
-    }
-    flush();
-    dl->PathStroke(s.colour, 0, line_width);
+    // Samples without the channel are left out (stroke_thinned asks for its points in order).
+    std::size_t n = 0;
+    for (std::size_t i = first; i < end; ++i) n += s.channel < h[i].num_channels;
+    std::size_t next = first;
+    stroke_thinned(dl, n, [&](std::size_t) {
+      while (s.channel >= h[next].num_channels) ++next;
+      const Telemetry& v = h[next++];
+      return frame.to_px(v.t, v.channels[std::size_t(s.channel)].value);
+    }, s.colour, line_width);
   }
   const float inset = scaled(3.0f);
   std::snprintf(buf, sizeof buf, "%.3g", hi - pad);
@@ -251,7 +277,7 @@ void plot(const History& h, const char* title, std::span<const Series> named, do
   dl->AddText(ImVec2(min.x + inset, max.y - ImGui::GetTextLineHeight() - scaled(1)),
               colour::rgb(170, 170, 170), buf);
   if (hovered) {
-    const float x = to_px(at->t, 0.0).x;
+    const float x = frame.px_x(at->t);
     dl->AddLine(ImVec2(x, min.y), ImVec2(x, max.y), colour::rgb(0xDD, 0xDD, 0xDD, 140), scaled(1.0f));
   }
 }

@@ -407,6 +407,19 @@ inline void add_syntax_error(Diagnostics& d, const toml::parse_error& e, std::st
     if (q2 != std::string::npos) {
       std::string key = desc.substr(q1 + 1, q2 - q1 - 1);
       if (desc.compare(at + redefine.size(), 5, "table") != 0) {
+        // toml++ 3.3 garbles a quoted key in this message ('"cocontroller.N" ' for
+        // "controller.N"): the key as written, before the '=' of the line, instead.
+        if (key.find_first_of("\" '") != std::string::npos) {
+          std::string_view l = text;
+          for (std::uint32_t n = 1; n < e.source().begin.line && !l.empty(); ++n) {
+            const std::size_t nl = l.find('\n');
+            l = nl == std::string_view::npos ? std::string_view() : l.substr(nl + 1);
+          }
+          l = l.substr(0, std::min(l.find('\n'), l.find('=')));
+          while (!l.empty() && (l.front() == ' ' || l.front() == '\t')) l.remove_prefix(1);
+          while (!l.empty() && (l.back() == ' ' || l.back() == '\t')) l.remove_suffix(1);
+          if (!l.empty()) key = std::string(l);
+        }
         const std::string table = header_before(text, e.source().begin.line);
         if (!table.empty()) key = table + '.' + key;
       }

@@ -144,21 +144,29 @@ void MiController::set_stage_data(double t, const PilotCommand& pilot, const Eig
   }
 }
 
-RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
+MiController::NextLambda MiController::next_lambda(double authority) const {
   // SPEC §10: λ = min(max(λ_PH, floor), ceiling, cap). The source's authority caps λ (input
   // loss hands the vehicle to the planner, SPEC §6) below any bound; a probe pins the PH
   // index's part to 1. The reason names what set λ, the PH index's own when nothing did.
-  const double cap = std::clamp(pilot.authority, 0.0, 1.0);
+  const double cap = std::clamp(authority, 0.0, 1.0);
   const AuthorityBounds& b = out_.bounds;
   const bool assisted = settings_.assist == Assistance::on;
   const double own = assisted ? out_.lambda_next : 1.0;
   const double bounded = std::min(std::max(own, b.floor), b.ceiling);
-  out_.reason = out_.reason_next;
-  out_.lambda_used = std::min(bounded, cap);
-  if (cap < bounded) out_.reason.cap = LambdaCap::input_lost;
-  else if (bounded < own) out_.reason.cap = LambdaCap::instructor_ceiling;
-  else if (bounded > own) out_.reason.cap = LambdaCap::instructor_floor;
-  else out_.reason.cap = assisted ? LambdaCap::none : LambdaCap::probe;
+  NextLambda n;
+  n.reason = out_.reason_next;
+  n.lambda = std::min(bounded, cap);
+  if (cap < bounded) n.reason.cap = LambdaCap::input_lost;
+  else if (bounded < own) n.reason.cap = LambdaCap::instructor_ceiling;
+  else if (bounded > own) n.reason.cap = LambdaCap::instructor_floor;
+  else n.reason.cap = assisted ? LambdaCap::none : LambdaCap::probe;
+  return n;
+}
+
+RtiStatus MiController::step(double t, const Eigen::VectorXd& x, const PilotCommand& pilot) {
+  const NextLambda next = next_lambda(pilot.authority);
+  out_.lambda_used = next.lambda;
+  out_.reason = next.reason;
   set_stage_data(t, pilot, x);
   rti_.prepare();
   const RtiStatus status = rti_.feedback(x);

@@ -73,6 +73,15 @@ class MiController {
 
   const Eigen::VectorXd& control() const { return out_.control; }  // τ (nu)
   double lambda() const { return out_.lambda_used; }               // λ used in the last step
+  // λ of the next step and what decides it, before it runs (SPEC §10): min(max(λ_PH, floor),
+  // ceiling, cap), `cap` the pilot source's authority; λ_PH the last prediction's PH index (the
+  // initial λ before any), 1 for a probe. step() flies with it; before the first step it is
+  // what a trainee is told the flight starts with.
+  struct NextLambda {
+    double lambda = 0.0;
+    LambdaReason reason;
+  };
+  NextLambda next_lambda(double cap = 1.0) const;
   // The PH index of the last step's prediction: λ for the next step when assisted (a probe
   // computes it and does not apply it).
   double ph_index() const { return out_.lambda_next; }

@@ -138,6 +138,34 @@ std::string check_attempt(const LessonAttempt& a) {
   return {};
 }
 
+std::string check_progress(const LessonProgress& p) {
+  if (std::string why = check_trainee(p.trainee); !why.empty()) return why;
+  const std::pair<const char*, const std::string*> texts[] = {{"the lesson", &p.lesson},
+                                                              {"the lesson hash", &p.lesson_hash}};
+  for (const auto& [field, text] : texts)
+    if (std::string why = check_text(field, *text); !why.empty()) return why;
+  if (p.lesson.empty() || p.lesson_hash.empty()) return "the lesson's name or hash is empty";
+  if (p.steps < 1 || p.step < 0 || p.step > p.steps)
+    return "step " + std::to_string(p.step) + " is not one of the lesson's " +
+           std::to_string(p.steps) + " (or past its last)";
+  if (p.failed_attempts < 0) return "the failed attempts are negative";
+  return {};
+}
+
+LessonAttempt StoredFlight::as_attempt() const {
+  LessonAttempt a;
+  a.lesson = lesson;
+  a.lesson_hash = lesson_hash;
+  a.steps = lesson_step + 1;
+  a.step = lesson_step;
+  a.step_title = lesson_step_title;
+  a.ceiling = lesson_ceiling;
+  a.passed = lesson_passed;
+  a.failed_criterion = lesson_failed;
+  a.detail = lesson_detail;
+  return a;
+}
+
 LessonProgress progress_after(const LessonProgress& before, const LessonAttempt& a,
                               std::string& why) {
   why.clear();

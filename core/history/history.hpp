@@ -71,6 +71,14 @@ struct StoredFlight : FlightRecord {
   int lesson_step = -1;
   bool lesson_passed = false;
   std::string lesson_failed;  // the criterion that failed ("" when passed or not a lesson's)
+  // The rest of the attempt's row (push copies it whole): the lesson's hash, the step's title,
+  // the ceiling it was flown with and the verdict in words.
+  std::string lesson_hash, lesson_step_title, lesson_detail;
+  double lesson_ceiling = 1.0;
+  bool attempt() const { return lesson_step >= 0; }
+  // The attempt as add_attempt() takes it; its `steps` is step + 1 (a row does not keep how
+  // many steps the lesson has: the progress does).
+  LessonAttempt as_attempt() const;
 };
 // Which flights query() returns: all of them where a field is empty / 0. `limit` keeps the
 // newest `limit` flights. The answer is oldest first (by start time, then id).
@@ -115,9 +123,29 @@ class HistoryStore {
                                              const std::string& lesson_hash,
                                              std::vector<StoredAttempt>& out,
                                              std::string& error) = 0;
-  // The trainee starts the lesson over (step 0, no failed attempt); the attempts stay.
+  // The trainee starts the lesson over (step 0, no failed attempt, updated now: the row stays,
+  // so a push carries the reset); the attempts stay.
   [[nodiscard]] virtual bool reset_lesson(const std::string& trainee, const std::string& lesson,
                                           const std::string& lesson_hash, std::string& error) = 0;
+
+  // For push (core/history/push.hpp), which copies every table of the schema:
+  // copy_flight(): a flight read from another store, with its metrics and, for a lesson
+  // attempt, the attempt's row as it is (the progress is merged apart), in one transaction. A
+  // flight is the same one here when a recorded flight's recording hash is, or an unrecorded
+  // flight's trainee, station and start time (to the millisecond) are; such a flight is not
+  // added again, but gains its attempt's row when it lacks it (a store pushed to by a mixpilot
+  // that did not copy attempts).
+  struct Copied {
+    bool flight = false;   // the flight was added
+    bool attempt = false;  // its attempt's row was added
+  };
+  [[nodiscard]] virtual std::optional<Copied> copy_flight(const StoredFlight& f,
+                                                          std::string& error) = 0;
+  // merge_progress(): the trainee's place in a lesson as `p` says, when this store has none or
+  // an older one (by updated_unix_ms: the newest wins, so the same row twice writes nothing).
+  // true when written.
+  [[nodiscard]] virtual std::optional<bool> merge_progress(const LessonProgress& p,
+                                                           std::string& error) = 0;
   virtual std::string where() const = 0;  // for messages: the file, or the server WITHOUT credentials
 };
 
@@ -143,6 +171,9 @@ std::string check_record(const FlightRecord& f);
 // "" when the attempt can be stored (its texts as check_record's, 0 ≤ step < steps, the ceiling
 // in (0, 1], a failed criterion exactly when it failed), else why not.
 std::string check_attempt(const LessonAttempt& a);
+// "" when the progress row can be stored (the trainee's name as above, the lesson's texts,
+// 1 ≤ steps, 0 ≤ step ≤ steps, failed attempts ≥ 0), else why not.
+std::string check_progress(const LessonProgress& p);
 // The progress after `a`, from `before` (the trainee's progress at that lesson, step 0 when
 // none): passed → the next step, failed → one more failed attempt. "" in `why` when `a` is at
 // the step `before` is on, else why it is refused.

@@ -246,6 +246,8 @@ class PostgresHistory final : public HistoryStore {
                        std::string& error) override;
   bool reset_lesson(const std::string& trainee, const std::string& lesson,
                     const std::string& lesson_hash, std::string& error) override;
+  std::optional<Copied> copy_flight(const StoredFlight& f, std::string& error) override;
+  std::optional<bool> merge_progress(const LessonProgress& p, std::string& error) override;
   std::string where() const override { return where_; }
 
   // "SERVER: what failed: the message (hint)", scrubbed of every password.
@@ -262,6 +264,12 @@ class PostgresHistory final : public HistoryStore {
     std::string flight_id, trainee_id;
   };
   std::optional<Inserted> insert_flight(const FlightRecord& f, std::string& error);
+  // Inside a transaction: the flight here that is `f` (copy_flight's match), or an empty id.
+  std::optional<Inserted> find_flight(const FlightRecord& f, std::string& error);
+  // Inside a transaction: the attempt's row of the flight `in`, unless it has one; whether
+  // it was added.
+  std::optional<bool> insert_attempt(const Inserted& in, const LessonAttempt& a,
+                                     std::string& error);
   // Runs `sql` with `p`; the result when its status is `expected`, else nullopt with `error`.
   std::optional<Result> run(const std::string& sql, const Params& p, ExecStatusType expected,
                             const char* what, std::string& error);
@@ -523,22 +531,7 @@ std::optional<HistoryStore::Added> PostgresHistory::add_attempt(const FlightReco
     error = where_ + ": the lesson attempt is not stored: " + why;
     return std::nullopt;
   }
-  Params ap;
-  ap.text(in->flight_id)
-      .text(in->trainee_id)
-      .text(a.lesson)
-      .text(a.lesson_hash)
-      .integer(a.step)
-      .text(a.step_title)
-      .text(number(a.ceiling))
-      .integer(a.passed ? 1 : 0)
-      .text_or_null(a.failed_criterion)
-      .text(a.detail);
-  if (!run("INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, step, "
-           "step_title, ceiling, passed, failed_criterion, detail) VALUES ($1::bigint, "
-           "$2::bigint, $3, $4, $5::integer, $6, $7::double precision, $8::integer, $9, $10)",
-           ap, PGRES_COMMAND_OK, "cannot add the lesson attempt", error))
-    return rollback(), std::nullopt;
+  if (!insert_attempt(*in, a, error)) return rollback(), std::nullopt;
   Params up = key;
   up.integer(after.steps).integer(after.step).integer(after.failed_attempts).integer(now_unix_ms());
   if (!run("UPDATE lesson_progress SET steps = $4::integer, step = $5::integer, "
@@ -620,11 +613,136 @@ bool PostgresHistory::lesson_attempts(const std::string& trainee, const std::str
 bool PostgresHistory::reset_lesson(const std::string& trainee, const std::string& lesson,
                                    const std::string& lesson_hash, std::string& error) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  return first("DELETE FROM lesson_progress WHERE trainee_id = (SELECT id FROM trainees WHERE "
+  return first("UPDATE lesson_progress SET step = 0, failed_attempts = 0, "
+               "updated_unix_ms = $4::bigint WHERE trainee_id = (SELECT id FROM trainees WHERE "
                "name = $1) AND lesson = $2 AND lesson_hash = $3",
-               Params{}.text(trainee).text(lesson).text(lesson_hash), PGRES_COMMAND_OK,
-               "cannot start the lesson over", error)
+               Params{}.text(trainee).text(lesson).text(lesson_hash).integer(now_unix_ms()),
+               PGRES_COMMAND_OK, "cannot start the lesson over", error)
       .has_value();
+}
+
+std::optional<bool> PostgresHistory::insert_attempt(const Inserted& in, const LessonAttempt& a,
+                                                    std::string& error) {
+  Params ap;
+  ap.text(in.flight_id)
+      .text(in.trainee_id)
+      .text(a.lesson)
+      .text(a.lesson_hash)
+      .integer(a.step)
+      .text(a.step_title)
+      .text(number(a.ceiling))
+      .integer(a.passed ? 1 : 0)
+      .text_or_null(a.failed_criterion)
+      .text(a.detail);
+  const auto r = run("INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, "
+                     "step, step_title, ceiling, passed, failed_criterion, detail) VALUES "
+                     "($1::bigint, $2::bigint, $3, $4, $5::integer, $6, $7::double precision, "
+                     "$8::integer, $9, $10) ON CONFLICT (flight_id) DO NOTHING RETURNING 1",
+                     ap, PGRES_TUPLES_OK, "cannot add the lesson attempt", error);
+  if (!r) return std::nullopt;
+  return r->rows() > 0;
+}
+
+std::optional<PostgresHistory::Inserted> PostgresHistory::find_flight(const FlightRecord& f,
+                                                                    std::string& error) {
+  const bool recorded = !f.recording_hash.empty();
+  const auto r =
+      recorded
+          ? run("SELECT id, trainee_id FROM flights WHERE recording_hash = $1",
+                Params{}.text(f.recording_hash), PGRES_TUPLES_OK, "cannot look the flight up",
+                error)
+          : run("SELECT f.id, f.trainee_id FROM flights f JOIN trainees t ON "
+                "t.id = f.trainee_id WHERE f.recording_hash IS NULL AND t.name = $1 AND "
+                "f.station = $2 AND f.started_unix_ms = $3::bigint ORDER BY f.id LIMIT 1",
+                Params{}.text(f.trainee).text(f.station).integer(f.started_unix_ms),
+                PGRES_TUPLES_OK, "cannot look the flight up", error);
+  if (!r) return std::nullopt;
+  if (r->rows() == 0) return Inserted{};
+  return Inserted{r->text(0, 0), r->text(0, 1)};
+}
+
+// Two pushes at once copy one flight at a time (an unrecorded flight has no unique key the
+// server could hold them to). ('mixp' 'push' in ASCII.)
+constexpr const char* kPushLock = "SELECT pg_advisory_xact_lock(7883965047007179624)";
+
+std::optional<HistoryStore::Copied> PostgresHistory::copy_flight(const StoredFlight& f,
+                                                                 std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = where_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!std::isfinite(f.duration_s)) {
+    error = where_ + ": the flight is not stored: its duration is not a finite number";
+    return std::nullopt;
+  }
+  const LessonAttempt a = f.as_attempt();
+  if (f.attempt())
+    if (std::string why = check_attempt(a); !why.empty()) {
+      error = where_ + ": the lesson attempt is not stored: " + why;
+      return std::nullopt;
+    }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!begin("BEGIN", "cannot start adding a flight", error)) return std::nullopt;
+  if (!run(kPushLock, Params{}, PGRES_TUPLES_OK, "cannot lock the history for a push", error))
+    return rollback(), std::nullopt;
+  Copied c;
+  std::optional<Inserted> in = find_flight(f, error);
+  if (in && in->flight_id.empty()) {
+    in = insert_flight(f, error);
+    c.flight = true;
+    // Added at this moment by a station that flew it: that row is the flight.
+    if (in && in->flight_id.empty()) {
+      c.flight = false;
+      in = find_flight(f, error);
+    }
+  }
+  if (!in) return rollback(), std::nullopt;
+  if (in->flight_id.empty()) {
+    error = where_ + ": cannot find the flight just added";
+    return rollback(), std::nullopt;
+  }
+  if (f.attempt()) {
+    const std::optional<bool> added = insert_attempt(*in, a, error);
+    if (!added) return rollback(), std::nullopt;
+    c.attempt = *added;
+  }
+  if (!command("COMMIT", "cannot commit the flight", error)) return rollback(), std::nullopt;
+  return c;
+}
+
+std::optional<bool> PostgresHistory::merge_progress(const LessonProgress& lp,
+                                                    std::string& error) {
+  if (std::string why = check_progress(lp); !why.empty()) {
+    error = where_ + ": the lesson's progress is not stored: " + why;
+    return std::nullopt;
+  }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!begin("BEGIN", "cannot start merging a lesson's progress", error)) return std::nullopt;
+  if (!run("INSERT INTO trainees (name) VALUES ($1) ON CONFLICT (name) DO NOTHING",
+           Params{}.text(lp.trainee), PGRES_COMMAND_OK, "cannot add the trainee", error))
+    return rollback(), std::nullopt;
+  const auto r =
+      run("INSERT INTO lesson_progress (trainee_id, lesson, lesson_hash, steps, step, "
+          "failed_attempts, updated_unix_ms) VALUES ((SELECT id FROM trainees WHERE name = $1), "
+          "$2, $3, $4::integer, $5::integer, $6::integer, $7::bigint) "
+          "ON CONFLICT (trainee_id, lesson, lesson_hash) DO UPDATE SET "
+          "steps = excluded.steps, step = excluded.step, "
+          "failed_attempts = excluded.failed_attempts, "
+          "updated_unix_ms = excluded.updated_unix_ms "
+          "WHERE excluded.updated_unix_ms > lesson_progress.updated_unix_ms RETURNING 1",
+          Params{}
+              .text(lp.trainee)
+              .text(lp.lesson)
+              .text(lp.lesson_hash)
+              .integer(lp.steps)
+              .integer(lp.step)
+              .integer(lp.failed_attempts)
+              .integer(lp.updated_unix_ms),
+          PGRES_TUPLES_OK, "cannot merge the lesson's progress", error);
+  if (!r) return rollback(), std::nullopt;
+  if (!command("COMMIT", "cannot commit the lesson's progress", error))
+    return rollback(), std::nullopt;
+  return r->rows() > 0;
 }
 
 bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std::string& error) {
@@ -645,7 +763,7 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
       "f.pilot, f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, "
       "f.probe, f.recording_path, f.recording_hash, f.app_version, f.front_end, "
       "f.parent_recording_hash, f.parent_step, f.ended_by, a.lesson, a.step, a.passed, "
-      "a.failed_criterion "
+      "a.failed_criterion, a.lesson_hash, a.step_title, a.ceiling, a.detail "
       "FROM flights f JOIN trainees t ON t.id = f.trainee_id "
       "LEFT JOIN lesson_attempts a ON a.flight_id = f.id "
       "WHERE ($1::text = '' OR t.name = $1::text) AND ($2::text = '' OR f.scenario = $2::text) "
@@ -687,6 +805,10 @@ bool PostgresHistory::query(const Query& q, std::vector<StoredFlight>& out, std:
       f.lesson_step = int(read_int(s.at(r, 21)));
       f.lesson_passed = read_int(s.at(r, 22)) != 0;
       f.lesson_failed = s.text(r, 23);
+      f.lesson_hash = s.text(r, 24);
+      f.lesson_step_title = s.text(r, 25);
+      f.lesson_ceiling = read_double(s.at(r, 26));
+      f.lesson_detail = s.text(r, 27);
     }
     if (r > 0) ids += ',';
     ids += std::to_string(f.id);

@@ -74,6 +74,8 @@ class SqliteHistory final : public HistoryStore {
                        std::string& error) override;
   bool reset_lesson(const std::string& trainee, const std::string& lesson,
                     const std::string& lesson_hash, std::string& error) override;
+  std::optional<Copied> copy_flight(const StoredFlight& f, std::string& error) override;
+  std::optional<bool> merge_progress(const LessonProgress& p, std::string& error) override;
   std::string where() const override { return path_; }
 
  private:
@@ -84,6 +86,12 @@ class SqliteHistory final : public HistoryStore {
     std::int64_t flight_id = 0, trainee_id = 0;
   };
   std::optional<Inserted> insert_flight(const FlightRecord& f, std::string& error);
+  // Inside a transaction: the flight here that is `f` (copy_flight's match), or a zero id.
+  std::optional<Inserted> find_flight(const FlightRecord& f, std::string& error);
+  // Inside a transaction: the attempt's row of the flight `in`, unless it has one; whether
+  // it was added.
+  std::optional<bool> insert_attempt(const Inserted& in, const LessonAttempt& a,
+                                     std::string& error);
   // "FILE: what failed: SQLite's message", with the usual causes said in words.
   std::string fail(const char* what) const;
   bool exec(const char* sql, std::string& error, const char* what);
@@ -361,27 +369,7 @@ std::optional<HistoryStore::Added> SqliteHistory::add_attempt(const FlightRecord
     error = path_ + ": the lesson attempt is not stored: " + why;
     return std::nullopt;
   }
-  {
-    Stmt s;
-    if (!prepare(s,
-                 "INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, step, "
-                 "step_title, ceiling, passed, failed_criterion, detail) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                 error))
-      return rollback(), std::nullopt;
-    sqlite3_stmt* p = s.get();
-    sqlite3_bind_int64(p, 1, in->flight_id);
-    sqlite3_bind_int64(p, 2, in->trainee_id);
-    bind_text(p, 3, a.lesson);
-    bind_text(p, 4, a.lesson_hash);
-    sqlite3_bind_int(p, 5, a.step);
-    bind_text(p, 6, a.step_title);
-    sqlite3_bind_double(p, 7, a.ceiling);
-    sqlite3_bind_int(p, 8, a.passed ? 1 : 0);
-    bind_text(p, 9, a.failed_criterion, true);
-    bind_text(p, 10, a.detail);
-    if (sqlite3_step(p) != SQLITE_DONE) return failed("cannot add the lesson attempt");
-  }
+  if (!insert_attempt(*in, a, error)) return rollback(), std::nullopt;
   {
     Stmt s;
     if (!prepare(s,
@@ -406,6 +394,147 @@ std::optional<HistoryStore::Added> SqliteHistory::add_attempt(const FlightRecord
   if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK)
     return failed("cannot commit the lesson attempt");
   return Added::added;
+}
+
+std::optional<bool> SqliteHistory::insert_attempt(const Inserted& in, const LessonAttempt& a,
+                                                  std::string& error) {
+  Stmt s;
+  if (!prepare(s,
+               "INSERT INTO lesson_attempts (flight_id, trainee_id, lesson, lesson_hash, step, "
+               "step_title, ceiling, passed, failed_criterion, detail) "
+               "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (flight_id) DO NOTHING",
+               error))
+    return std::nullopt;
+  sqlite3_stmt* p = s.get();
+  sqlite3_bind_int64(p, 1, in.flight_id);
+  sqlite3_bind_int64(p, 2, in.trainee_id);
+  bind_text(p, 3, a.lesson);
+  bind_text(p, 4, a.lesson_hash);
+  sqlite3_bind_int(p, 5, a.step);
+  bind_text(p, 6, a.step_title);
+  sqlite3_bind_double(p, 7, a.ceiling);
+  sqlite3_bind_int(p, 8, a.passed ? 1 : 0);
+  bind_text(p, 9, a.failed_criterion, true);
+  bind_text(p, 10, a.detail);
+  if (sqlite3_step(p) != SQLITE_DONE) {
+    error = fail("cannot add the lesson attempt");
+    return std::nullopt;
+  }
+  return sqlite3_changes(db_) > 0;
+}
+
+std::optional<SqliteHistory::Inserted> SqliteHistory::find_flight(const FlightRecord& f,
+                                                                std::string& error) {
+  Stmt s;
+  const bool recorded = !f.recording_hash.empty();
+  if (!prepare(s,
+               recorded ? "SELECT id, trainee_id FROM flights WHERE recording_hash = ?"
+                        : "SELECT f.id, f.trainee_id FROM flights f JOIN trainees t ON "
+                          "t.id = f.trainee_id WHERE f.recording_hash IS NULL AND t.name = ? AND "
+                          "f.station = ? AND f.started_unix_ms = ? ORDER BY f.id LIMIT 1",
+               error))
+    return std::nullopt;
+  if (recorded) {
+    bind_text(s.get(), 1, f.recording_hash);
+  } else {
+    bind_text(s.get(), 1, f.trainee);
+    bind_text(s.get(), 2, f.station);
+    sqlite3_bind_int64(s.get(), 3, f.started_unix_ms);
+  }
+  const int rc = sqlite3_step(s.get());
+  if (rc == SQLITE_DONE) return Inserted{};
+  if (rc != SQLITE_ROW) {
+    error = fail("cannot look the flight up");
+    return std::nullopt;
+  }
+  return Inserted{sqlite3_column_int64(s.get(), 0), sqlite3_column_int64(s.get(), 1)};
+}
+
+std::optional<HistoryStore::Copied> SqliteHistory::copy_flight(const StoredFlight& f,
+                                                               std::string& error) {
+  if (std::string why = check_record(f); !why.empty()) {
+    error = path_ + ": the flight is not stored: " + why;
+    return std::nullopt;
+  }
+  const LessonAttempt a = f.as_attempt();
+  if (f.attempt())
+    if (std::string why = check_attempt(a); !why.empty()) {
+      error = path_ + ": the lesson attempt is not stored: " + why;
+      return std::nullopt;
+    }
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to add a flight"))
+    return std::nullopt;
+  Copied c;
+  std::optional<Inserted> in = find_flight(f, error);
+  if (in && in->flight_id == 0) {
+    in = insert_flight(f, error);
+    c.flight = true;
+  }
+  if (!in) return rollback(), std::nullopt;
+  if (f.attempt()) {
+    const std::optional<bool> added = insert_attempt(*in, a, error);
+    if (!added) return rollback(), std::nullopt;
+    c.attempt = *added;
+  }
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+    error = fail("cannot commit the flight");
+    rollback();
+    return std::nullopt;
+  }
+  return c;
+}
+
+std::optional<bool> SqliteHistory::merge_progress(const LessonProgress& lp, std::string& error) {
+  if (std::string why = check_progress(lp); !why.empty()) {
+    error = path_ + ": the lesson's progress is not stored: " + why;
+    return std::nullopt;
+  }
+  if (!exec("BEGIN IMMEDIATE", error, "cannot lock the history to merge a lesson's progress"))
+    return std::nullopt;
+  {
+    Stmt t;
+    if (!prepare(t, "INSERT INTO trainees (name) VALUES (?) ON CONFLICT (name) DO NOTHING", error))
+      return rollback(), std::nullopt;
+    bind_text(t.get(), 1, lp.trainee);
+    if (sqlite3_step(t.get()) != SQLITE_DONE) {
+      error = fail("cannot add the trainee");
+      return rollback(), std::nullopt;
+    }
+  }
+  bool written = false;
+  {
+    Stmt s;
+    if (!prepare(s,
+                 "INSERT INTO lesson_progress (trainee_id, lesson, lesson_hash, steps, step, "
+                 "failed_attempts, updated_unix_ms) VALUES ((SELECT id FROM trainees WHERE "
+                 "name = ?), ?, ?, ?, ?, ?, ?) "
+                 "ON CONFLICT (trainee_id, lesson, lesson_hash) DO UPDATE SET "
+                 "steps = excluded.steps, step = excluded.step, "
+                 "failed_attempts = excluded.failed_attempts, "
+                 "updated_unix_ms = excluded.updated_unix_ms "
+                 "WHERE excluded.updated_unix_ms > lesson_progress.updated_unix_ms",
+                 error))
+      return rollback(), std::nullopt;
+    sqlite3_stmt* p = s.get();
+    bind_text(p, 1, lp.trainee);
+    bind_text(p, 2, lp.lesson);
+    bind_text(p, 3, lp.lesson_hash);
+    sqlite3_bind_int(p, 4, lp.steps);
+    sqlite3_bind_int(p, 5, lp.step);
+    sqlite3_bind_int(p, 6, lp.failed_attempts);
+    sqlite3_bind_int64(p, 7, lp.updated_unix_ms);
+    if (sqlite3_step(p) != SQLITE_DONE) {
+      error = fail("cannot merge the lesson's progress");
+      return rollback(), std::nullopt;
+    }
+    written = sqlite3_changes(db_) > 0;
+  }
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+    error = fail("cannot commit the lesson's progress");
+    rollback();
+    return std::nullopt;
+  }
+  return written;
 }
 
 bool SqliteHistory::lesson_progress(const std::string& trainee, std::vector<LessonProgress>& out,
@@ -489,13 +618,15 @@ bool SqliteHistory::reset_lesson(const std::string& trainee, const std::string& 
                                  const std::string& lesson_hash, std::string& error) {
   Stmt s;
   if (!prepare(s,
-               "DELETE FROM lesson_progress WHERE trainee_id = (SELECT id FROM trainees WHERE "
-               "name = ?) AND lesson = ? AND lesson_hash = ?",
+               "UPDATE lesson_progress SET step = 0, failed_attempts = 0, updated_unix_ms = ? "
+               "WHERE trainee_id = (SELECT id FROM trainees WHERE name = ?) AND lesson = ? AND "
+               "lesson_hash = ?",
                error))
     return false;
-  bind_text(s.get(), 1, trainee);
-  bind_text(s.get(), 2, lesson);
-  bind_text(s.get(), 3, lesson_hash);
+  sqlite3_bind_int64(s.get(), 1, now_unix_ms());
+  bind_text(s.get(), 2, trainee);
+  bind_text(s.get(), 3, lesson);
+  bind_text(s.get(), 4, lesson_hash);
   if (sqlite3_step(s.get()) == SQLITE_DONE) return true;
   error = fail("cannot start the lesson over");
   return false;
@@ -515,7 +646,7 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
       "f.input_device, f.input_settings_hash, f.started_unix_ms, f.duration_s, f.ended, f.probe, "
       "f.recording_path, f.recording_hash, f.app_version, f.front_end, "
       "f.parent_recording_hash, f.parent_step, f.ended_by, a.lesson, a.step, a.passed, "
-      "a.failed_criterion";
+      "a.failed_criterion, a.lesson_hash, a.step_title, a.ceiling, a.detail";
   // Without a limit the start-time index gives the order as it is: no sort of every row.
   const std::string flights_sql =
       q.limit > 0 ? std::string("SELECT * FROM (") + kColumns + kFilter +
@@ -562,6 +693,10 @@ bool SqliteHistory::query(const Query& q, std::vector<StoredFlight>& out, std::s
         f.lesson_step = sqlite3_column_int(p, 21);
         f.lesson_passed = sqlite3_column_int(p, 22) != 0;
         f.lesson_failed = column_text(p, 23);
+        f.lesson_hash = column_text(p, 24);
+        f.lesson_step_title = column_text(p, 25);
+        f.lesson_ceiling = sqlite3_column_double(p, 26);
+        f.lesson_detail = column_text(p, 27);
       }
       out.push_back(std::move(f));
     }

@@ -10,7 +10,9 @@
 namespace mixpilot::history {
 
 struct SqliteSettings {
-  int busy_timeout_ms = 5000;  // how long a write waits for another process's
+  // How long a write waits for another process's. Writes happen off the control thread (the
+  // history writer, the CLI), so a long wait costs nothing, and a row given up is a flight lost.
+  int busy_timeout_ms = 30000;
   bool create_folder = true;   // the file's missing folders are made (mode 700: a person's data)
 };
 

@@ -90,12 +90,28 @@ SetupResult MiMode::setup(Scenario scenario, std::unique_ptr<PilotSource> pilot)
   set_reference(0.0);
   s.predicted = controller_.predicted_positions();
   s.predicted_reference = controller_.reference_positions();
-  s.lambda = controller_.lambda();
-  s.reason = controller_.reason();
   s.pilot.rotor_speed.setConstant(model_.hover_speed());
   s.applied = s.pilot;
-  set_channels();
+  preview_first_step();
   return {};
+}
+
+bool MiMode::set_authority_bounds(const AuthorityBounds& bounds) {
+  if (!bounds.valid()) return false;
+  controller_.set_bounds(bounds);
+  preview_first_step();
+  return true;
+}
+
+void MiMode::preview_first_step() {
+  if (run_.step != 0) return;
+  Telemetry& s = run_.telemetry;
+  // The pilot's input is not known yet: its cap (SPEC §6) shows from the first step on.
+  const MiController::NextLambda next = controller_.next_lambda();
+  s.lambda = next.lambda;
+  s.reason = next.reason;
+  s.instructor.bounds = controller_.bounds();
+  set_channels();
 }
 
 // Lost: a non-finite state, or farther than mi_defaults::kLostMargin outside the arena.

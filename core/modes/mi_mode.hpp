@@ -53,11 +53,9 @@ class MiMode final : public Mode {
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
   RtiSolver* rti_solver() override { return &controller_.rti(); }
-  [[nodiscard]] bool set_authority_bounds(const AuthorityBounds& bounds) override {
-    if (!bounds.valid()) return false;
-    controller_.set_bounds(bounds);
-    return true;
-  }
+  // Before the first step the telemetry takes the new bounds and the λ they leave the first
+  // step (what READY shows).
+  [[nodiscard]] bool set_authority_bounds(const AuthorityBounds& bounds) override;
   AuthorityBounds authority_bounds() const override { return controller_.bounds(); }
   // The score; with a remote vehicle also rtt_s (the median round-trip sample) and
   // rtt_estimated_s (the final estimate).
@@ -118,6 +116,9 @@ class MiMode final : public Mode {
   void measure_remote(double t);
   void set_reference(double t);
   void set_channels();
+  // Before the first step: the telemetry says what the flight starts with (λ of its first
+  // step, the initial λ within the instructor's bounds, and the bounds); nothing after.
+  void preview_first_step();
   void lose_input(PilotCommand& pilot) const;
 
   Scenario scenario_;

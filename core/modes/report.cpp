@@ -4,36 +4,16 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/base/json.hpp"
+
 namespace mixpilot {
-
-namespace {
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string to_json(const Labels& labels, const Metrics& metrics, int indent) {
   const std::string pad(std::size_t(std::max(indent, 0)), ' ');
   std::string out = "{";
   const char* sep = "\n";
   for (const auto& [key, value] : labels) {
-    out += sep + pad + "\"" + json_escape(key) + "\": \"" + json_escape(value) + "\"";
+    out += sep + pad + json_quote(key) + ": " + json_quote(value);
     sep = ",\n";
   }
   char buf[64];
@@ -44,7 +24,7 @@ std::string to_json(const Labels& labels, const Metrics& metrics, int indent) {
     } else {
       std::snprintf(buf, sizeof buf, "null");
     }
-    out += sep + pad + "\"" + json_escape(key) + "\": " + buf;
+    out += sep + pad + json_quote(key) + ": " + buf;
     sep = ",\n";
   }
   out += "\n}";

@@ -165,7 +165,7 @@ std::optional<SecurityFiles> security_files(const std::string& folder, std::stri
   const std::filesystem::path dir = std::filesystem::absolute(folder, ec);
   if (ec || !std::filesystem::is_directory(dir, ec)) {
     error = "--dds-security " + folder + ": not a folder (it holds one identity's files, as "
-            "packaging/dds-security-ca.sh makes them; docs/instructor-security.md)";
+            "mixpilot-security-ca makes a test set of them; docs/instructor-security.md)";
     return std::nullopt;
   }
   SecurityFiles f;

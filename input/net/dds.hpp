@@ -25,7 +25,7 @@ void use_loopback_unless_configured();
 // --- DDS Security (docs/instructor-security.md) ----------------------------------------------
 
 // One identity's DDS Security files, from the folder `--dds-security FOLDER` names (as
-// packaging/dds-security-ca.sh makes them): identity_ca.pem, cert.pem, key.pem,
+// mixpilot-security-ca, packaging/dds-security-ca.sh, makes them): identity_ca.pem, cert.pem, key.pem,
 // permissions_ca.pem, governance.p7s, permissions.p7s. Paths absolute.
 struct SecurityFiles {
   std::string folder;

@@ -25,6 +25,26 @@ void put(char (&out)[N], std::string_view t) {
   out[n] = '\0';
 }
 
+// What an announcement says is in force, each part kept only within the ranges a station
+// applies (core/modes/instructor.hpp): a peer's numbers are shown, so none may be NaN or absurd.
+InstructorInForce in_force_of(const mixpilot_msgs_msg_dds__StationStatus_& m) {
+  InstructorInForce f;
+  const AuthorityBounds b{m.floor, m.ceiling};
+  if (std::isfinite(b.floor) && std::isfinite(b.ceiling) && b.valid()) f.bounds = b;
+  const Eigen::Vector3d force(m.gust[0], m.gust[1], m.gust[2]);
+  if (force.allFinite() && force.norm() <= kMaxGustForce && std::isfinite(m.gust_left) &&
+      m.gust_left > 0.0 && m.gust_left <= kMaxCommandDuration) {
+    f.gust = force;
+    f.gust_left = m.gust_left;
+  }
+  if (std::isfinite(m.extra_delay) && m.extra_delay > 0.0 && m.extra_delay <= kMaxExtraDelay)
+    f.extra_delay = m.extra_delay;
+  if (std::isfinite(m.input_loss_left) && m.input_loss_left > 0.0 &&
+      m.input_loss_left <= kMaxCommandDuration)
+    f.input_loss_left = m.input_loss_left;
+  return f;
+}
+
 }  // namespace
 
 std::uint64_t StationView::refused_total() const {
@@ -158,6 +178,7 @@ void InstructorClient::read_status() {
     v.deviation = m.deviation;
     v.time_in_ball = m.time_in_ball;
     v.mean_lambda = m.mean_lambda;
+    v.in_force = in_force_of(m);
     v.accepts_instructor = m.accepts_instructor;
     v.security = m.command_security <= 3 ? CommandSecurity(m.command_security)
                                          : CommandSecurity::no_instructor;

@@ -36,6 +36,7 @@ struct StationView {
   std::string station, trainee, scenario, mode;
   StationState state = StationState::ready;
   double t = 0, duration = 0, lambda = 0, deviation = 0, time_in_ball = 0, mean_lambda = 0;
+  InstructorInForce in_force;  // what the instructor's commands keep in force at t
   bool accepts_instructor = false;
   CommandSecurity security = CommandSecurity::no_instructor;
   std::uint64_t accepted = 0;

@@ -159,7 +159,14 @@ void InstructorLink::set_state(StationState s) {
   state_.store(std::uint8_t(s), std::memory_order_relaxed);
 }
 
+void InstructorLink::ready(const Telemetry& s) {
+  t_.store(s.t, std::memory_order_relaxed);
+  if (s.mode == ModeKind::mixed_initiative) lambda_.store(s.lambda, std::memory_order_relaxed);
+  in_force_.publish(s.instructor);
+}
+
 void InstructorLink::on_sample(const Telemetry& s) {
+  in_force_.publish(s.instructor);
   t_.store(s.t, std::memory_order_relaxed);
   ++samples_;
   if (s.mode == ModeKind::mixed_initiative) {
@@ -193,8 +200,10 @@ void InstructorLink::run() {
                      std::max<dds_duration_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count()));
     const std::uint64_t before = accepted_.load() + refusals_.total();
     take_commands();
-    if (accepted_.load() + refusals_.total() != before) {
-      announce();  // the result at once: an instructor waits for it
+    // A command's result at once (an instructor waits for it), and what it did once the flight
+    // applied it (a gust of half a second would otherwise end between two announcements).
+    if (accepted_.load() + refusals_.total() != before || in_force_changed()) {
+      announce();
       next = clock::now() + period;
     }
   }
@@ -264,6 +273,15 @@ void InstructorLink::take_commands() {
   dds_return_loan(reader_, samples, n);
 }
 
+bool InstructorLink::in_force_changed() {
+  const InstructorInForce& f = in_force_.read();
+  const InstructorInForce& a = announced_force_;
+  const bool paused = options_.paused && options_.paused();
+  return f.bounds != a.bounds || (f.gust_left > 0.0) != (a.gust_left > 0.0) ||
+         (f.gust_left > 0.0 && f.gust != a.gust) || f.extra_delay != a.extra_delay ||
+         (f.input_loss_left > 0.0) != (a.input_loss_left > 0.0) || paused != announced_paused_;
+}
+
 void InstructorLink::announce() {
   Status s{};
   put(s.station, options_.station.name);
@@ -279,6 +297,15 @@ void InstructorLink::announce() {
   s.deviation = deviation_.load(std::memory_order_relaxed);
   s.time_in_ball = time_in_ball_.load(std::memory_order_relaxed);
   s.mean_lambda = mean_lambda_.load(std::memory_order_relaxed);
+  const InstructorInForce& f = in_force_.read();
+  announced_force_ = f;
+  announced_paused_ = options_.paused && options_.paused();
+  s.floor = f.bounds.floor;
+  s.ceiling = f.bounds.ceiling;
+  for (int i = 0; i < 3; ++i) s.gust[i] = f.gust(i);
+  s.gust_left = f.gust_left;
+  s.extra_delay = f.extra_delay;
+  s.input_loss_left = f.input_loss_left;
   s.accepts_instructor = options_.security == CommandSecurity::dds_security ||
                          options_.security == CommandSecurity::unauthenticated_loopback;
   s.command_security = std::uint8_t(options_.security);

@@ -12,8 +12,11 @@
 // of the peers (Cyclone's log, input/net/dds.hpp), and the newest results (issuer, sequence,
 // result), so an instructor learns what became of its command.
 //
-// The control thread gives it each step's telemetry (on_sample: a few atomic stores, never a
-// wait) for the announcement's time, λ, deviation, time in B and mean λ so far.
+// The control thread gives it each step's telemetry (on_sample: a few atomic stores and a
+// wait-free slot, never a wait) for the announcement's time, λ, deviation, time in B, mean λ
+// so far and what the instructor's commands keep in force (bounds, a gust, an extra delay, an
+// input loss), which is announced at once when it changes, so an instructor sees a gust while
+// it acts; before the first step, ready() gives what the flight will start with.
 #include <array>
 #include <atomic>
 #include <functional>
@@ -22,6 +25,7 @@
 #include <string>
 #include <thread>
 
+#include "core/base/latest.hpp"
 #include "core/base/spsc_ring.hpp"
 #include "core/modes/instructor.hpp"
 #include "core/modes/session.hpp"
@@ -104,6 +108,10 @@ class InstructorLink final : public TelemetrySink {
   void stop();
 
   void on_sample(const Telemetry& sample) override;  // control thread: atomic stores only
+  // Before the flight starts (on the thread that starts it): its mode's telemetry before the
+  // first step, for the announcement's λ (what the first step will use) and the bounds in
+  // force. Not a sample: the state stays ready and no mean is taken.
+  void ready(const Telemetry& before_first_step);
   void set_state(StationState s);                   // any thread
 
   InstructorLinkStats stats() const;
@@ -114,6 +122,10 @@ class InstructorLink final : public TelemetrySink {
   void run();
   void take_commands();
   void announce();
+  // Whether what is in force, or the instructor's pause, changed in kind since the last
+  // announcement (a gust started or ended, bounds or the delay changed...; not a gust's time
+  // running down).
+  bool in_force_changed();
 
   Options options_;
   SpscRing<InstructorCommand>* ring_ = nullptr;
@@ -127,6 +139,7 @@ class InstructorLink final : public TelemetrySink {
   std::atomic<double> t_{0}, lambda_{0}, deviation_{0}, time_in_ball_{0}, mean_lambda_{0};
   std::int64_t samples_ = 0, in_ball_ = 0;  // control thread only
   double lambda_sum_ = 0;
+  Latest<InstructorInForce> in_force_;  // control thread → link thread (and stop()'s caller)
 
   // Link thread.
   InstructorCheck check_;
@@ -140,6 +153,9 @@ class InstructorLink final : public TelemetrySink {
   };
   std::array<Result, kRecent> recent_{};
   int recent_count_ = 0;  // results kept (newest last)
+  // What the last announcement said is in force (link thread): a change in kind announces.
+  InstructorInForce announced_force_;
+  bool announced_paused_ = false;
 };
 
 }  // namespace mixpilot::net

@@ -234,7 +234,7 @@ done
 rm -rf "$work/cwd" "$work/h.out"
 
 # --- Every command's own --help; every front end's own summary label. ------------------------
-for cmd in fly replay score recover gamepad-script joy-publish vehicle demo models; do
+for cmd in fly replay score recover gamepad-script joy-publish vehicle demo models sweep; do
   "$mixpilot" $cmd --help >"$work/help.out" 2>&1
   check "$cmd --help: exit 0" test $? -eq 0
   check "$cmd --help: its own usage" grep -q "^usage: mixpilot $cmd" "$work/help.out"
