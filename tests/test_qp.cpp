@@ -9,6 +9,7 @@
 #include <memory>
 
 #include <sstream>
+#include <string>
 
 #include "core/qp/ocp_qp_io.hpp"
 #include "core/qp/qp_condensed_dense.hpp"
@@ -1024,6 +1025,84 @@ TEST(QpKernels, GemmNnMatchesEigen) {
               << m << "x" << n << "x" << k;
           EXPECT_EQ(C.row(m), C0.row(m));
         }
+}
+
+// The condensing's Aᵀ B kernel against Eigen: rows 1..13 (blocks of four and a scalar tail),
+// columns 1..5, k = 0..17 (vectors of four and a masked tail), larger leading dimensions,
+// accumulating and overwriting; rows below m untouched.
+TEST(QpKernels, GemmTnMatchesEigen) {
+  std::srand(12);
+  for (int m = 1; m <= 13; ++m)
+    for (int n = 1; n <= 5; ++n)
+      for (int k : {0, 1, 3, 4, 13, 17})
+        for (bool overwrite : {false, true}) {
+          const Eigen::MatrixXd A = Eigen::MatrixXd::Random(k + 3, m);
+          const Eigen::MatrixXd B = Eigen::MatrixXd::Random(k + 2, n);
+          Eigen::MatrixXd C = Eigen::MatrixXd::Random(m + 1, n);
+          const Eigen::MatrixXd C0 = C;
+          Eigen::MatrixXd expected = A.topRows(k).transpose() * B.topRows(k);
+          if (!overwrite) expected += C0.topRows(m);
+          kernels::gemm_tn(m, n, k, A.data(), int(A.rows()), B.data(), int(B.rows()), C.data(),
+                           int(C.rows()), overwrite);
+          EXPECT_LE((C.topRows(m) - expected).cwiseAbs().maxCoeff(), 1e-14 * (k + 1))
+              << m << "x" << n << "x" << k;
+          EXPECT_EQ(C.row(m), C0.row(m));
+        }
+}
+
+// Each condensed pair block against the formulas of core/qp/qp_riccati_ipm_pairs.hpp, evaluated
+// with Eigen: for dense Hessians with cross terms S, and for the controllers' structure (Q
+// diagonal, S = 0: Q1 A0 as a row scaling, no S1 products); Q exactly symmetric.
+TEST(QpRiccatiIpmPairs, CondensedBlocksMatchTheirDefinition) {
+  for (const bool structured : {false, true}) {
+    SCOPED_TRACE(structured ? "diagonal Q, S = 0" : "dense Q, S");
+    OcpQp qp = testing_qp::random_qp(spec(9, 3, 6, 2, 2, 0.3), 61);
+    if (structured)
+      for (OcpQpStage& s : qp.stage) {
+        s.Q = Eigen::MatrixXd(s.Q.diagonal().asDiagonal());
+        s.S.setZero();
+      }
+    QpRiccatiIpmPairs pairs(qp.dims);
+    pairs.prepare(qp);
+    const OcpQp& c = pairs.condensed();
+    for (int j = 0; 2 * j + 1 < qp.dims.N; ++j) {
+      SCOPED_TRACE("pair " + std::to_string(j));
+      const OcpQpStage &s0 = qp.stage[2 * j], &s1 = qp.stage[2 * j + 1], &t = c.stage[j];
+      const int nu0 = qp.dims.nu[2 * j], nu1 = qp.dims.nu[2 * j + 1];
+      const int ng0 = qp.dims.ng[2 * j], nbx1 = qp.dims.nbx[2 * j + 1];
+      const Eigen::VectorXd g1 = s1.Q * s0.b + s1.q;
+      Eigen::MatrixXd B(s1.A.rows(), nu0 + nu1), S(nu0 + nu1, s0.Q.cols()), R(nu0 + nu1, nu0 + nu1);
+      B << s1.A * s0.B, s1.B;
+      S << s0.S + s0.B.transpose() * s1.Q * s0.A, s1.S * s0.A;
+      R << s0.R + s0.B.transpose() * s1.Q * s0.B, (s1.S * s0.B).transpose(), s1.S * s0.B, s1.R;
+      Eigen::VectorXd r(nu0 + nu1);
+      r << s0.r + s0.B.transpose() * g1, s1.r + s1.S * s0.b;
+      const auto near = [](const auto& a, const auto& b) {
+        return (a - b).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + b.cwiseAbs().maxCoeff());
+      };
+      EXPECT_TRUE(near(t.A, s1.A * s0.A));
+      EXPECT_TRUE(near(t.B, B));
+      EXPECT_TRUE(near(t.b, s1.A * s0.b + s1.b));
+      EXPECT_TRUE(near(t.Q, s0.Q + s0.A.transpose() * s1.Q * s0.A));
+      EXPECT_EQ(t.Q, t.Q.transpose());
+      EXPECT_TRUE(near(t.S, S));
+      EXPECT_TRUE(near(t.R, R));
+      EXPECT_TRUE(near(t.q, s0.q + s0.A.transpose() * g1));
+      EXPECT_TRUE(near(t.r, r));
+      for (int k = 0; k < nbx1; ++k) {  // x_{k+1}'s bounds as rows of [A0 B0]
+        const int idx = s1.idxbx[k];
+        EXPECT_EQ(t.C.row(ng0 + k), s0.A.row(idx));
+        EXPECT_EQ(t.D.row(ng0 + k).head(nu0), s0.B.row(idx));
+        EXPECT_EQ(t.D.row(ng0 + k).tail(nu1).cwiseAbs().sum(), 0.0);
+      }
+      const int r0 = ng0 + nbx1, ng1 = qp.dims.ng[2 * j + 1];
+      if (ng1 > 0) {
+        EXPECT_TRUE(near(t.C.middleRows(r0, ng1), s1.C * s0.A));
+        EXPECT_TRUE(near(t.D.middleRows(r0, ng1).leftCols(nu0), s1.C * s0.B));
+        EXPECT_EQ(t.D.middleRows(r0, ng1).rightCols(nu1), s1.D);
+      }
+    }
+  }
 }
 
 TEST(QpRiccatiIpmPairs, FailureStatusesWithoutNan) {

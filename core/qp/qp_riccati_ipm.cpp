@@ -53,7 +53,6 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   w.L.assign(n1, {});
   w.Y.assign(n1, {});
   w.Hbase.assign(n1, {});
-  w.Hfull.assign(n1, {});
   w.inv_diag.assign(n1, {});
   w.Dinv.assign(n1, {});
   w.pivot_floor.assign(n1, 0.0);
@@ -83,7 +82,6 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     w.L[i] = Eigen::MatrixXd::Zero(np, nv);
     w.Y[i] = Eigen::MatrixXd::Zero(np, nx1 + dims.ng[i]);
     w.Hbase[i] = Eigen::MatrixXd::Zero(np, nv);
-    w.Hfull[i] = Eigen::MatrixXd::Zero(nv, nv);
     w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
     w.Dinv[i] = Eigen::MatrixXd::Zero(std::max(np, 4), 4);
     w.tmp[i] = Eigen::VectorXd::Zero(std::max({nv, nx1, nc, 1}));
@@ -114,30 +112,51 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     const OcpQpStage& s = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i];
     const int nc = w.nc[i], ns = d.ns[i];
-    if (i < d.N) {
-      w.BAt[i].topRows(nu) = s.B.transpose();
-      w.BAt[i].middleRows(nu, nx) = s.A.transpose();
-      w.bflat.segment(w.off_pi[i], d.nx[i + 1]) = s.b;
+    // Plain loops over the source columns: Eigen's transposed and triangular block assignments
+    // cost several times more at these sizes, and this runs for every QP.
+    if (i < d.N) {  // [Bᵀ; Aᵀ]
+      const int nx1 = d.nx[i + 1], ldb = static_cast<int>(w.BAt[i].rows());
+      double* bat = w.BAt[i].data();
+      const double* B = s.B.data();
+      const double* A = s.A.data();
+      for (int r = 0; r < nu; ++r)
+        for (int c = 0; c < nx1; ++c) bat[r + static_cast<std::ptrdiff_t>(c) * ldb] = B[c + r * nx1];
+      for (int r = 0; r < nx; ++r)
+        for (int c = 0; c < nx1; ++c)
+          bat[nu + r + static_cast<std::ptrdiff_t>(c) * ldb] = A[c + r * nx1];
+      std::copy_n(s.b.data(), nx1, w.bflat.data() + w.off_pi[i]);
     }
-    w.gflat.segment(w.off_v[i], nu) = s.r;
-    w.gflat.segment(w.off_v[i] + nu, nx) = s.q;
-    w.zflat.segment(w.off_s[i], ns) = s.zl;
-    w.zflat.segment(w.off_s[i] + ns, ns) = s.zu;
-    if (ng > 0) {
-      w.DCt[i].topRows(nu) = s.D.transpose();
-      w.DCt[i].bottomRows(nx) = s.C.transpose();
+    std::copy_n(s.r.data(), nu, w.gflat.data() + w.off_v[i]);
+    std::copy_n(s.q.data(), nx, w.gflat.data() + w.off_v[i] + nu);
+    std::copy_n(s.zl.data(), ns, w.zflat.data() + w.off_s[i]);
+    std::copy_n(s.zu.data(), ns, w.zflat.data() + w.off_s[i] + ns);
+    if (ng > 0) {  // [Dᵀ; Cᵀ]
+      const int nv = nu + nx;
+      double* dct = w.DCt[i].data();
+      for (int r = 0; r < nu; ++r)
+        for (int k = 0; k < ng; ++k) dct[r + k * nv] = s.D.data()[k + r * ng];
+      for (int r = 0; r < nx; ++r)
+        for (int k = 0; k < ng; ++k) dct[nu + r + k * nv] = s.C.data()[k + r * ng];
     }
-    // Stage Hessian [R S; Sᵀ Q] in (u, x) order: lower triangle (strict upper stays zero) for
-    // the factorization, full for residuals.
-    w.Hbase[i].topLeftCorner(nu, nu).triangularView<Eigen::Lower>() = s.R;
-    w.Hbase[i].block(nu, 0, nx, nu) = s.S.transpose();
-    w.Hbase[i].block(nu, nu, nx, nx).triangularView<Eigen::Lower>() = s.Q;
-    w.Hfull[i].topLeftCorner(nu, nu) = s.R;
-    w.Hfull[i].topRightCorner(nu, nx) = s.S;
-    w.Hfull[i].bottomLeftCorner(nx, nu) = s.S.transpose();
-    w.Hfull[i].bottomRightCorner(nx, nx) = s.Q;
-    const double scale = nu + nx > 0 ? w.Hfull[i].diagonal().cwiseAbs().maxCoeff() : 0.0;
-    w.pivot_floor[i] = settings_.psd_tol * (scale > 0.0 ? scale : 1.0);
+    // Stage Hessian [R S; Sᵀ Q] in (u, x) order, lower triangle (the strict upper stays zero),
+    // for the factorization; the residuals read R, S and Q in place.
+    {
+      const int ldh = static_cast<int>(w.Hbase[i].rows());
+      double* h = w.Hbase[i].data();
+      double scale = 0.0;
+      for (int c = 0; c < nu; ++c) {
+        const double* rc = s.R.data() + c * nu;
+        for (int r = c; r < nu; ++r) h[r + c * ldh] = rc[r];
+        for (int r = 0; r < nx; ++r) h[nu + r + c * ldh] = s.S.data()[c + r * nu];
+        scale = std::max(scale, std::abs(rc[c]));
+      }
+      for (int c = 0; c < nx; ++c) {
+        const double* qc = s.Q.data() + c * nx;
+        for (int r = c; r < nx; ++r) h[nu + r + (nu + c) * ldh] = qc[r];
+        scale = std::max(scale, std::abs(qc[c]));
+      }
+      w.pivot_floor[i] = settings_.psd_tol * (scale > 0.0 ? scale : 1.0);
+    }
     for (int k = 0; k < nbu; ++k) w.var_of_box[i][k] = s.idxbu[k];
     for (int k = 0; k < nbx; ++k) w.var_of_box[i][nbu + k] = nu + s.idxbx[k];
     w.soft_of[i].setConstant(-1);
@@ -301,7 +320,13 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
     const int nv = nu + nx;
     auto rx = out_v.segment(ov + nu, nx);
     out_v.segment(ov, nv) = g.segment(ov, nv);
-    kernels::gemv_n(nv, nv, w.Hfull[i].data(), nv, v.data() + ov, out_v.data() + ov);
+    // [R S; Sᵀ Q] v, read in place.
+    if (nu > 0) {
+      kernels::gemv_n(nu, nu, st.R.data(), nu, v.data() + ov, out_v.data() + ov);
+      kernels::gemv_n(nu, nx, st.S.data(), nu, v.data() + ov + nu, out_v.data() + ov);
+      kernels::gemv_t(nu, nx, st.S.data(), nu, v.data() + ov, out_v.data() + ov + nu);
+    }
+    kernels::gemv_n(nx, nx, st.Q.data(), nx, v.data() + ov + nu, out_v.data() + ov + nu);
     if (i < d.N)
       kernels::gemv_n(nv, d.nx[i + 1], w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
                       pi.data() + w.off_pi[i], out_v.data() + ov);
@@ -790,14 +815,21 @@ void QpRiccatiIpm::write_solution(const OcpQp& qp, OcpQpSolution& sol) {
       if (w.slive[os + j] == 0.0) sol.lam_sl[i][j] = st.Zl[j] * sol.sl[i][j] + st.zl[j];
       if (w.slive[os + ns + j] == 0.0) sol.lam_su[i][j] = st.Zu[j] * sol.su[i][j] + st.zu[j];
     }
+    // ½vᵀHv + gᵀv = ½uᵀ(R u + 2 S x) + ½xᵀQ x + rᵀu + qᵀx (the kernels: Eigen's products
+    // cost more in their set-up than in their arithmetic at these sizes).
     auto tmp = w.tmp[i].head(std::max(nu, nx));
+    const double* u = w.v.data() + ov;
+    const double* x = u + nu;
     if (nu > 0) {
-      tmp.head(nu).noalias() = st.R * sol.u[i];
-      tmp.head(nu).noalias() += 2.0 * st.S * sol.x[i];
+      tmp.head(nu).setZero();
+      kernels::gemv_n(nu, nx, st.S.data(), nu, x, tmp.data());
+      tmp.head(nu) *= 2.0;
+      kernels::gemv_n(nu, nu, st.R.data(), nu, u, tmp.data());
       f += 0.5 * sol.u[i].dot(tmp.head(nu)) + st.r.dot(sol.u[i]);
     }
     if (nx > 0) {
-      tmp.head(nx).noalias() = st.Q * sol.x[i];
+      tmp.head(nx).setZero();
+      kernels::gemv_n(nx, nx, st.Q.data(), nx, x, tmp.data());
       f += 0.5 * sol.x[i].dot(tmp.head(nx)) + st.q.dot(sol.x[i]);
     }
     f += 0.5 * sol.sl[i].dot(st.Zl.cwiseProduct(sol.sl[i])) + st.zl.dot(sol.sl[i]);

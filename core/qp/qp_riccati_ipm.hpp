@@ -39,7 +39,6 @@ struct QpRiccatiIpmWorkspace {
   // (np = pad4(nu+nx)); padding rows are zero.
   std::vector<Eigen::MatrixXd> BAt;         // np x nx_{i+1}: [Bᵀ; Aᵀ]
   std::vector<Eigen::MatrixXd> Hbase;       // np x (nu+nx): [R S; Sᵀ Q], lower triangle only
-  std::vector<Eigen::MatrixXd> Hfull;       // (nu+nx) x (nu+nx): [R S; Sᵀ Q]
   std::vector<Eigen::MatrixXd> DCt;         // (nu+nx) x ng: [Dᵀ; Cᵀ]
   std::vector<Eigen::MatrixXd> L;           // np x (nu+nx): H̃ + Y Yᵀ, then its lower Cholesky
                                             // factor, strict upper triangle zero (stage 0: uu

@@ -83,10 +83,8 @@ class QpRiccatiIpmPairs : public QpSolver {
   std::unique_ptr<QpSolver> inner_;  // QpRiccatiIpm, or QpRiccatiIpmPairs(levels − 1)
   // Condensing workspace, sized for the largest stage.
   Eigen::MatrixXd Q1A0_;  // nx1 x nx0
-  Eigen::MatrixXd Q1B0_;  // nx1 x nu0
-  Eigen::MatrixXd A0t_;   // nx0 x nx1: A0ᵀ
-  Eigen::MatrixXd B0t_;   // nu0 x nx1: B0ᵀ
-  Eigen::VectorXd g1_;    // nx1: Q1 b0 + q1
+  Eigen::MatrixXd Q1B0_;  // nx1 x nu0 (same leading dimension as Q1A0_)
+  Eigen::VectorXd g1_;    // nx1: Q1 b0 + q1 (first the diagonal of a diagonal Q1)
   Eigen::VectorXd x1_;    // nx1: scratch of the expansion
   std::vector<double> constant_;  // per block: ½b0ᵀQ1b0 + q1ᵀb0
 };
