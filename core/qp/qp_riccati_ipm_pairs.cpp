@@ -337,9 +337,9 @@ void QpRiccatiIpmPairs::restrict_warm_start(const OcpQpSolution& sol) {
     solc_.u[j].head(nu0) = sol.u[k];
     solc_.u[j].tail(nu1) = sol.u[k + 1];
     solc_.pi[j] = sol.pi[k + 1];
-    for (const Segment& g : pair_segments(d, k)) {
-      solc_.lam_l[j].segment(g.block, g.size) = sol.lam_l[k + g.stage].segment(g.offset, g.size);
-      solc_.lam_u[j].segment(g.block, g.size) = sol.lam_u[k + g.stage].segment(g.offset, g.size);
+    for (const Segment& g : pair_segments(d, k)) {  // plain copies: most segments are tiny or empty
+      std::copy_n(sol.lam_l[k + g.stage].data() + g.offset, g.size, solc_.lam_l[j].data() + g.block);
+      std::copy_n(sol.lam_u[k + g.stage].data() + g.offset, g.size, solc_.lam_u[j].data() + g.block);
     }
     for (auto [dst, src] : {std::pair{&solc_.sl, &sol.sl}, std::pair{&solc_.su, &sol.su},
                             std::pair{&solc_.lam_sl, &sol.lam_sl},
@@ -371,8 +371,8 @@ void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
     add_ax(s0.A, sol.x[k], x1);
     add_ax(s0.B, sol.u[k], x1);
     for (const Segment& g : pair_segments(d, k)) {
-      sol.lam_l[k + g.stage].segment(g.offset, g.size) = solc_.lam_l[j].segment(g.block, g.size);
-      sol.lam_u[k + g.stage].segment(g.offset, g.size) = solc_.lam_u[j].segment(g.block, g.size);
+      std::copy_n(solc_.lam_l[j].data() + g.block, g.size, sol.lam_l[k + g.stage].data() + g.offset);
+      std::copy_n(solc_.lam_u[j].data() + g.block, g.size, sol.lam_u[k + g.stage].data() + g.offset);
     }
     for (auto [dst, src] : {std::pair{&sol.sl, &solc_.sl[j]}, std::pair{&sol.su, &solc_.su[j]},
                             std::pair{&sol.lam_sl, &solc_.lam_sl[j]},
@@ -389,9 +389,13 @@ void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
     add_atx(s1.A, sol.pi[k + 1], pk);
     for (int r = 0; r < nbx1; ++r)
       pk[s1.idxbx[r]] -= sol.lam_l[k + 1][nbu1 + r] - sol.lam_u[k + 1][nbu1 + r];
-    for (int r = 0; r < ng1; ++r)
-      pk -= (sol.lam_l[k + 1][nbu1 + nbx1 + r] - sol.lam_u[k + 1][nbu1 + nbx1 + r]) *
-            s1.C.row(r).transpose();
+    for (int r0 = 0; r0 < ng1; r0 += 16) {  // + C1ᵀ(λ_u − λ_l) of the general rows
+      double diff[16];
+      const int n = std::min(16, ng1 - r0);
+      for (int r = 0; r < n; ++r)
+        diff[r] = sol.lam_u[k + 1][nbu1 + nbx1 + r0 + r] - sol.lam_l[k + 1][nbu1 + nbx1 + r0 + r];
+      kernels::gemv_t(n, d.nx[k + 1], s1.C.data() + r0, ng1, diff, pk.data());
+    }
   }
   sol.lam_x0 = solc_.lam_x0;
   sol.status = solc_.status;
