@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -44,7 +45,9 @@ constexpr const char* kScoreUsage =
     "statistics: they describe that flight); other modes are flown for the recorded number of\n"
     "steps and give their metrics (timing fields from this run). A probe flight (fly --assist\n"
     "off) is replayed as one and marked \"probe\": \"true\". Progress on stderr, a table on\n"
-    "stdout.\n"
+    "stdout. Each progress line says how fast the replay ran: the flight's length over the CPU\n"
+    "time of the thread that replayed it (\"30.0 s in 0.29 s CPU: 103x real time\"; wall time\n"
+    "too), which on a machine shared with other work is the figure that stays put.\n"
     "\n"
     "  --jobs N     replay N recordings in parallel (default: the number of cores)\n"
     "  --json OUT   write a JSON array with one object per recording\n"
@@ -85,8 +88,29 @@ struct ScoreRow {
   std::string error;
   // The flight stopped before its planned end: "interrupted at t = 3.0 s of 30.0 s" ("" if not).
   std::string ended_early;
+  // How fast it was replayed: the steps flown [s of flight], the replaying thread's CPU time and
+  // the wall time it took [s] (assembling the flight and reading the recording included).
+  double flown_s = 0.0;
+  double cpu_s = 0.0;
+  double wall_s = 0.0;
   bool stopped = false;  // ^C or SIGTERM stopped the replay: no score
 };
+
+// CPU time of the calling thread [s].
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// " (30.0 s in 0.29 s CPU, 0.31 s wall: 103x real time)" for the progress line.
+std::string speed_words(const ScoreRow& row) {
+  if (!(row.flown_s > 0.0) || !(row.cpu_s > 0.0)) return "";
+  char buf[128];
+  std::snprintf(buf, sizeof buf, " (%.1f s in %.2f s CPU, %.2f s wall: %.0fx real time)",
+                row.flown_s, row.cpu_s, row.wall_s, row.flown_s / row.cpu_s);
+  return buf;
+}
 
 // A metric of the row by name (0 when the mode has none).
 double metric_of(const ScoreRow& row, std::string_view name) {
@@ -98,6 +122,8 @@ double metric_of(const ScoreRow& row, std::string_view name) {
 ScoreRow score_recording(const std::string& path) {
   ScoreRow row;
   row.file = path;
+  const double cpu0 = thread_cpu_s();
+  const auto wall0 = std::chrono::steady_clock::now();
   FlyOptions o;
   o.pilot = path;
   o.replay = true;
@@ -127,6 +153,10 @@ ScoreRow score_recording(const std::string& path) {
   row.metrics = rig->metrics();
   row.difference = rig->replay_difference();
   row.ended_early = recording_ended_early(rec, mode);
+  row.flown_s = double(mode.steps_done()) * mode.dt();
+  row.cpu_s = thread_cpu_s() - cpu0;
+  row.wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   row.ok = true;
   return row;
 }
@@ -480,11 +510,11 @@ int score_command(int argc, char** argv) {
       const std::size_t d = ++done;
       const std::lock_guard<std::mutex> lock(io);
       if (rows[i].ok && rows[i].mode == "mixed_initiative") {
-        std::fprintf(stderr, "[%zu/%zu] %s: skill %.1f\n", d, files.size(), files[i].c_str(),
-                     metric_of(rows[i], "skill"));
+        std::fprintf(stderr, "[%zu/%zu] %s: skill %.1f%s\n", d, files.size(), files[i].c_str(),
+                     metric_of(rows[i], "skill"), speed_words(rows[i]).c_str());
       } else if (rows[i].ok) {
-        std::fprintf(stderr, "[%zu/%zu] %s: %s\n", d, files.size(), files[i].c_str(),
-                     rows[i].mode.c_str());
+        std::fprintf(stderr, "[%zu/%zu] %s: %s%s\n", d, files.size(), files[i].c_str(),
+                     rows[i].mode.c_str(), speed_words(rows[i]).c_str());
       } else {
         std::fprintf(stderr, "[%zu/%zu] %s\n", d, files.size(), rows[i].error.c_str());
       }

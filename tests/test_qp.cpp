@@ -9,6 +9,7 @@
 #include <memory>
 
 #include <sstream>
+#include <string>
 
 #include "core/qp/ocp_qp_io.hpp"
 #include "core/qp/qp_condensed_dense.hpp"
@@ -483,6 +484,41 @@ TEST(QpDump, RoundTripIsExact) {
   EXPECT_FALSE(read_ocp_qp_json("{\"format\":\"other\"}", back, st2, name, err));
   EXPECT_FALSE(read_ocp_qp_json(line.substr(0, line.size() / 2), back, st2, name, err));
   EXPECT_FALSE(err.empty());
+
+  // A closed-loop record: the warm start goes with the QP, and the warm solve from the read
+  // record repeats the original one exactly.
+  std::stringstream ws;
+  write_ocp_qp_json(ws, qp, st, "warm", &r1, QpWarmStart::primal_dual);
+  std::getline(ws, line);
+  OcpQpSolution start;
+  QpWarmStart warm = QpWarmStart::cold;
+  ASSERT_TRUE(read_ocp_qp_json(line, back, st2, name, err, &start, &warm)) << err;
+  EXPECT_EQ(warm, QpWarmStart::primal_dual);
+  for (int i = 0; i <= qp.dims.N; ++i) {
+    EXPECT_TRUE(start.x[i] == r1.x[i] && start.u[i] == r1.u[i] && start.lam_l[i] == r1.lam_l[i] &&
+                start.lam_u[i] == r1.lam_u[i] && start.sl[i] == r1.sl[i] &&
+                start.su[i] == r1.su[i] && start.lam_sl[i] == r1.lam_sl[i] &&
+                start.lam_su[i] == r1.lam_su[i])
+        << i;
+    if (i < qp.dims.N) {
+      EXPECT_TRUE(start.pi[i] == r1.pi[i]) << i;
+    }
+  }
+  OcpQpSolution w1 = r1, w2 = start;
+  ASSERT_EQ(s1.solve(qp, w1, QpWarmStart::primal_dual), QpStatus::success);
+  ASSERT_EQ(s2.solve(back, w2, QpWarmStart::primal_dual), QpStatus::success);
+  EXPECT_EQ(w1.iterations, w2.iterations);
+  EXPECT_EQ(w1.objective, w2.objective);
+  // Without a start member a warm record is refused; a cold record reads as cold.
+  const std::string no_start = line.substr(0, line.find(",\"start\"")) +
+                               line.substr(line.find(",\"x0\""));
+  EXPECT_FALSE(read_ocp_qp_json(no_start, back, st2, name, err, &start, &warm));
+  EXPECT_NE(err.find("start"), std::string::npos) << err;
+  std::stringstream cs;
+  write_ocp_qp_json(cs, qp, st, "cold", &r1, QpWarmStart::cold);
+  std::getline(cs, line);
+  ASSERT_TRUE(read_ocp_qp_json(line, back, st2, name, err, &start, &warm)) << err;
+  EXPECT_EQ(warm, QpWarmStart::cold);
 }
 
 // --- Condensing + dense IPM (core/qp_condensed_dense): the same contract on short horizons. ---
@@ -901,6 +937,41 @@ TEST(QpCondensedDense, ActiveSetFallsBackToTheIpm) {
 
 // The benchmark QPs through partial condensing: the same solution as the plain Riccati IPM,
 // and a primal-dual warm start with a changed x0 as in the RTI feedback phase.
+// RTI's preparation phase (QpSolver::prepare with the warm start) factorizes the first Newton
+// system of stages N..1 before x0 is known: prepared on the QP with the previous x0, then solved
+// with the new one, the solve is the plain warm solve's bit for bit (stage 0 is initialized and
+// factorized again with the new x0), for the stage-wise solver and behind pair condensing (whose
+// first block's constraints do involve x0).
+TEST_P(ControllerQp, PreparedWarmStartSolvesAsThePlainWarmStart) {
+  const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
+                   : GetParam() == 1 ? testing_qp::crazyflie_qp()
+                                     : testing_qp::pendubot_qp();
+  QpRiccatiIpm plain(qp.dims, tight()), prepared(qp.dims, tight());
+  QpRiccatiIpmPairs pairs_plain(qp.dims, tight()), pairs_prepared(qp.dims, tight());
+  OcpQpSolution start(qp.dims);
+  ASSERT_EQ(plain.solve(qp, start), QpStatus::success);
+  OcpQp moved = qp;
+  moved.x0 += 1e-2 * Eigen::VectorXd::Ones(qp.x0.size());
+  for (auto [a, b] : {std::pair<QpSolver*, QpSolver*>{&plain, &prepared},
+                      std::pair<QpSolver*, QpSolver*>{&pairs_plain, &pairs_prepared}}) {
+    OcpQpSolution sa = start, sb = start;
+    ASSERT_EQ(a->solve(moved, sa, QpWarmStart::primal_dual), QpStatus::success);
+    OcpQp stale = moved;
+    stale.x0 = qp.x0;  // the preparation does not know x0 yet
+    b->prepare(stale, sb, QpWarmStart::primal_dual);
+    stale.x0 = moved.x0;
+    ASSERT_EQ(b->solve(stale, sb, QpWarmStart::primal_dual), QpStatus::success);
+    EXPECT_EQ(sa.iterations, sb.iterations);
+    EXPECT_GT(sa.iterations, 0);
+    for (int i = 0; i <= qp.dims.N; ++i) {
+      ASSERT_EQ(sa.x[i], sb.x[i]) << i;
+      ASSERT_EQ(sa.u[i], sb.u[i]) << i;
+      ASSERT_EQ(sa.lam_l[i], sb.lam_l[i]) << i;
+    }
+    EXPECT_LE(kkt_residuals(moved, sb).max(), 1e-8);
+  }
+}
+
 TEST_P(ControllerQp, PairsMatchThePlainSolverColdAndWarm) {
   const OcpQp qp = GetParam() == 0   ? testing_qp::mixed_initiative_qp()
                    : GetParam() == 1 ? testing_qp::crazyflie_qp()
@@ -954,6 +1025,84 @@ TEST(QpKernels, GemmNnMatchesEigen) {
               << m << "x" << n << "x" << k;
           EXPECT_EQ(C.row(m), C0.row(m));
         }
+}
+
+// The condensing's Aᵀ B kernel against Eigen: rows 1..13 (blocks of four and a scalar tail),
+// columns 1..5, k = 0..17 (vectors of four and a masked tail), larger leading dimensions,
+// accumulating and overwriting; rows below m untouched.
+TEST(QpKernels, GemmTnMatchesEigen) {
+  std::srand(12);
+  for (int m = 1; m <= 13; ++m)
+    for (int n = 1; n <= 5; ++n)
+      for (int k : {0, 1, 3, 4, 13, 17})
+        for (bool overwrite : {false, true}) {
+          const Eigen::MatrixXd A = Eigen::MatrixXd::Random(k + 3, m);
+          const Eigen::MatrixXd B = Eigen::MatrixXd::Random(k + 2, n);
+          Eigen::MatrixXd C = Eigen::MatrixXd::Random(m + 1, n);
+          const Eigen::MatrixXd C0 = C;
+          Eigen::MatrixXd expected = A.topRows(k).transpose() * B.topRows(k);
+          if (!overwrite) expected += C0.topRows(m);
+          kernels::gemm_tn(m, n, k, A.data(), int(A.rows()), B.data(), int(B.rows()), C.data(),
+                           int(C.rows()), overwrite);
+          EXPECT_LE((C.topRows(m) - expected).cwiseAbs().maxCoeff(), 1e-14 * (k + 1))
+              << m << "x" << n << "x" << k;
+          EXPECT_EQ(C.row(m), C0.row(m));
+        }
+}
+
+// Each condensed pair block against the formulas of core/qp/qp_riccati_ipm_pairs.hpp, evaluated
+// with Eigen: for dense Hessians with cross terms S, and for the controllers' structure (Q
+// diagonal, S = 0: Q1 A0 as a row scaling, no S1 products); Q exactly symmetric.
+TEST(QpRiccatiIpmPairs, CondensedBlocksMatchTheirDefinition) {
+  for (const bool structured : {false, true}) {
+    SCOPED_TRACE(structured ? "diagonal Q, S = 0" : "dense Q, S");
+    OcpQp qp = testing_qp::random_qp(spec(9, 3, 6, 2, 2, 0.3), 61);
+    if (structured)
+      for (OcpQpStage& s : qp.stage) {
+        s.Q = Eigen::MatrixXd(s.Q.diagonal().asDiagonal());
+        s.S.setZero();
+      }
+    QpRiccatiIpmPairs pairs(qp.dims);
+    pairs.prepare(qp);
+    const OcpQp& c = pairs.condensed();
+    for (int j = 0; 2 * j + 1 < qp.dims.N; ++j) {
+      SCOPED_TRACE("pair " + std::to_string(j));
+      const OcpQpStage &s0 = qp.stage[2 * j], &s1 = qp.stage[2 * j + 1], &t = c.stage[j];
+      const int nu0 = qp.dims.nu[2 * j], nu1 = qp.dims.nu[2 * j + 1];
+      const int ng0 = qp.dims.ng[2 * j], nbx1 = qp.dims.nbx[2 * j + 1];
+      const Eigen::VectorXd g1 = s1.Q * s0.b + s1.q;
+      Eigen::MatrixXd B(s1.A.rows(), nu0 + nu1), S(nu0 + nu1, s0.Q.cols()), R(nu0 + nu1, nu0 + nu1);
+      B << s1.A * s0.B, s1.B;
+      S << s0.S + s0.B.transpose() * s1.Q * s0.A, s1.S * s0.A;
+      R << s0.R + s0.B.transpose() * s1.Q * s0.B, (s1.S * s0.B).transpose(), s1.S * s0.B, s1.R;
+      Eigen::VectorXd r(nu0 + nu1);
+      r << s0.r + s0.B.transpose() * g1, s1.r + s1.S * s0.b;
+      const auto near = [](const auto& a, const auto& b) {
+        return (a - b).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + b.cwiseAbs().maxCoeff());
+      };
+      EXPECT_TRUE(near(t.A, s1.A * s0.A));
+      EXPECT_TRUE(near(t.B, B));
+      EXPECT_TRUE(near(t.b, s1.A * s0.b + s1.b));
+      EXPECT_TRUE(near(t.Q, s0.Q + s0.A.transpose() * s1.Q * s0.A));
+      EXPECT_EQ(t.Q, t.Q.transpose());
+      EXPECT_TRUE(near(t.S, S));
+      EXPECT_TRUE(near(t.R, R));
+      EXPECT_TRUE(near(t.q, s0.q + s0.A.transpose() * g1));
+      EXPECT_TRUE(near(t.r, r));
+      for (int k = 0; k < nbx1; ++k) {  // x_{k+1}'s bounds as rows of [A0 B0]
+        const int idx = s1.idxbx[k];
+        EXPECT_EQ(t.C.row(ng0 + k), s0.A.row(idx));
+        EXPECT_EQ(t.D.row(ng0 + k).head(nu0), s0.B.row(idx));
+        EXPECT_EQ(t.D.row(ng0 + k).tail(nu1).cwiseAbs().sum(), 0.0);
+      }
+      const int r0 = ng0 + nbx1, ng1 = qp.dims.ng[2 * j + 1];
+      if (ng1 > 0) {
+        EXPECT_TRUE(near(t.C.middleRows(r0, ng1), s1.C * s0.A));
+        EXPECT_TRUE(near(t.D.middleRows(r0, ng1).leftCols(nu0), s1.C * s0.B));
+        EXPECT_EQ(t.D.middleRows(r0, ng1).rightCols(nu1), s1.D);
+      }
+    }
+  }
 }
 
 TEST(QpRiccatiIpmPairs, FailureStatusesWithoutNan) {

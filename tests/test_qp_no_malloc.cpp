@@ -57,17 +57,20 @@ QpCases random_cases(int N, int nx_min, int nx_max, int nu, unsigned seed) {
   return c;
 }
 
-// Cold, primal and primal-dual warm starts (after a prepare(), where the solver has one),
-// invalid data and a failed factorization: none allocates.
+// Cold, primal and primal-dual warm starts (after a prepare(), where the solver has one, and
+// after a prepare() given the warm start, as RTI's preparation phase does), invalid data and a
+// failed factorization: none allocates.
 void expect_solves_allocate_nothing(QpSolver& solver, const QpCases& c) {
   OcpQpSolution sol(c.qp.dims);
-  QpStatus cold, primal, dual, invalid, failed;
+  QpStatus cold, primal, dual, prepared_dual, invalid, failed;
   {
     NoMalloc guard;
     cold = solver.solve(c.qp, sol);
     solver.prepare(c.qp);
     primal = solver.solve(c.qp, sol, QpWarmStart::primal);
     dual = solver.solve(c.qp, sol, QpWarmStart::primal_dual);
+    solver.prepare(c.qp, sol, QpWarmStart::primal_dual);
+    prepared_dual = solver.solve(c.qp, sol, QpWarmStart::primal_dual);
     invalid = solver.solve(c.bad, sol);
     failed = solver.solve(c.indefinite, sol);
     EXPECT_EQ(NoMalloc::count(), 0);
@@ -75,6 +78,7 @@ void expect_solves_allocate_nothing(QpSolver& solver, const QpCases& c) {
   EXPECT_EQ(cold, QpStatus::success);
   EXPECT_EQ(primal, QpStatus::success);
   EXPECT_EQ(dual, QpStatus::success);
+  EXPECT_EQ(prepared_dual, QpStatus::success);
   EXPECT_EQ(invalid, QpStatus::invalid_data);
   EXPECT_EQ(failed, QpStatus::factorization_failed);
 }

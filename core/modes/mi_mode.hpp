@@ -52,6 +52,7 @@ class MiMode final : public Mode {
   double lost_at() const override { return run_.lost_at; }
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { controller_.rti().set_deadline_us(d); }
+  RtiSolver* rti_solver() override { return &controller_.rti(); }
   // Before the first step the telemetry takes the new bounds and the λ they leave the first
   // step (what READY shows).
   [[nodiscard]] bool set_authority_bounds(const AuthorityBounds& bounds) override;

@@ -192,6 +192,9 @@ class Mode {
   // of wall time is discarded as a fallback and raises kEventOverrun. 0 (the default): no
   // deadline, so runs not paced by a clock stay deterministic.
   virtual void set_deadline_us(double deadline_us) = 0;
+  // The mode's NMPC, for tools that watch the QPs it solves (RtiSolver::set_qp_observer:
+  // mixpilot-bench's closed-loop QP sets); null when it flies none (an LQR law).
+  virtual RtiSolver* rti_solver() { return nullptr; }
   // Flies the vehicle behind `link` (core/modes/vehicle_link.hpp) instead of the simulated
   // plant: after setup, before the first step. false: this mode has no remote vehicle.
   [[nodiscard]] virtual bool set_vehicle(VehicleLink* link) {

@@ -83,6 +83,7 @@ class ObstacleMode final : public Mode {
   double lost_at() const override { return run_.lost_at; }
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { rti_.set_deadline_us(d); }
+  RtiSolver* rti_solver() override { return &rti_; }
   // min_distance_m, min_margin_m, min_distance_control_m, clearance_m, violations,
   // tracking_rms_m, final_error_m, rti_median_us, rti_p99_us, fallbacks, form (0 lcl,
   // 1 squared), steps.

@@ -117,6 +117,7 @@ class PendubotMode final : public Mode {
   double lost_at() const override { return -1.0; }
   const Telemetry& telemetry() const override { return run_.telemetry; }
   void set_deadline_us(double d) override { rti_.set_deadline_us(d); }
+  RtiSolver* rti_solver() override { return &rti_; }
   // duration_s, swingup_time_s, hold_time_s, final_angle_norm, max_abs_u, velocity_violations,
   // worst_velocity_violation, tracking_rms, rti_median_us, rti_p99_us, rti_max_us, nmpc_steps,
   // fallbacks, lqr_entry_time_s, lqr_time_s, lqr_entries, quantization.

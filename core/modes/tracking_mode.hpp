@@ -104,6 +104,7 @@ class TrackingMode final : public Mode {
   void set_deadline_us(double d) override {
     if (rti_) rti_->set_deadline_us(d);
   }
+  RtiSolver* rti_solver() override { return rti_.get(); }
   // tracking_rms_m, max_error_m, final_error_m, [overshoot_m, settle_time_s: smooth step],
   // rti_median_us, rti_p99_us, fallbacks (NMPC) or lqr_median_us, lqr_p99_us (LQR),
   // predictor_median_us, max_input_violation, rtt_s, compensation, steps, lost.

@@ -137,8 +137,6 @@ void RtiSolver::linearize_cost(int i) {
       const int z = zi(k);
       r(k) = (z < nx ? x(z) : traj.u[i](z - nx)) - data_.yref[i](k);
     }
-    auto wr = ws_.y.head(ny);
-    wr.noalias() = W * r;
     s.Q.setZero();
     s.q.setZero();
     if (!terminal) {
@@ -146,7 +144,29 @@ void RtiSolver::linearize_cost(int i) {
       s.R.setZero();
       s.r.setZero();
     }
+    // A diagonal W (the controllers' usual weights) contributes its diagonal only: one pass
+    // over the off-diagonal entries (contiguous runs, no branches) instead of a branch on each
+    // of the ny² entries. The same additions in the same order as the general loop below.
+    double off = 0.0;
     for (int l = 0; l < ny; ++l) {
+      const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
+      for (int k = 0; k < l; ++k) off += std::abs(col[k]);
+      for (int k = l + 1; k < ny; ++k) off += std::abs(col[k]);
+    }
+    const bool diagonal = off == 0.0;  // NaN or ∞ anywhere off the diagonal: the general loop
+    auto wr = ws_.y.head(ny);
+    if (diagonal)
+      wr = W.diagonal().cwiseProduct(r);
+    else
+      wr.noalias() = W * r;
+    for (int l = 0; diagonal && l < ny; ++l) {
+      const int z = zi(l);
+      const double w = W(l, l);
+      if (w == 0.0) continue;
+      if (z < nx) s.Q(z, z) += w;
+      else s.R(z - nx, z - nx) += w;
+    }
+    for (int l = 0; !diagonal && l < ny; ++l) {
       const int zl = zi(l);
       const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
       for (int k = 0; k < ny; ++k) {
@@ -239,7 +259,9 @@ RtiStatus RtiSolver::prepare() {
     linearize_cost(i);
     linearize_constraints(i);
   }
-  qp_solver().prepare(qp_);  // the x̄_0-free part of the QP solver's work (condensing)
+  // The x̄_0-free part of the QP solver's work: its layout, condensing, and with the warm start
+  // the first factorization of every stage but the first.
+  qp_solver().prepare(qp_, state_.qp_solution, warm_start());
   RtiStats& stats = state_.stats;
   stats.integration_us = std::chrono::duration<double, std::micro>(t1 - t0).count();
   stats.linearization_us = micros_since(t1);
@@ -254,16 +276,19 @@ RtiStatus RtiSolver::feedback(const Eigen::Ref<const Eigen::VectorXd>& x0) {
   RtiState& st = state_;
   if (!st.prepared) return RtiStatus::not_prepared;
   st.prepared = false;
-  const auto t0 = Clock::now();
+  auto t0 = Clock::now();
   qp_.x0 = x0 - st.trajectory.x[0];
 
   RtiStatus status = RtiStatus::fallback;
   RtiStats& stats = st.stats;
   stats.qp_iterations = 0;
   if (stats.linearization_finite) {
-    const QpWarmStart warm = settings_.qp_warm_start && st.have_qp_solution
-                                 ? QpWarmStart::primal_dual
-                                 : QpWarmStart::cold;
+    const QpWarmStart warm = warm_start();
+    if (observer_) {  // a tool's time, not the feedback phase's
+      const auto o0 = Clock::now();
+      observer_->on_qp(qp_, st.qp_solution, warm);
+      t0 += Clock::now() - o0;
+    }
     stats.qp_status = qp_solver().solve(qp_, st.qp_solution, warm);
     stats.qp_iterations = st.qp_solution.iterations;
     const double elapsed_us = stats.integration_us + stats.linearization_us + micros_since(t0);

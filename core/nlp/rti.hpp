@@ -91,6 +91,18 @@ struct RtiState {
   bool force_overrun = false;     // the next feedback() is an overrun (force_overrun_next())
 };
 
+// Sees every QP the feedback phase solves, with the warm start it is solved from: what the
+// closed-loop QP sets of mixpilot-bench are made of (docs/qp-dump-format.md). Called on the
+// control thread right before the solve, so an observer that copies (allocates) is for tools,
+// never for a paced flight.
+class RtiQpObserver {
+ public:
+  virtual ~RtiQpObserver() = default;
+  // qp with x0 embedded; start the solution the solve starts from (read only when warm is not
+  // cold).
+  virtual void on_qp(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) = 0;
+};
+
 // Buffers of the preparation phase.
 struct RtiWorkspace {
   Eigen::VectorXd x_next;  // nx: F(x_i, u_i)
@@ -116,6 +128,8 @@ class RtiSolver {
   // returns RtiStatus::invalid.
   SetupResult setup(const Ocp& ocp, const Settings& settings = {});
 
+  const Settings& settings() const { return settings_; }
+
   // References, weights and parameters per stage: set them before prepare().
   OcpStageData& data() { return data_; }
   const OcpStageData& data() const { return data_; }
@@ -132,6 +146,10 @@ class RtiSolver {
   void set_deadline_us(double deadline_us) { deadline_us_ = deadline_us; }
   // The next feedback() is an overrun whatever its time: a replay reproduces a recorded one.
   void force_overrun_next() { state_.force_overrun = true; }
+
+  // Every QP of a feedback phase goes to `observer` (null: none, the default) before it is
+  // solved. The observer outlives the solver or is reset to null first.
+  void set_qp_observer(RtiQpObserver* observer) { observer_ = observer; }
 
   // Iterates prepare/feedback from the current trajectory until ‖(Δx, Δu)‖∞ ≤ tol.
   SqpResult sqp(const Eigen::Ref<const Eigen::VectorXd>& x0, int max_iterations, double tol);
@@ -150,6 +168,11 @@ class RtiSolver {
   bool restore(const RtiState& state);
 
  private:
+  // How the next QP starts: from the previous (shifted) solution when there is one.
+  QpWarmStart warm_start() const {
+    return settings_.qp_warm_start && state_.have_qp_solution ? QpWarmStart::primal_dual
+                                                              : QpWarmStart::cold;
+  }
   void linearize_cost(int i);
   void linearize_constraints(int i);
 
@@ -174,6 +197,7 @@ class RtiSolver {
   Eigen::VectorXi z_index_;           // ny: index in z = (x, u) of each selected output
   Eigen::VectorXi terminal_z_index_;  // ny_N
   double deadline_us_ = 0.0;
+  RtiQpObserver* observer_ = nullptr;
 };
 
 }  // namespace mixpilot

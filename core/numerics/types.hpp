@@ -33,9 +33,18 @@ inline constexpr double kMinStep = 1e-10;
 // Cold start: inequality slacks start at ≥ kInitSlack, multipliers at kInitMu / t.
 inline constexpr double kInitSlack = 1e-1;
 inline constexpr double kInitMu = 1.0;
-// Warm start from primal and dual: slacks and multipliers are clipped from below at this value
-// so the iterate is strictly interior.
-inline constexpr double kWarmStartFloor = 1e-4;
+// Warm start from primal and dual: multipliers λ are clipped from below at kWarmStartFloor and
+// inequality slacks t at kWarmStartSlackFloor, so the iterate is strictly interior. The
+// complementarity t∘λ of the start, and with it the iterations, grows with these floors: on the
+// closed-loop QP sets of mixpilot-bench (mean IPM iterations: mi novice, mi reckless, thrown
+// balls, crazyflie tracking) 1e-4 for both gave 1.80, 7.48, 1.90, 1.25; 1e-6 for both 1.27, 6.16,
+// 1.61, 1.20; t ≥ 1e-8 and λ ≥ 1e-6 1.04, 6.09, 1.51, 1.20, with kWarmStartViolated 1.04, 5.50,
+// 1.56, 1.20 and no worst QP above the 1e-4 floors' (15, 21 against 15, 34).
+inline constexpr double kWarmStartFloor = 1e-6;
+inline constexpr double kWarmStartSlackFloor = 1e-8;
+// ... except a hard constraint the new QP's data violate at the warm start's primal point: its
+// slack starts at the violation's size, at least this (room for the first step to restore it).
+inline constexpr double kWarmStartViolated = 1e-4;
 // Riccati Cholesky: input pivots must be > 0; a state pivot in [−kPsdTol·|diagonal|, 0] is a
 // zero eigenvalue of a positive semidefinite cost-to-go (allowed), anything below is indefinite.
 inline constexpr double kPsdTol = 1e-10;

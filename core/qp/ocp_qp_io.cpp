@@ -207,24 +207,59 @@ struct Reader {
   }
 };
 
+const char* warm_name(QpWarmStart warm) {
+  switch (warm) {
+    case QpWarmStart::primal: return "primal";
+    case QpWarmStart::primal_dual: return "primal_dual";
+    default: return "cold";
+  }
+}
+
+// The per-stage vectors of a solution written as warm start, in this order.
+constexpr const char* kStartFields[] = {"x",  "u",  "pi",     "lam_l", "lam_u",
+                                        "sl", "su", "lam_sl", "lam_su"};
+template <class Solution>  // OcpQpSolution, const or not
+auto start_field(Solution& s, int k) -> decltype(&s.x) {
+  decltype(&s.x) f[] = {&s.x, &s.u, &s.pi, &s.lam_l, &s.lam_u, &s.sl, &s.su, &s.lam_sl, &s.lam_su};
+  return f[k];
+}
+
 }  // namespace
 
 void write_ocp_qp_json(std::ostream& o, const OcpQp& qp, const QpRiccatiIpmSettings& st,
-                       const std::string& name) {
+                       const std::string& name, const OcpQpSolution* start, QpWarmStart warm) {
   const OcpQpDims& d = qp.dims;
-  o << "{\"format\":\"mixpilot-ocp-qp\",\"version\":1,\"name\":\"" << name << "\",\"N\":" << d.N;
+  o << "{\"format\":\"mixpilot-ocp-qp\",\"version\":2,\"name\":\"" << name << "\",\"N\":" << d.N;
   o << ",\"settings\":{\"max_iterations\":" << st.max_iterations;
   const std::pair<const char*, double> tols[] = {
       {"tol_stat", st.tol_stat}, {"tol_eq", st.tol_eq}, {"tol_ineq", st.tol_ineq},
       {"tol_comp", st.tol_comp}, {"step_fraction", st.step_fraction}, {"min_step", st.min_step},
       {"init_slack", st.init_slack}, {"init_mu", st.init_mu},
-      {"warm_start_floor", st.warm_start_floor}, {"psd_tol", st.psd_tol},
+      {"warm_start_floor", st.warm_start_floor},
+      {"warm_start_slack_floor", st.warm_start_slack_floor},
+      {"warm_start_violated", st.warm_start_violated}, {"psd_tol", st.psd_tol},
       {"refine_ratio", st.refine_ratio}, {"inf_bound", st.inf_bound}};
   for (const auto& [k, v] : tols) {
     o << ",\"" << k << "\":";
     num(o, v);
   }
   o << ",\"refinement_steps\":" << st.refinement_steps << "}";
+  if (start) {
+    o << ",\"warm\":\"" << warm_name(warm) << '"';
+    if (warm != QpWarmStart::cold) {
+      o << ",\"start\":{";
+      for (int k = 0; k < 9; ++k) {
+        o << (k ? "," : "") << '"' << kStartFields[k] << "\":[";
+        const std::vector<Eigen::VectorXd>& f = *start_field(*start, k);
+        for (std::size_t i = 0; i < f.size(); ++i) {
+          if (i) o << ',';
+          vec(o, f[i]);
+        }
+        o << ']';
+      }
+      o << '}';
+    }
+  }
   o << ",\"x0\":";
   vec(o, qp.x0);
   o << ",\"stages\":[";
@@ -261,7 +296,8 @@ void write_ocp_qp_json(std::ostream& o, const OcpQp& qp, const QpRiccatiIpmSetti
 }
 
 bool read_ocp_qp_json(const std::string& line, OcpQp& qp, QpRiccatiIpmSettings& st,
-                      std::string& name, std::string& error) {
+                      std::string& name, std::string& error, OcpQpSolution* start,
+                      QpWarmStart* warm) {
   Json root;
   Parser parser{line, 0, {}};
   if (!parser.value(root) || root.type != Json::object) {
@@ -328,8 +364,52 @@ bool read_ocp_qp_json(const std::string& line, OcpQp& qp, QpRiccatiIpmSettings& 
     error = r.err;
     return false;
   }
+  // Written since version 2 (older dumps: the defaults).
+  if (settings->get("warm_start_slack_floor"))
+    ok = r.number(*settings, "warm_start_slack_floor", st.warm_start_slack_floor);
+  if (ok && settings->get("warm_start_violated"))
+    ok = r.number(*settings, "warm_start_violated", st.warm_start_violated);
+  if (!ok) {
+    error = r.err;
+    return false;
+  }
   st.max_iterations = static_cast<int>(mi);
   st.refinement_steps = static_cast<int>(rs);
+  if (start == nullptr || warm == nullptr) return true;
+  start->resize(d);
+  *warm = QpWarmStart::cold;
+  if (const Json* w = root.get("warm")) {
+    if (w->type != Json::string || (w->s != "cold" && w->s != "primal" && w->s != "primal_dual")) {
+      error = "warm: expected \"cold\", \"primal\" or \"primal_dual\"";
+      return false;
+    }
+    *warm = w->s == "primal"        ? QpWarmStart::primal
+            : w->s == "primal_dual" ? QpWarmStart::primal_dual
+                                    : QpWarmStart::cold;
+  }
+  if (*warm == QpWarmStart::cold) return true;
+  const Json* sj = root.get("start");
+  if (!sj || sj->type != Json::object) {
+    error = "a warm record without its start";
+    return false;
+  }
+  for (int k = 0; k < 9; ++k) {
+    std::vector<Eigen::VectorXd>& f = *start_field(*start, k);
+    const Json* a = sj->get(kStartFields[k]);
+    if (!a || a->type != Json::array || a->a.size() != f.size()) {
+      error = std::string("start: bad ") + kStartFields[k];
+      return false;
+    }
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      Json holder;
+      holder.type = Json::object;
+      holder.o.push_back({kStartFields[k], a->a[i]});
+      if (!r.vec(holder, kStartFields[k], f[i])) {
+        error = "start: " + r.err;
+        return false;
+      }
+    }
+  }
   return true;
 }
 

@@ -93,6 +93,7 @@ class QpCondensedDense final : public QpSolver {
 
   bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
   // Condenses the Hessian, the x0-free linear terms and the constraint rows of qp.
+  using QpSolver::prepare;
   void prepare(const OcpQp& qp) override;
   QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
                  QpWarmStart warm = QpWarmStart::cold) override;

@@ -143,7 +143,9 @@ void QpDenseIpm::initialize(const OcpQpStage& st, const OcpQpSolution& sol, QpWa
   const int n = w.n, nc = w.nc, ns = w.ns, m = w.m;
   const bool primal = warm != QpWarmStart::cold;
   const bool dual = warm == QpWarmStart::primal_dual;
-  const double thr = dual ? settings_.warm_start_floor : settings_.init_slack;
+  // Warm: one floor for t and λ, warm_start_violated (1e-4): the dense IPM is the active set's
+  // fallback on short horizons and was not measured with the Riccati IPM's smaller floors.
+  const double thr = dual ? settings_.warm_start_violated : settings_.init_slack;
   double* s = w.s.data();
   double* t = w.t.data();
   double* lam = w.lam.data();

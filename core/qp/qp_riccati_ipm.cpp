@@ -53,7 +53,6 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   w.L.assign(n1, {});
   w.Y.assign(n1, {});
   w.Hbase.assign(n1, {});
-  w.Hfull.assign(n1, {});
   w.inv_diag.assign(n1, {});
   w.Dinv.assign(n1, {});
   w.pivot_floor.assign(n1, 0.0);
@@ -83,7 +82,6 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
     w.L[i] = Eigen::MatrixXd::Zero(np, nv);
     w.Y[i] = Eigen::MatrixXd::Zero(np, nx1 + dims.ng[i]);
     w.Hbase[i] = Eigen::MatrixXd::Zero(np, nv);
-    w.Hfull[i] = Eigen::MatrixXd::Zero(nv, nv);
     w.inv_diag[i] = Eigen::VectorXd::Zero(nv);
     w.Dinv[i] = Eigen::MatrixXd::Zero(std::max(np, 4), 4);
     w.tmp[i] = Eigen::VectorXd::Zero(std::max({nv, nx1, nc, 1}));
@@ -114,30 +112,51 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     const OcpQpStage& s = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i];
     const int nc = w.nc[i], ns = d.ns[i];
-    if (i < d.N) {
-      w.BAt[i].topRows(nu) = s.B.transpose();
-      w.BAt[i].middleRows(nu, nx) = s.A.transpose();
-      w.bflat.segment(w.off_pi[i], d.nx[i + 1]) = s.b;
+    // Plain loops over the source columns: Eigen's transposed and triangular block assignments
+    // cost several times more at these sizes, and this runs for every QP.
+    if (i < d.N) {  // [Bᵀ; Aᵀ]
+      const int nx1 = d.nx[i + 1], ldb = static_cast<int>(w.BAt[i].rows());
+      double* bat = w.BAt[i].data();
+      const double* B = s.B.data();
+      const double* A = s.A.data();
+      for (int r = 0; r < nu; ++r)
+        for (int c = 0; c < nx1; ++c) bat[r + static_cast<std::ptrdiff_t>(c) * ldb] = B[c + r * nx1];
+      for (int r = 0; r < nx; ++r)
+        for (int c = 0; c < nx1; ++c)
+          bat[nu + r + static_cast<std::ptrdiff_t>(c) * ldb] = A[c + r * nx1];
+      std::copy_n(s.b.data(), nx1, w.bflat.data() + w.off_pi[i]);
     }
-    w.gflat.segment(w.off_v[i], nu) = s.r;
-    w.gflat.segment(w.off_v[i] + nu, nx) = s.q;
-    w.zflat.segment(w.off_s[i], ns) = s.zl;
-    w.zflat.segment(w.off_s[i] + ns, ns) = s.zu;
-    if (ng > 0) {
-      w.DCt[i].topRows(nu) = s.D.transpose();
-      w.DCt[i].bottomRows(nx) = s.C.transpose();
+    std::copy_n(s.r.data(), nu, w.gflat.data() + w.off_v[i]);
+    std::copy_n(s.q.data(), nx, w.gflat.data() + w.off_v[i] + nu);
+    std::copy_n(s.zl.data(), ns, w.zflat.data() + w.off_s[i]);
+    std::copy_n(s.zu.data(), ns, w.zflat.data() + w.off_s[i] + ns);
+    if (ng > 0) {  // [Dᵀ; Cᵀ]
+      const int nv = nu + nx;
+      double* dct = w.DCt[i].data();
+      for (int r = 0; r < nu; ++r)
+        for (int k = 0; k < ng; ++k) dct[r + k * nv] = s.D.data()[k + r * ng];
+      for (int r = 0; r < nx; ++r)
+        for (int k = 0; k < ng; ++k) dct[nu + r + k * nv] = s.C.data()[k + r * ng];
     }
-    // Stage Hessian [R S; Sᵀ Q] in (u, x) order: lower triangle (strict upper stays zero) for
-    // the factorization, full for residuals.
-    w.Hbase[i].topLeftCorner(nu, nu).triangularView<Eigen::Lower>() = s.R;
-    w.Hbase[i].block(nu, 0, nx, nu) = s.S.transpose();
-    w.Hbase[i].block(nu, nu, nx, nx).triangularView<Eigen::Lower>() = s.Q;
-    w.Hfull[i].topLeftCorner(nu, nu) = s.R;
-    w.Hfull[i].topRightCorner(nu, nx) = s.S;
-    w.Hfull[i].bottomLeftCorner(nx, nu) = s.S.transpose();
-    w.Hfull[i].bottomRightCorner(nx, nx) = s.Q;
-    const double scale = nu + nx > 0 ? w.Hfull[i].diagonal().cwiseAbs().maxCoeff() : 0.0;
-    w.pivot_floor[i] = settings_.psd_tol * (scale > 0.0 ? scale : 1.0);
+    // Stage Hessian [R S; Sᵀ Q] in (u, x) order, lower triangle (the strict upper stays zero),
+    // for the factorization; the residuals read R, S and Q in place.
+    {
+      const int ldh = static_cast<int>(w.Hbase[i].rows());
+      double* h = w.Hbase[i].data();
+      double scale = 0.0;
+      for (int c = 0; c < nu; ++c) {
+        const double* rc = s.R.data() + c * nu;
+        for (int r = c; r < nu; ++r) h[r + c * ldh] = rc[r];
+        for (int r = 0; r < nx; ++r) h[nu + r + c * ldh] = s.S.data()[c + r * nu];
+        scale = std::max(scale, std::abs(rc[c]));
+      }
+      for (int c = 0; c < nx; ++c) {
+        const double* qc = s.Q.data() + c * nx;
+        for (int r = c; r < nx; ++r) h[nu + r + (nu + c) * ldh] = qc[r];
+        scale = std::max(scale, std::abs(qc[c]));
+      }
+      w.pivot_floor[i] = settings_.psd_tol * (scale > 0.0 ? scale : 1.0);
+    }
     for (int k = 0; k < nbu; ++k) w.var_of_box[i][k] = s.idxbu[k];
     for (int k = 0; k < nbx; ++k) w.var_of_box[i][nbu + k] = nu + s.idxbx[k];
     w.soft_of[i].setConstant(-1);
@@ -196,58 +215,70 @@ static void eval_constraints(const QpRiccatiIpmWorkspace& w, int i, const Eigen:
 }
 
 void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm) {
+  for (int i = 0; i <= ws_.dims.N; ++i) initialize_stage(qp, sol, warm, i);
+}
+
+void QpRiccatiIpm::initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm,
+                                    int i) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   const bool primal = warm != QpWarmStart::cold;
   const bool dual = warm == QpWarmStart::primal_dual;
-  const double thr = dual ? settings_.warm_start_floor : settings_.init_slack;
-  for (int i = 0; i <= d.N; ++i) {
-    const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
-    const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
-    if (primal) {
-      w.v.segment(ov, nu) = sol.u[i];
-      w.v.segment(ov + nu, nx) = sol.x[i];
-      w.s.segment(os, ns) = sol.sl[i].cwiseMax(0.0);
-      w.s.segment(os + ns, ns) = sol.su[i].cwiseMax(0.0);
-    } else {
-      w.v.segment(ov, nu + nx).setZero();
-      w.s.segment(os, 2 * ns).setZero();
-    }
-    for (int j = 0; j < 2 * ns; ++j)
-      if (w.slive[os + j] == 0.0) w.s[os + j] = w.sfix[os + j];
-    if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
-    if (i < d.N) {
-      if (dual)
-        w.pi.segment(w.off_pi[i], d.nx[i + 1]) = sol.pi[i];
-      else
-        w.pi.segment(w.off_pi[i], d.nx[i + 1]).setZero();
-    }
-    eval_constraints(w, i, w.v, w.dd);
-    for (int k = 0; k < nc; ++k) {
-      const int j = w.soft_of[i][k];
-      const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
-      w.t[om + k] = w.dd[oc + k] - w.lbnd[oc + k] + sl;
-      w.t[om + nc + k] = w.ubnd[oc + k] - w.dd[oc + k] + su;
-      if (dual) {
-        w.lam[om + k] = sol.lam_l[i][k];
-        w.lam[om + nc + k] = sol.lam_u[i][k];
-      }
-    }
-    w.t.segment(om + 2 * nc, 2 * ns) = w.s.segment(os, 2 * ns);
+  const double thr = dual ? settings_.warm_start_slack_floor : settings_.init_slack;
+  const double lam_floor = settings_.warm_start_floor;
+  const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i];
+  const int ov = w.off_v[i], os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
+  if (primal) {
+    w.v.segment(ov, nu) = sol.u[i];
+    w.v.segment(ov + nu, nx) = sol.x[i];
+    w.s.segment(os, ns) = sol.sl[i].cwiseMax(0.0);
+    w.s.segment(os + ns, ns) = sol.su[i].cwiseMax(0.0);
+  } else {
+    w.v.segment(ov, nu + nx).setZero();
+    w.s.segment(os, 2 * ns).setZero();
+  }
+  for (int j = 0; j < 2 * ns; ++j)
+    if (w.slive[os + j] == 0.0) w.s[os + j] = w.sfix[os + j];
+  if (i == 0) w.v.segment(ov + nu, nx) = qp.x0;
+  if (i < d.N) {
+    if (dual)
+      w.pi.segment(w.off_pi[i], d.nx[i + 1]) = sol.pi[i];
+    else
+      w.pi.segment(w.off_pi[i], d.nx[i + 1]).setZero();
+  }
+  eval_constraints(w, i, w.v, w.dd);
+  for (int k = 0; k < nc; ++k) {
+    const int j = w.soft_of[i][k];
+    const double sl = j >= 0 ? w.s[os + j] : 0.0, su = j >= 0 ? w.s[os + ns + j] : 0.0;
+    w.t[om + k] = w.dd[oc + k] - w.lbnd[oc + k] + sl;
+    w.t[om + nc + k] = w.ubnd[oc + k] - w.dd[oc + k] + su;
     if (dual) {
-      w.lam.segment(om + 2 * nc, ns) = sol.lam_sl[i];
-      w.lam.segment(om + 2 * nc + ns, ns) = sol.lam_su[i];
+      w.lam[om + k] = sol.lam_l[i][k];
+      w.lam[om + nc + k] = sol.lam_u[i][k];
     }
   }
-  const int m = static_cast<int>(w.t.size());
-  for (int k = 0; k < m; ++k) {
+  w.t.segment(om + 2 * nc, 2 * ns) = w.s.segment(os, 2 * ns);
+  if (dual) {
+    w.lam.segment(om + 2 * nc, ns) = sol.lam_sl[i];
+    w.lam.segment(om + 2 * nc + ns, ns) = sol.lam_su[i];
+  }
+  for (int k = om; k < om + 2 * nc + 2 * ns; ++k) {
     if (w.mask[k] == 0.0) {
       w.t[k] = 1.0;
       w.lam[k] = 0.0;
       continue;
     }
-    w.t[k] = std::max(w.t[k], thr);
-    w.lam[k] = dual ? std::max(w.lam[k], thr) : settings_.init_mu / w.t[k];
+    // A warm start: a hard constraint the new data violate (t ≤ 0) starts with the violation's
+    // size, at least warm_start_violated, so that the first step has room to restore it
+    // (floored at the tiny warm_start_slack_floor it blocks the step, and the solve ends in
+    // min_step and a cold restart); a soft one's slack absorbs its violation instead.
+    const int kc = k - om;
+    const bool hard = kc < 2 * nc && w.soft_of[i][kc < nc ? kc : kc - nc] < 0;
+    if (dual && hard && w.t[k] <= 0.0)
+      w.t[k] = std::max(-w.t[k], settings_.warm_start_violated);
+    else
+      w.t[k] = std::max(w.t[k], thr);
+    w.lam[k] = dual ? std::max(w.lam[k], lam_floor) : settings_.init_mu / w.t[k];
   }
   if (dual) return;
   // Cold multipliers of s ≥ 0 on the slack's stationarity Z s + z − λ_b − λ_s = 0 (linear, and
@@ -256,18 +287,14 @@ void QpRiccatiIpm::initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmS
   // for Δs ≈ −z/W, only a tiny step fits, and Mehrotra's second-order term Δλ_aff∘Δt_aff ≈ −z²/W
   // then drives s and t_s up by orders of magnitude. With Z = 0 nothing pulls them back and the
   // solve ends in min_step (an ℓ2² weight Z > 0 had masked this).
-  for (int i = 0; i <= d.N; ++i) {
-    const OcpQpStage& st = qp.stage[i];
-    const int ns = d.ns[i], nc = w.nc[i], os = w.off_s[i], om = w.off_m[i];
-    for (int j = 0; j < ns; ++j) {
-      const int k = st.idxs[j];
-      const int ml = om + 2 * nc + j, mu = om + 2 * nc + ns + j;
-      if (w.mask[ml] != 0.0)
-        w.lam[ml] = std::max(w.lam[ml], st.Zl[j] * w.s[os + j] + st.zl[j] - w.lam[om + k]);
-      if (w.mask[mu] != 0.0)
-        w.lam[mu] =
-            std::max(w.lam[mu], st.Zu[j] * w.s[os + ns + j] + st.zu[j] - w.lam[om + nc + k]);
-    }
+  const OcpQpStage& st = qp.stage[i];
+  for (int j = 0; j < ns; ++j) {
+    const int k = st.idxs[j];
+    const int ml = om + 2 * nc + j, mu = om + 2 * nc + ns + j;
+    if (w.mask[ml] != 0.0)
+      w.lam[ml] = std::max(w.lam[ml], st.Zl[j] * w.s[os + j] + st.zl[j] - w.lam[om + k]);
+    if (w.mask[mu] != 0.0)
+      w.lam[mu] = std::max(w.lam[mu], st.Zu[j] * w.s[os + ns + j] + st.zu[j] - w.lam[om + nc + k]);
   }
 }
 
@@ -293,7 +320,13 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
     const int nv = nu + nx;
     auto rx = out_v.segment(ov + nu, nx);
     out_v.segment(ov, nv) = g.segment(ov, nv);
-    kernels::gemv_n(nv, nv, w.Hfull[i].data(), nv, v.data() + ov, out_v.data() + ov);
+    // [R S; Sᵀ Q] v, read in place.
+    if (nu > 0) {
+      kernels::gemv_n(nu, nu, st.R.data(), nu, v.data() + ov, out_v.data() + ov);
+      kernels::gemv_n(nu, nx, st.S.data(), nu, v.data() + ov + nu, out_v.data() + ov);
+      kernels::gemv_t(nu, nx, st.S.data(), nu, v.data() + ov, out_v.data() + ov + nu);
+    }
+    kernels::gemv_n(nx, nx, st.Q.data(), nx, v.data() + ov + nu, out_v.data() + ov + nu);
     if (i < d.N)
       kernels::gemv_n(nv, d.nx[i + 1], w.BAt[i].data(), static_cast<int>(w.BAt[i].rows()),
                       pi.data() + w.off_pi[i], out_v.data() + ov);
@@ -361,13 +394,16 @@ double QpRiccatiIpm::stationarity_norm(const Eigen::VectorXd& rv, const Eigen::V
   return r;
 }
 
-bool QpRiccatiIpm::factorize(const OcpQp& qp) {
+bool QpRiccatiIpm::factorize(const OcpQp& qp, int first, int last) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   // 1/t once per iteration: the directions below then multiply instead of divide.
-  w.inv_t = w.mask.cwiseQuotient(w.t);
-  w.w = w.lam.cwiseProduct(w.inv_t);
-  for (int i = d.N; i >= 0; --i) {
+  const int m0 = w.off_m[first];
+  const int m1 = last < d.N ? w.off_m[last + 1] : static_cast<int>(w.t.size());
+  w.inv_t.segment(m0, m1 - m0) = w.mask.segment(m0, m1 - m0).cwiseQuotient(w.t.segment(m0, m1 - m0));
+  w.w.segment(m0, m1 - m0) =
+      w.lam.segment(m0, m1 - m0).cwiseProduct(w.inv_t.segment(m0, m1 - m0));
+  for (int i = last; i >= first; --i) {
     const OcpQpStage& st = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
     const int nb = d.nbu[i] + d.nbx[i];
@@ -629,14 +665,36 @@ double step_length(const QpRiccatiIpmWorkspace& w, double eta, double tol_comp) 
 }
 }  // namespace
 
-QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
-  Workspace& w = ws_;
-  if (!ready_ || !ocp_qp_valid_for(qp, w.dims, settings_.check_data))
-    return sol.set_invalid_data();
+void QpRiccatiIpm::prepare(const OcpQp& qp) {
+  loaded_ = prefactored_ = false;
+  if (!ready_ || !ocp_qp_valid_for(qp, ws_.dims, settings_.check_data)) return;
   load(qp);
-  initialize(qp, sol, warm);
+  loaded_ = true;
+}
+
+void QpRiccatiIpm::prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
+  prepare(qp);
+  if (!loaded_ || warm != QpWarmStart::primal_dual || ws_.dims.N == 0) return;
+  // Stages 1..N start from `start` whatever x0 is; stage 0 (x_0 = x0) is initialized again in
+  // solve(). Their factorization needs W = λ/t and the Hessian only.
+  for (int i = 1; i <= ws_.dims.N; ++i) initialize_stage(qp, start, warm, i);
+  prefactored_ = factorize(qp, 1, ws_.dims.N);
+}
+
+QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
+  const bool loaded = loaded_;
+  const bool prefactored = prefactored_ && warm == QpWarmStart::primal_dual;
+  loaded_ = prefactored_ = false;
+  if (!ready_ || (!loaded && !ocp_qp_valid_for(qp, ws_.dims, settings_.check_data)) ||
+      (loaded && settings_.check_data && !qp.x0.allFinite()))  // prepare() checked the rest
+    return sol.set_invalid_data();
+  if (!loaded) load(qp);
+  if (prefactored)
+    initialize_stage(qp, sol, warm, 0);  // the rest is the prepared start
+  else
+    initialize(qp, sol, warm);
   int it = 0;
-  QpStatus status = iterate(qp, settings_.max_iterations, it);
+  QpStatus status = iterate(qp, settings_.max_iterations, it, prefactored);
   if (status == QpStatus::min_step && warm != QpWarmStart::cold) {
     int it_cold = 0;
     initialize(qp, sol, QpWarmStart::cold);
@@ -649,7 +707,7 @@ QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart wa
   return status;
 }
 
-QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it) {
+QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, bool prefactored) {
   Workspace& w = ws_;
   const Settings& cfg = settings_;
   QpStatus status = QpStatus::max_iterations;
@@ -669,7 +727,9 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it) {
       status = QpStatus::max_iterations;
       break;
     }
-    if (!factorize(qp)) {
+    const bool factorized = it == 0 && prefactored ? factorize(qp, 0, 0)
+                                                   : factorize(qp, 0, w.dims.N);
+    if (!factorized) {
       status = QpStatus::factorization_failed;
       break;
     }
@@ -755,14 +815,21 @@ void QpRiccatiIpm::write_solution(const OcpQp& qp, OcpQpSolution& sol) {
       if (w.slive[os + j] == 0.0) sol.lam_sl[i][j] = st.Zl[j] * sol.sl[i][j] + st.zl[j];
       if (w.slive[os + ns + j] == 0.0) sol.lam_su[i][j] = st.Zu[j] * sol.su[i][j] + st.zu[j];
     }
+    // ½vᵀHv + gᵀv = ½uᵀ(R u + 2 S x) + ½xᵀQ x + rᵀu + qᵀx (the kernels: Eigen's products
+    // cost more in their set-up than in their arithmetic at these sizes).
     auto tmp = w.tmp[i].head(std::max(nu, nx));
+    const double* u = w.v.data() + ov;
+    const double* x = u + nu;
     if (nu > 0) {
-      tmp.head(nu).noalias() = st.R * sol.u[i];
-      tmp.head(nu).noalias() += 2.0 * st.S * sol.x[i];
+      tmp.head(nu).setZero();
+      kernels::gemv_n(nu, nx, st.S.data(), nu, x, tmp.data());
+      tmp.head(nu) *= 2.0;
+      kernels::gemv_n(nu, nu, st.R.data(), nu, u, tmp.data());
       f += 0.5 * sol.u[i].dot(tmp.head(nu)) + st.r.dot(sol.u[i]);
     }
     if (nx > 0) {
-      tmp.head(nx).noalias() = st.Q * sol.x[i];
+      tmp.head(nx).setZero();
+      kernels::gemv_n(nx, nx, st.Q.data(), nx, x, tmp.data());
       f += 0.5 * sol.x[i].dot(tmp.head(nx)) + st.q.dot(sol.x[i]);
     }
     f += 0.5 * sol.sl[i].dot(st.Zl.cwiseProduct(sol.sl[i])) + st.zl.dot(sol.sl[i]);

@@ -39,7 +39,6 @@ struct QpRiccatiIpmWorkspace {
   // (np = pad4(nu+nx)); padding rows are zero.
   std::vector<Eigen::MatrixXd> BAt;         // np x nx_{i+1}: [Bᵀ; Aᵀ]
   std::vector<Eigen::MatrixXd> Hbase;       // np x (nu+nx): [R S; Sᵀ Q], lower triangle only
-  std::vector<Eigen::MatrixXd> Hfull;       // (nu+nx) x (nu+nx): [R S; Sᵀ Q]
   std::vector<Eigen::MatrixXd> DCt;         // (nu+nx) x ng: [Dᵀ; Cᵀ]
   std::vector<Eigen::MatrixXd> L;           // np x (nu+nx): H̃ + Y Yᵀ, then its lower Cholesky
                                             // factor, strict upper triangle zero (stage 0: uu
@@ -93,11 +92,18 @@ class QpRiccatiIpm final : public QpSolver {
   // dims are not valid().
   bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
 
+  // Takes qp's data into the solver's layout (the x0-free part of a solve): the next solve()
+  // of qp — only x0 may have changed — starts from it.
+  void prepare(const OcpQp& qp) override;
+  // ... and, for a primal-dual warm start, initializes from `start` and factorizes the first
+  // Newton system of stages N..1 (QpSolver::prepare).
+  void prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) override;
+
   // Solves qp (whose dims must equal the setup dims) into sol (sized with the same dims; read
   // as the warm start when requested). Never allocates, throws or prints. On any status other
   // than success, sol holds the last finite iterate (or zeros for invalid_data) and no NaN.
   // A warm start that ends in min_step (an iterate far from the new problem's central path: a
-  // large λ on a constraint the new data violate, its t clipped to warm_start_floor) is
+  // large λ on a constraint the new data violate, its t clipped to warm_start_slack_floor) is
   // restarted cold with the iterations left; sol.iterations counts both.
   QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
                  QpWarmStart warm = QpWarmStart::cold) override;
@@ -109,9 +115,11 @@ class QpRiccatiIpm final : public QpSolver {
  private:
   void load(const OcpQp& qp);
   void initialize(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm);
+  void initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm, int i);
   // Mehrotra iterations from the initialized point until a status, at most max_iterations;
-  // `it` receives the number taken.
-  QpStatus iterate(const OcpQp& qp, int max_iterations, int& it);
+  // `it` receives the number taken. prefactored: the first iteration's stages N..1 are
+  // factorized already (prepare()), stage 0 is left.
+  QpStatus iterate(const OcpQp& qp, int max_iterations, int& it, bool prefactored = false);
   void linear_residual(const OcpQp& qp, const Eigen::VectorXd& v, const Eigen::VectorXd& pi,
                        const Eigen::VectorXd& s, const Eigen::VectorXd& lam,
                        const Eigen::VectorXd& g, const Eigen::VectorXd& z,
@@ -119,7 +127,9 @@ class QpRiccatiIpm final : public QpSolver {
                        Eigen::VectorXd& out_pi);
   void residuals(const OcpQp& qp);
   double stationarity_norm(const Eigen::VectorXd& rv, const Eigen::VectorXd& rs) const;
-  bool factorize(const OcpQp& qp);
+  // The Riccati factorization of the Newton system, stages `last` down to `first` (stage last + 1
+  // factorized already when last < N).
+  bool factorize(const OcpQp& qp, int first, int last);
   // Newton direction for the right-hand side (r_v, r_s, r_π, r_t, r_c) into (dv, dπ, ds, dt, dλ).
   void solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv, const Eigen::VectorXd& rs,
                        const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
@@ -134,6 +144,8 @@ class QpRiccatiIpm final : public QpSolver {
   Settings settings_{};
   Workspace ws_{};
   bool ready_ = false;
+  bool loaded_ = false;       // prepare() loaded the QP for the next solve()
+  bool prefactored_ = false;  // ... and initialized it warm and factorized stages N..1
   double res_stat_ = 0, res_eq_ = 0, res_ineq_ = 0, mu_ = 0;
 };
 

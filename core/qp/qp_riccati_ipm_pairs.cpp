@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <tuple>
 
 #include "core/qp/detail/qp_kernels.hpp"
 
@@ -121,16 +122,41 @@ bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
     nx = std::max(nx, dims.nx[i]);
     nu = std::max(nu, dims.nu[i]);
   }
-  Q1A0_.resize(nx, nx);
-  Q1B0_.resize(nx, nu);
-  A0t_.resize(nx, nx);
-  B0t_.resize(nu, nx);
+  Q1A0_.setZero(nx, nx);
+  Q1B0_.setZero(nx, nu);
   g1_.resize(nx);
   x1_.resize(nx);
   constant_.assign(first_.size(), 0.0);
   ready_ = true;
   return true;
 }
+
+namespace {
+// Is the n x n matrix M diagonal (every off-diagonal entry exactly 0; NaN counts as not)? A sum
+// of magnitudes per run of off-diagonal entries: no early exit, so it vectorizes.
+bool is_diagonal(const Eigen::MatrixXd& M) {
+  const int n = static_cast<int>(M.rows());
+  double off = 0.0;
+  for (int c = 0; c < n; ++c) {
+    const double* col = M.data() + static_cast<std::ptrdiff_t>(c) * n;
+    for (int r = 0; r < c; ++r) off += std::abs(col[r]);
+    for (int r = c + 1; r < n; ++r) off += std::abs(col[r]);
+  }
+  return off == 0.0;
+}
+bool is_zero(const Eigen::MatrixXd& M) {
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < M.size(); ++k) s += std::abs(M.data()[k]);
+  return s == 0.0;
+}
+// M (rows x cols, ld ldm) = diag(q) X (ld ldx).
+void scale_rows(int rows, int cols, const double* q, const double* X, int ldx, double* M,
+                int ldm) {
+  for (int c = 0; c < cols; ++c)
+    for (int r = 0; r < rows; ++r)
+      M[r + static_cast<std::ptrdiff_t>(c) * ldm] = q[r] * X[r + static_cast<std::ptrdiff_t>(c) * ldx];
+}
+}  // namespace
 
 void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   const int k = first_[j];
@@ -139,14 +165,25 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   const OcpQpStage& s1 = qp.stage[k + 1];
   OcpQpStage& t = qpc_.stage[j];
   const int nx0 = d.nx[k], nu0 = d.nu[k], nx1 = d.nx[k + 1], nu1 = d.nu[k + 1];
+  const int nx2 = d.nx[k + 2];
   const int nbu0 = d.nbu[k], nbu1 = d.nbu[k + 1], nbx1 = d.nbx[k + 1];
   const int ng0 = d.ng[k], ng1 = d.ng[k + 1], ns0 = d.ns[k], ns1 = d.ns[k + 1];
+  const int nu = nu0 + nu1;
   const Eigen::MatrixXd &A0 = s0.A, &B0 = s0.B;
-  auto Q1A0 = Q1A0_.topLeftCorner(nx1, nx0);
-  auto Q1B0 = Q1B0_.topLeftCorner(nx1, nu0);
-  auto g1 = g1_.head(nx1);
-  set_ab(s1.Q, A0, Q1A0);
-  set_ab(s1.Q, B0, Q1B0);
+  // Q1 A0 and Q1 B0 (a row scaling for a diagonal Q1: the Gauss-Newton Hessian of a selection
+  // output with diagonal weights, what the controllers have).
+  double* QA = Q1A0_.data();
+  double* QB = Q1B0_.data();
+  const int ldq = static_cast<int>(Q1A0_.rows());
+  if (is_diagonal(s1.Q)) {
+    for (int r = 0; r < nx1; ++r) g1_[r] = s1.Q(r, r);
+    scale_rows(nx1, nx0, g1_.data(), A0.data(), nx1, QA, ldq);
+    scale_rows(nx1, nu0, g1_.data(), B0.data(), nx1, QB, ldq);
+  } else {
+    kernels::gemm_nn(nx1, nx0, nx1, s1.Q.data(), nx1, A0.data(), nx1, QA, ldq, true);
+    kernels::gemm_nn(nx1, nu0, nx1, s1.Q.data(), nx1, B0.data(), nx1, QB, ldq, true);
+  }
+  auto g1 = g1_.head(nx1);  // Q1 b0 + q1
   auto Q1b0 = x1_.head(nx1);
   Q1b0.setZero();
   add_ax(s1.Q, s0.b, Q1b0);
@@ -156,87 +193,102 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   // Dynamics to x_{k+2}.
   set_ab(s1.A, A0, t.A);
   set_ab(s1.A, B0, t.B.leftCols(nu0));
-  t.B.rightCols(nu1) = s1.B;
+  std::copy_n(s1.B.data(), nx2 * nu1, t.B.data() + static_cast<std::ptrdiff_t>(nx2) * nu0);
   t.b = s1.b;
   add_ax(s1.A, s0.b, t.b);
-  // Cost.
+  // Cost. Q = Q0 + A0ᵀQ1A0: its lower triangle (blocks of 4 columns), then mirrored.
   t.Q = s0.Q;
-  auto A0t = A0t_.topLeftCorner(nx0, nx1);
-  auto B0t = B0t_.topLeftCorner(nu0, nx1);
-  A0t = A0.transpose();
-  B0t = B0.transpose();
-  add_ab(A0t, Q1A0, t.Q);
+  for (int cb = 0; cb < nx0; cb += 4)
+    kernels::gemm_tn(nx0 - cb, std::min(4, nx0 - cb), nx1, A0.data() + std::ptrdiff_t(cb) * nx1,
+                     nx1, QA + std::ptrdiff_t(cb) * ldq, ldq,
+                     t.Q.data() + cb + std::ptrdiff_t(cb) * nx0, nx0);
+  for (int c = 1; c < nx0; ++c) {
+    double* qc = t.Q.data() + std::ptrdiff_t(c) * nx0;
+    const double* qr = t.Q.data() + c;
+    for (int r = 0; r < c; ++r) qc[r] = qr[std::ptrdiff_t(r) * nx0];
+  }
+  // S = [S0 + B0ᵀQ1A0; S1A0].
   t.S.topRows(nu0) = s0.S;
-  add_ab(B0t, Q1A0, t.S.topRows(nu0));
-  set_ab(s1.S, A0, t.S.bottomRows(nu1));
+  kernels::gemm_tn(nu0, nx0, nx1, B0.data(), nx1, QA, ldq, t.S.data(), nu);
+  // R = [R0 + B0ᵀQ1B0, (S1B0)ᵀ; S1B0, R1].
   t.R.topLeftCorner(nu0, nu0) = s0.R;
-  add_ab(B0t, Q1B0, t.R.topLeftCorner(nu0, nu0));
-  set_ab(s1.S, B0, t.R.bottomLeftCorner(nu1, nu0));
-  t.R.topRightCorner(nu0, nu1) = t.R.bottomLeftCorner(nu1, nu0).transpose();
+  kernels::gemm_tn(nu0, nu0, nx1, B0.data(), nx1, QB, ldq, t.R.data(), nu);
   t.R.bottomRightCorner(nu1, nu1) = s1.R;
   t.q = s0.q;
   add_atx(A0, g1, t.q);
   t.r.head(nu0) = s0.r;
   add_atx(B0, g1, t.r.head(nu0));
   t.r.tail(nu1) = s1.r;
-  add_ax(s1.S, s0.b, t.r.tail(nu1));
+  if (nu1 > 0 && !is_zero(s1.S)) {
+    set_ab(s1.S, A0, t.S.bottomRows(nu1));
+    set_ab(s1.S, B0, t.R.bottomLeftCorner(nu1, nu0));
+    add_ax(s1.S, s0.b, t.r.tail(nu1));
+  } else {  // S1 = 0 (the controllers' Gauss-Newton blocks): nothing to multiply
+    t.S.bottomRows(nu1).setZero();
+    t.R.bottomLeftCorner(nu1, nu0).setZero();
+  }
+  t.R.topRightCorner(nu0, nu1) = t.R.bottomLeftCorner(nu1, nu0).transpose();
   // Constraints: [bu0; bu1], bx0, [g0; bx1 rows; g1 rows].
-  t.idxbu.head(nbu0) = s0.idxbu;
-  t.idxbu.tail(nbu1) = (s1.idxbu.array() + nu0).matrix();
-  t.lbu.head(nbu0) = s0.lbu;
-  t.lbu.tail(nbu1) = s1.lbu;
-  t.ubu.head(nbu0) = s0.ubu;
-  t.ubu.tail(nbu1) = s1.ubu;
+  std::copy_n(s0.idxbu.data(), nbu0, t.idxbu.data());
+  for (int r = 0; r < nbu1; ++r) t.idxbu[nbu0 + r] = s1.idxbu[r] + nu0;
+  std::copy_n(s0.lbu.data(), nbu0, t.lbu.data());
+  std::copy_n(s1.lbu.data(), nbu1, t.lbu.data() + nbu0);
+  std::copy_n(s0.ubu.data(), nbu0, t.ubu.data());
+  std::copy_n(s1.ubu.data(), nbu1, t.ubu.data() + nbu0);
   t.idxbx = s0.idxbx;
   t.lbx = s0.lbx;
   t.ubx = s0.ubx;
-  t.C.topRows(ng0) = s0.C;
-  t.D.topLeftCorner(ng0, nu0) = s0.D;
-  t.D.topRightCorner(ng0, nu1).setZero();
-  t.lg.head(ng0) = s0.lg;
-  t.ug.head(ng0) = s0.ug;
+  const int ngt = ng0 + nbx1 + ng1;
+  for (int c = 0; c < nx0; ++c) std::copy_n(s0.C.data() + c * ng0, ng0, t.C.data() + c * ngt);
+  for (int c = 0; c < nu0; ++c) std::copy_n(s0.D.data() + c * ng0, ng0, t.D.data() + c * ngt);
+  t.D.topRightCorner(ng0 + nbx1, nu1).setZero();
+  std::copy_n(s0.lg.data(), ng0, t.lg.data());
+  std::copy_n(s0.ug.data(), ng0, t.ug.data());
   for (int r = 0; r < nbx1; ++r) {  // x_{k+1}[idx] = A0[idx,:] x + B0[idx,:] u0 + b0[idx]
     const int idx = s1.idxbx[r], row = ng0 + r;
-    t.C.row(row) = A0.row(idx);
-    t.D.row(row).head(nu0) = B0.row(idx);
-    t.D.row(row).tail(nu1).setZero();
+    const double* a = A0.data() + idx;
+    const double* b = B0.data() + idx;
+    double* tc = t.C.data() + row;
+    double* td = t.D.data() + row;
+    for (int c = 0; c < nx0; ++c) tc[std::ptrdiff_t(c) * ngt] = a[std::ptrdiff_t(c) * nx1];
+    for (int c = 0; c < nu0; ++c) td[std::ptrdiff_t(c) * ngt] = b[std::ptrdiff_t(c) * nx1];
     t.lg[row] = s1.lbx[r] - s0.b[idx];
     t.ug[row] = s1.ubx[r] - s0.b[idx];
   }
-  {  // C1 x_{k+1} + D1 u1 = C1A0 x + C1B0 u0 + D1 u1 + C1 b0
-    auto C = t.C.middleRows(ng0 + nbx1, ng1);
-    auto D = t.D.middleRows(ng0 + nbx1, ng1);
+  if (ng1 > 0) {  // C1 x_{k+1} + D1 u1 = C1A0 x + C1B0 u0 + D1 u1 + C1 b0
+    const int r0 = ng0 + nbx1;
+    auto C = t.C.middleRows(r0, ng1);
+    auto D = t.D.middleRows(r0, ng1);
     set_ab(s1.C, A0, C);
     set_ab(s1.C, B0, D.leftCols(nu0));
     D.rightCols(nu1) = s1.D;
     for (int r = 0; r < ng1; ++r) {
-      const double c = s1.C.row(r).dot(s0.b);
-      t.lg[ng0 + nbx1 + r] = s1.lg[r] - c;
-      t.ug[ng0 + nbx1 + r] = s1.ug[r] - c;
+      const double cb = s1.C.row(r).dot(s0.b);
+      t.lg[r0 + r] = s1.lg[r] - cb;
+      t.ug[r0 + r] = s1.ug[r] - cb;
     }
   }
   // Soft constraints: stage k's, then stage k+1's, re-indexed into the block's d.
   const std::array<Segment, 6> segments = pair_segments(d, k);
   const auto block_index = [&](int stage, int c) {
-    for (const Segment& g : segments)
-      if (g.stage == stage && c >= g.offset && c < g.offset + g.size) return g.block + c - g.offset;
+    for (const Segment& sg : segments)
+      if (sg.stage == stage && c >= sg.offset && c < sg.offset + sg.size)
+        return sg.block + c - sg.offset;
     return -1;  // unreachable: the indices were validated
   };
   for (int r = 0; r < ns0; ++r) t.idxs[r] = block_index(0, s0.idxs[r]);
   for (int r = 0; r < ns1; ++r) t.idxs[ns0 + r] = block_index(1, s1.idxs[r]);
-  t.Zl.head(ns0) = s0.Zl;
-  t.Zl.tail(ns1) = s1.Zl;
-  t.Zu.head(ns0) = s0.Zu;
-  t.Zu.tail(ns1) = s1.Zu;
-  t.zl.head(ns0) = s0.zl;
-  t.zl.tail(ns1) = s1.zl;
-  t.zu.head(ns0) = s0.zu;
-  t.zu.tail(ns1) = s1.zu;
+  for (auto [dst, a, b] : {std::tuple{&t.Zl, &s0.Zl, &s1.Zl}, std::tuple{&t.Zu, &s0.Zu, &s1.Zu},
+                           std::tuple{&t.zl, &s0.zl, &s1.zl}, std::tuple{&t.zu, &s0.zu, &s1.zu}}) {
+    std::copy_n(a->data(), ns0, dst->data());
+    std::copy_n(b->data(), ns1, dst->data() + ns0);
+  }
 }
 
-void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
+bool QpRiccatiIpmPairs::condense(const OcpQp& qp) {
   prepared_ = false;
-  if (!ready_ || !ocp_qp_valid_for(qp, dims_, settings_.check_data)) return;
+  restricted_ = false;
+  if (!ready_ || !ocp_qp_valid_for(qp, dims_, settings_.check_data)) return false;
   for (std::size_t j = 0; j < first_.size(); ++j) {
     if (count_[j] == 2) {
       condense_pair(qp, static_cast<int>(j));
@@ -246,7 +298,23 @@ void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
     }
   }
   set_inner_settings();
+  return true;
+}
+
+void QpRiccatiIpmPairs::prepare(const OcpQp& qp) {
+  if (!condense(qp)) return;
   inner_->prepare(qpc_);  // a nested level condenses its pairs (x0 plays no part)
+  prepared_ = true;
+}
+
+void QpRiccatiIpmPairs::prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
+  if (!condense(qp)) return;
+  qpc_.x0 = qp.x0;  // not read by the preparation; set for a consistent QP
+  if (warm != QpWarmStart::cold) {
+    restrict_warm_start(start);
+    restricted_ = true;
+  }
+  inner_->prepare(qpc_, solc_, warm);
   prepared_ = true;
 }
 
@@ -269,9 +337,9 @@ void QpRiccatiIpmPairs::restrict_warm_start(const OcpQpSolution& sol) {
     solc_.u[j].head(nu0) = sol.u[k];
     solc_.u[j].tail(nu1) = sol.u[k + 1];
     solc_.pi[j] = sol.pi[k + 1];
-    for (const Segment& g : pair_segments(d, k)) {
-      solc_.lam_l[j].segment(g.block, g.size) = sol.lam_l[k + g.stage].segment(g.offset, g.size);
-      solc_.lam_u[j].segment(g.block, g.size) = sol.lam_u[k + g.stage].segment(g.offset, g.size);
+    for (const Segment& g : pair_segments(d, k)) {  // plain copies: most segments are tiny or empty
+      std::copy_n(sol.lam_l[k + g.stage].data() + g.offset, g.size, solc_.lam_l[j].data() + g.block);
+      std::copy_n(sol.lam_u[k + g.stage].data() + g.offset, g.size, solc_.lam_u[j].data() + g.block);
     }
     for (auto [dst, src] : {std::pair{&solc_.sl, &sol.sl}, std::pair{&solc_.su, &sol.su},
                             std::pair{&solc_.lam_sl, &sol.lam_sl},
@@ -303,8 +371,8 @@ void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
     add_ax(s0.A, sol.x[k], x1);
     add_ax(s0.B, sol.u[k], x1);
     for (const Segment& g : pair_segments(d, k)) {
-      sol.lam_l[k + g.stage].segment(g.offset, g.size) = solc_.lam_l[j].segment(g.block, g.size);
-      sol.lam_u[k + g.stage].segment(g.offset, g.size) = solc_.lam_u[j].segment(g.block, g.size);
+      std::copy_n(solc_.lam_l[j].data() + g.block, g.size, sol.lam_l[k + g.stage].data() + g.offset);
+      std::copy_n(solc_.lam_u[j].data() + g.block, g.size, sol.lam_u[k + g.stage].data() + g.offset);
     }
     for (auto [dst, src] : {std::pair{&sol.sl, &solc_.sl[j]}, std::pair{&sol.su, &solc_.su[j]},
                             std::pair{&sol.lam_sl, &solc_.lam_sl[j]},
@@ -321,9 +389,13 @@ void QpRiccatiIpmPairs::expand(const OcpQp& qp, OcpQpSolution& sol) const {
     add_atx(s1.A, sol.pi[k + 1], pk);
     for (int r = 0; r < nbx1; ++r)
       pk[s1.idxbx[r]] -= sol.lam_l[k + 1][nbu1 + r] - sol.lam_u[k + 1][nbu1 + r];
-    for (int r = 0; r < ng1; ++r)
-      pk -= (sol.lam_l[k + 1][nbu1 + nbx1 + r] - sol.lam_u[k + 1][nbu1 + nbx1 + r]) *
-            s1.C.row(r).transpose();
+    for (int r0 = 0; r0 < ng1; r0 += 16) {  // + C1ᵀ(λ_u − λ_l) of the general rows
+      double diff[16];
+      const int n = std::min(16, ng1 - r0);
+      for (int r = 0; r < n; ++r)
+        diff[r] = sol.lam_u[k + 1][nbu1 + nbx1 + r0 + r] - sol.lam_l[k + 1][nbu1 + nbx1 + r0 + r];
+      kernels::gemv_t(n, d.nx[k + 1], s1.C.data() + r0, ng1, diff, pk.data());
+    }
   }
   sol.lam_x0 = solc_.lam_x0;
   sol.status = solc_.status;
@@ -340,7 +412,8 @@ QpStatus QpRiccatiIpmPairs::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmSta
   if (!prepared_) return sol.set_invalid_data();
   prepared_ = false;
   qpc_.x0 = qp.x0;
-  if (warm != QpWarmStart::cold) restrict_warm_start(sol);
+  if (warm != QpWarmStart::cold && !restricted_) restrict_warm_start(sol);
+  restricted_ = false;
   inner_->solve(qpc_, solc_, warm);
   expand(qp, sol);
   return sol.status;

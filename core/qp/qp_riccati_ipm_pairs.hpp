@@ -52,6 +52,8 @@ class QpRiccatiIpmPairs : public QpSolver {
   bool setup(const OcpQpDims& dims, const Settings& settings = {}) override;
   // Condenses qp (everything but x0); the next solve() of the same qp reuses it.
   void prepare(const OcpQp& qp) override;
+  // ... and hands the restricted warm start to the inner solver's preparation.
+  void prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) override;
   QpStatus solve(const OcpQp& qp, OcpQpSolution& sol,
                  QpWarmStart warm = QpWarmStart::cold) override;
 
@@ -62,6 +64,7 @@ class QpRiccatiIpmPairs : public QpSolver {
   const OcpQp& condensed() const { return qpc_; }  // the last condensed QP
 
  private:
+  bool condense(const OcpQp& qp);  // every block into qpc_; false for invalid data
   void condense_pair(const OcpQp& qp, int j);
   void expand(const OcpQp& qp, OcpQpSolution& sol) const;
   void restrict_warm_start(const OcpQpSolution& sol);
@@ -72,6 +75,7 @@ class QpRiccatiIpmPairs : public QpSolver {
   OcpQpDims dims_;
   bool ready_ = false;
   bool prepared_ = false;
+  bool restricted_ = false;  // solc_ holds the warm start given to prepare()
   std::vector<int> first_;  // per block: its first original stage
   std::vector<int> count_;  // per block: 1 or 2 stages
   OcpQp qpc_;               // the condensed QP (x0 copied at each solve)
@@ -79,10 +83,8 @@ class QpRiccatiIpmPairs : public QpSolver {
   std::unique_ptr<QpSolver> inner_;  // QpRiccatiIpm, or QpRiccatiIpmPairs(levels − 1)
   // Condensing workspace, sized for the largest stage.
   Eigen::MatrixXd Q1A0_;  // nx1 x nx0
-  Eigen::MatrixXd Q1B0_;  // nx1 x nu0
-  Eigen::MatrixXd A0t_;   // nx0 x nx1: A0ᵀ
-  Eigen::MatrixXd B0t_;   // nu0 x nx1: B0ᵀ
-  Eigen::VectorXd g1_;    // nx1: Q1 b0 + q1
+  Eigen::MatrixXd Q1B0_;  // nx1 x nu0 (same leading dimension as Q1A0_)
+  Eigen::VectorXd g1_;    // nx1: Q1 b0 + q1 (first the diagonal of a diagonal Q1)
   Eigen::VectorXd x1_;    // nx1: scratch of the expansion
   std::vector<double> constant_;  // per block: ½b0ᵀQ1b0 + q1ᵀb0
 };

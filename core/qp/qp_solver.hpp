@@ -28,7 +28,9 @@ struct QpRiccatiIpmSettings {
   double min_step = qp_defaults::kMinStep;
   double init_slack = qp_defaults::kInitSlack;
   double init_mu = qp_defaults::kInitMu;
-  double warm_start_floor = qp_defaults::kWarmStartFloor;
+  double warm_start_floor = qp_defaults::kWarmStartFloor;              // λ
+  double warm_start_slack_floor = qp_defaults::kWarmStartSlackFloor;  // t
+  double warm_start_violated = qp_defaults::kWarmStartViolated;       // t of a violated hard row
   double psd_tol = qp_defaults::kPsdTol;
   double inf_bound = qp_defaults::kInfBound;
   // Iterative refinement of each iteration's final Newton direction: at most refinement_steps,
@@ -55,9 +57,20 @@ class QpSolver {
 
   // Optional preparation phase (RTI, SPEC §4): the work on qp that does not depend on x0. The
   // next solve() of the same qp — only x0 may have changed in between — reuses it; a solve()
-  // without a preceding prepare() does all the work itself. The Riccati IPM has nothing to
-  // prepare (every factorization depends on the iterate).
+  // without a preceding prepare() does all the work itself. The Riccati IPM takes the QP data
+  // into its own layout here; partial condensing condenses.
   virtual void prepare(const OcpQp& qp) { (void)qp; }
+  // The same, knowing the warm start of that next solve() (in RTI the shifted previous
+  // solution, known before x̄_0): a solver may also do the x0-free part of its first iteration.
+  // The Riccati IPM, warm-started primal-dual, factorizes the first Newton system of every stage
+  // but stage 0 here (their W = λ/t and Hessians do not involve x0; x_0 only enters stage 0's
+  // constraints), so the feedback phase factorizes one stage before its first direction. The
+  // next solve() must be given the same start and warm.
+  virtual void prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
+    (void)start;
+    (void)warm;
+    prepare(qp);
+  }
 
   // Solves qp (dims equal to the setup dims) into sol (sized with the same dims; read as the
   // warm start when requested).

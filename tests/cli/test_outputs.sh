@@ -162,6 +162,7 @@ check "... it is in place, byte for byte" cmp -s "$work/second.mcap" "$work/rec.
 check "... and the temporary is gone" test ! -e "$work/second.mcap.Qw34Er.tmp"
 "$mixpilot" score "$work/second.mcap" >"$work/r.out" 2>&1
 check "... and it scores" grep -q "exact" "$work/r.out"
+check "... saying how fast it replayed" grep -Eq "s CPU, [0-9.]+ s wall: [0-9]+x real time" "$work/r.out"
 rm -f "$work"/nostep* "$work/second.mcap" "$work/r.out"
 
 # --- Names at NAME_MAX: the temporary's suffix never makes a legal name fail. ----------------

@@ -59,5 +59,10 @@ void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
 void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
              int ldc, bool overwrite = false);
 void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y);
+// C += Aᵀ B with A k x m, B k x n, C m x n (column-major): each entry a dot product of two
+// columns, four rows at a time (partial condensing's Aᵀ(Q A) without transposing A). With
+// overwrite, C = Aᵀ B.
+void gemm_tn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
+             int ldc, bool overwrite = false);
 
 }  // namespace mixpilot::kernels
