@@ -105,6 +105,10 @@ struct FlyOptions {
   LessonTag lesson;
   // The window: the lesson its picker starts on (a file; `mixpilot lesson` without --headless).
   std::string lesson_file;
+  // The window may offer the first launch's welcome (ui/first_launch.hpp): `fly` in the window
+  // without a scenario named (app/fly.cpp says when); it shows while the history has no flight
+  // and the user never dismissed it.
+  bool first_launch = false;
 };
 
 // A person's device flying the session (--pilot gamepad | keyboard, SPEC §6), kept alive for

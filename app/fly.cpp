@@ -50,7 +50,9 @@ constexpr const char* kFlyUsage =
     "\n"
     "  --scenario FILE    scenario file (TOML, docs/scenario-format.md); optional when PILOT is\n"
     "                     a recording, whose embedded scenario is then used, and in the window\n"
-    "                     (default: the shipped mi_helix). Its `mode` picks what flies:\n"
+    "                     (default: the shipped mi_helix; while the history has no flight, the\n"
+    "                     window then opens on a welcome with three ways in, until it is\n"
+    "                     dismissed; F1 shows it again). Its `mode` picks what flies:\n"
     "                     mixed_initiative (with a pilot) or a thesis controller\n"
     "  --pilot PILOT      novice | experienced | reckless | another profile of the scenario |\n"
     "                     gamepad (headless only with --realtime) | keyboard (window) |\n"
@@ -629,6 +631,12 @@ int fly_command(int argc, char** argv) {
   if (o.ghost == "best" && o.history == "off")
     usage_error(o.command, "--ghost best is read from the history: not with --history off "
                            "(name a recording: --ghost REC.mcap)");
+  // The first launch's welcome (ui/first_launch.hpp) is for a person opening the window to look
+  // around: not when the command line names the scenario (an expert's choice), replays, or runs
+  // the window by script.
+  o.first_launch = !o.headless && o.scenario_path.empty() && !o.pilot.ends_with(".mcap") &&
+                   !o.exit_at_end && o.screenshots.empty() && o.gamepad_script.empty() &&
+                   o.commands.empty() && o.vehicle.empty();
   // The window without a scenario (the desktop entry): the shipped mi_helix, changeable there.
   if (o.scenario_path.empty() && !o.headless && !o.pilot.ends_with(".mcap"))
     o.scenario_path = data_file("scenarios/mi_helix.toml");

@@ -835,6 +835,34 @@ void LiveController::handle(const ui::LiveRequest& r) {
                                  (history_ ? "" : " (lessons need the history: --history is off)"),
                              true);
           },
+          [&](const ui::FlyWith& w) {
+            // The first launch's ways in: a shipped scenario by name, a pilot by theirs.
+            if (is_flying(*live_)) return;
+            if (lesson()) pick_lesson(0);
+            const FlyOptions before = options_;
+            if (!w.scenario.empty()) {
+              const auto it = std::find_if(scenario_paths_.begin(), scenario_paths_.end(),
+                                           [&](const std::string& p) {
+                                             return fs::path(p).stem().string() == w.scenario;
+                                           });
+              if (it == scenario_paths_.end()) {
+                status_line_.say("no shipped scenario named " + w.scenario, true);
+                return;
+              }
+              options_.scenario_path = *it;
+            }
+            options_.pilot = w.pilot;
+            from_.reset();
+            from_shown_.clear();
+            if (!replace_live(error)) {
+              options_ = before;
+              status_line_.say(error, true);
+              return;
+            }
+            const auto at = std::find(scenario_paths_.begin(), scenario_paths_.end(),
+                                      options_.scenario_path);
+            if (at != scenario_paths_.end()) choices_.scenario = int(at - scenario_paths_.begin());
+          },
           [&](const ui::FlyFromStart&) {
             if (!from_ || is_flying(*live_)) return;
             const FlyOptions before = options_;

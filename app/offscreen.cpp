@@ -103,6 +103,14 @@ bool Offscreen::open(int width, int height, std::string& error, float scale) {
   return true;
 }
 
+void Offscreen::rescale(float scale) {
+  scale_ = scale;
+  mixpilot::ui::apply_style(scale);
+  font_ = mixpilot::ui::load_fonts(scale);
+  ImGui_ImplOpenGL3_DestroyFontsTexture();
+  ImGui_ImplOpenGL3_CreateFontsTexture();
+}
+
 void Offscreen::frame(const std::function<void()>& build, float dt) {
   ImGuiIO& io = ImGui::GetIO();
   io.DeltaTime = dt;

@@ -21,6 +21,9 @@ class Offscreen {
   // False with the reason (no EGL device, no OpenGL 3.3) and what to install.
   [[nodiscard]] bool open(int width, int height, std::string& error, float scale = 1.0f);
 
+  // The UI at another display scale from the next frame on: style and fonts made again.
+  void rescale(float scale);
+
   // Renders one ImGui frame: `build` runs between ImGui::NewFrame() and ImGui::Render().
   // `dt` is the frame's time step for ImGui [s].
   void frame(const std::function<void()>& build, float dt = 1.0f / 60.0f);

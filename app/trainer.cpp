@@ -1,12 +1,57 @@
 #include "app/trainer.hpp"
 
+#include <algorithm>
+
+#include "ui/first_launch.hpp"
+
 namespace mixpilot::cli {
 
 Trainer::Trainer(FlyOptions o)
     : input_(o.input_settings, status_),
       history_(o.history == "off" ? nullptr : std::make_unique<HistoryWriter>(o.history)),
       live_(o, input_, status_, history_.get()),
-      replay_(o.command, o.allow_mismatch, status_, o.replay ? o.ghost : std::string()) {}
+      replay_(o.command, o.allow_mismatch, status_, o.replay ? o.ghost : std::string()) {
+  std::string note;
+  window_settings_ = load_window_settings("", note);
+  if (!note.empty()) status_.say(note, true);
+  welcome_pending_ = o.first_launch && !o.replay && !window_settings_.welcome_dismissed;
+}
+
+void Trainer::update_welcome() {
+  if (!welcome_pending_ || replay_.is_open() || !live_.flight()) return;
+  // "No flight yet": the history read and it knows no trainee (every flight has one). Without
+  // a history (--history off) there is nothing to ask: the welcome shows.
+  if (history_) {
+    if (!history_view_ || !history_view_->loaded) return;
+    if (!history_view_->trainees.empty()) {
+      welcome_pending_ = false;
+      return;
+    }
+  }
+  welcome_pending_ = false;
+  ui::show_welcome(ui_);
+}
+
+void Trainer::first_launch(const ui::FirstLaunchChoice& c) {
+  switch (c.way) {
+    case ui::WayIn::watch:
+      live_.handle(ui::FlyWith{"mi_helix", "novice"});
+      break;
+    case ui::WayIn::fly:
+      live_.handle(ui::FlyWith{"mi_helix", ui::found_gamepad(run_).empty() ? "keyboard" : "gamepad"});
+      break;
+    case ui::WayIn::course:
+      if (!c.trainee.empty()) live_.handle(ui::SetTrainee{c.trainee});
+      live_.handle(ui::ChooseLesson{"beginner"});
+      break;
+  }
+}
+
+void Trainer::save_window_settings(const char* what) {
+  std::string error;
+  if (!cli::save_window_settings("", window_settings_, error))
+    status_.say(std::string("could not keep ") + what + " for the next start: " + error, true);
+}
 
 bool Trainer::open_live(std::string& error, int& status) { return live_.open(error, status); }
 
@@ -27,7 +72,9 @@ void Trainer::start() {
 
 void Trainer::build_frame(double wall_dt) {
   const LiveFlight* f = live_.flight();
-  input_.update(f ? f->flight().devices.get() : nullptr, f && f->waiting, ui_.show_settings,
+  // The settings panel and the welcome name the gamepads SDL sees.
+  input_.update(f ? f->flight().devices.get() : nullptr, f && f->waiting,
+                ui_.show_settings || ui_.first_launch == ui::FirstLaunch::welcome,
                 wizard_.running());
   wizard_.update(input_.started(), input_.info().wizard);
   run_.input = &input_.info();
@@ -36,6 +83,8 @@ void Trainer::build_frame(double wall_dt) {
   poll_take_over();
   if (replay_.is_open()) replay_.update(wall_dt, run_);
   else if (live_.flight()) live_.update(input_.info().connected, run_);
+  update_welcome();
+  run_.text_scale = window_settings_.text_scale;
   requests_.clear();
   if (replay_.is_open()) {
     ui::draw_screen(replay_.scene(), replay_.shown(), run_, ui_, requests_);
@@ -79,6 +128,19 @@ void Trainer::act(const ui::Request& r) {
                                     else status_.say(error, true);
                                   },
                                   [&](const ui::FlyFromHere&) { fly_from_here(); },
+                                  [&](const ui::FirstLaunchChoice& c) { first_launch(c); },
+                                  [&](const ui::FirstLaunchDone&) {
+                                    welcome_pending_ = false;
+                                    if (window_settings_.welcome_dismissed) return;
+                                    window_settings_.welcome_dismissed = true;
+                                    save_window_settings("that the welcome was seen (it will "
+                                                         "show again)");
+                                  },
+                                  [&](const ui::SetTextScale& t) {
+                                    window_settings_.text_scale =
+                                        std::clamp(t.scale, kMinTextScale, kMaxTextScale);
+                                    save_window_settings("the text size");
+                                  },
                               },
                               a);
                  },

@@ -19,6 +19,7 @@
 #include "app/replay_tape.hpp"
 #include "app/status_line.hpp"
 #include "app/take_over.hpp"
+#include "app/window_settings.hpp"
 #include "app/wizard_controller.hpp"
 #include "ui/requests.hpp"
 #include "ui/screen.hpp"
@@ -60,6 +61,9 @@ class Trainer {
   ClipExporter& clips() { return clips_; }
   // Fly from here (SPEC §10): the moment being made ready off the UI thread (nullptr: none).
   const TakeOver* taking_over() const { return take_over_.get(); }
+  // The user's text size, a factor on the display's scale (window.toml; the window rebuilds
+  // its fonts when it changes).
+  float text_scale() const { return window_settings_.text_scale; }
 
   // Stops the flight (closing its recording) and the replay; prints the summary, writes the
   // report; returns the exit status (kExitReplayMismatch for a replay that differs).
@@ -71,6 +75,11 @@ class Trainer {
   void leave_replay();
   void fly_from_here();    // the replay's playhead: a moment made ready for a live flight
   void poll_take_over();   // ... and once it is, the live flight READY there
+  // The first launch: the welcome shows once the history says it has no flight (at once
+  // without a history), unless it was dismissed; its choices, and it done with (saved).
+  void update_welcome();
+  void first_launch(const ui::FirstLaunchChoice& c);
+  void save_window_settings(const char* what);
 
   // Declared before the controllers, which say things into it and outlive none of it.
   ui::RunInfo run_;  // the frame's snapshot
@@ -87,6 +96,9 @@ class Trainer {
   ReplayController replay_;
   std::unique_ptr<TakeOver> take_over_;  // after replay_: it outlives no replay
   ui::UiState ui_;
+  // window.toml: the text size and whether the welcome was done with.
+  WindowSettings window_settings_;
+  bool welcome_pending_ = false;  // the welcome may show, once the history is read
   ui::Requests requests_;  // this frame's; cleared each frame, its capacity kept
 };
 

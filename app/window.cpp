@@ -83,6 +83,11 @@ std::optional<ui::Key> ui_key(int key) {
     case GLFW_KEY_END: return Key::end;
     case GLFW_KEY_LEFT_BRACKET: return Key::left_bracket;
     case GLFW_KEY_RIGHT_BRACKET: return Key::right_bracket;
+    case GLFW_KEY_MINUS: return Key::minus;
+    case GLFW_KEY_EQUAL: return Key::equal;
+    case GLFW_KEY_KP_SUBTRACT: return Key::keypad_subtract;
+    case GLFW_KEY_KP_ADD: return Key::keypad_add;
+    case GLFW_KEY_KP_0: return Key::keypad_0;
     case GLFW_KEY_LEFT_SHIFT: return Key::left_shift;
     case GLFW_KEY_RIGHT_SHIFT: return Key::right_shift;
     case GLFW_KEY_LEFT_CONTROL: return Key::left_ctrl;
@@ -129,6 +134,7 @@ bool run_window(Trainer& app, const WindowOptions& o, std::vector<std::string>& 
   c.shown_time = [&app] { return app.shown_time(); };
   c.start = [&app] { app.start(); };
   c.over = [&app] { return app.over(); };
+  c.text_scale = [&app] { return app.text_scale(); };
   return run_window(c, o, written, error);
 }
 
@@ -152,7 +158,12 @@ bool run_window(const WindowContent& app, const WindowOptions& o,
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
-  const float scale = o.scale > 0 ? o.scale : ui_scale(window);
+  // The UI's scale: the display's (or --scale) times the user's text size, followed as either
+  // changes (the window moved to another display, the text size set).
+  const auto wanted_scale = [&] {
+    return (o.scale > 0 ? o.scale : ui_scale(window)) * (app.text_scale ? app.text_scale() : 1.0f);
+  };
+  float scale = wanted_scale();
   ui::apply_style(scale);
   ui::load_fonts(scale);
   ImGui_ImplGlfw_InitForOpenGL(window, true);
@@ -167,6 +178,14 @@ bool run_window(const WindowContent& app, const WindowOptions& o,
   std::string title;
   while (!glfwWindowShouldClose(window) && !interrupted()) {  // ^C ends the flight as headless
     glfwPollEvents();
+    if (const float want = wanted_scale(); std::abs(want - scale) > 1e-3f) {
+      // Fonts are rebuilt between frames, never within one.
+      scale = want;
+      ui::apply_style(scale);
+      ui::load_fonts(scale);
+      ImGui_ImplOpenGL3_DestroyFontsTexture();
+      ImGui_ImplOpenGL3_CreateFontsTexture();
+    }
     const auto now = std::chrono::steady_clock::now();
     const double wall_dt = std::chrono::duration<double>(now - last).count();
     last = now;

@@ -26,6 +26,8 @@ struct WindowContent {
   std::function<double()> shown_time;  // [s] what the screenshots' times are measured against
   std::function<void()> start;         // exit_at_end: at once
   std::function<bool()> over;          // exit_at_end: close once true
+  // The user's text size, a factor on the display's scale (nullptr: 1).
+  std::function<float()> text_scale;
 };
 
 // Whether a window can be opened here (a display and GLFW); false with the reason.

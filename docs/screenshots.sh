@@ -2,7 +2,8 @@
 # Regenerates the README's screenshots with the headless renderer (mixpilot fly --screenshot):
 # one per mode, one of a replay and one of input loss, 800x450; the screen on a 150 % display,
 # why λ fell, a ghost run, and the input settings, Progress and lesson panels, fly from here and
-# the debrief at 1280x720 (app tests render them), and the instructor's window with two
+# the debrief at 1280x720 (app tests render them), the first launch's welcome and tour at 100 %
+# and 150 %, and the instructor's window with two
 # stations. The flights
 # flown here go to a temporary data folder, never into the developer's history.
 # Usage: docs/screenshots.sh [path/to/mixpilot]
@@ -56,6 +57,13 @@ MIXPILOT_SHOT_DIR="$tmp" "$tests/test_fly_from_here_app" \
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
 cp "$tmp/fly_from_here.png" $out/fly_from_here.png
+# The first launch: the welcome and each callout of its tour at 100 % and 150 %, from the test
+# that drives them with the keyboard alone (in a fresh data and config folder of its own).
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_onboarding" \
+  --gtest_filter='Scales/FirstLaunchAtScale.TheKeyboardAloneGoesFromTheWelcomeToAScoreCard/*' >/dev/null
+for at in 100 150; do cp "$tmp/first_launch_welcome_$at.png" $out/first_launch_$at.png; done
+for step in 1 2 3 4; do cp "$tmp/first_launch_tour_${step}_100.png" $out/tour_${step}_100.png; done
+cp "$tmp/first_launch_tour_1_150.png" $out/tour_1_150.png
 # The lesson picker: the beginner course of a trainee two steps in, after a failed attempt at
 # the third (the test fills a history of its own).
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_lesson" \

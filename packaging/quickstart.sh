@@ -32,9 +32,10 @@ esac
 
 case "$1" in
   run)
-    # The window where a display exists, else the headless demo.
+    # The window where a display exists (mi_helix; the first time, a welcome with three ways
+    # in), else the headless demo.
     if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
-      exec ./build/release/app/mixpilot fly --scenario scenarios/mi_helix.toml --pilot novice
+      exec ./build/release/app/mixpilot fly
     fi
     exec ./build/release/app/mixpilot demo ;;
   test) exec ctest --preset release -j "$(nproc)" ;;

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "models/attitude.hpp"
+#include "ui/chase_camera.hpp"
 #include "ui/panels.hpp"
 #include "ui/reason.hpp"
 #include "ui/theme.hpp"
@@ -82,14 +83,11 @@ View make_view(const Scene& sc, const Telemetry& s, UiState& ui, ImVec2 min, ImV
   const double size = (sc.arena_max - sc.arena_min).norm();
   const Eigen::Vector3d p = s.x.size() >= 3 ? Eigen::Vector3d(s.x.head<3>()) : centre;
   switch (ui.camera) {
-    case Camera::chase: {  // behind the vehicle's heading, above it
-      const Eigen::Vector3d fwd = attitude(s.x).col(0);
-      Eigen::Vector3d back(-fwd.x(), -fwd.y(), 0.0);
-      if (back.norm() < 1e-6) back = Eigen::Vector3d(-1, 0, 0);
-      back.normalize();
-      return View(p + 2.2 * back + Eigen::Vector3d(0, 0, 1.0), p, Eigen::Vector3d::UnitZ(), min,
+    case Camera::chase:  // behind the vehicle's heading (turned clear of obstacles), above it
+      if (s.x.size() < 3) return View(centre + Eigen::Vector3d(-2.2, 0, 1), centre,
+                                      Eigen::Vector3d::UnitZ(), min, max, 60.0);
+      return View(chase_eye(s, {ui.chase_turn, ui.chase_rise}), p, Eigen::Vector3d::UnitZ(), min,
                   max, 60.0);
-    }
     case Camera::top:
       return View(centre + Eigen::Vector3d(0, 0, 1.1 * size), centre, Eigen::Vector3d::UnitY(),
                   min, max, 50.0);
@@ -304,19 +302,10 @@ struct Ball {
   bool blocks = false;  // it stands between the camera and the vehicle
 };
 
-// Whether the sphere (c, r) hides part of the vehicle (a ball of radius `size` around p) from
-// the eye: it holds the eye, or it lies along the line of sight, nearer than the vehicle, and
-// comes within r + size of it.
+// Whether the sphere (c, r) hides part of the vehicle from the view's eye (ui/chase_camera.hpp).
 bool blocks_view(const View& v, const Eigen::Vector3d& c, double r, const Eigen::Vector3d& p,
                  double size) {
-  if ((c - v.eye).norm() <= r) return true;
-  const Eigen::Vector3d sight = p - v.eye;
-  const double length = sight.norm();
-  if (length < 1e-9) return false;
-  const double along = (c - v.eye).dot(sight) / length;
-  if (along <= 0.0 || along - r >= length) return false;
-  const double t = std::min(along, length);
-  return (v.eye + t / length * sight - c).norm() < r + size;
+  return blocks_sight(v.eye, c, r, p, size);
 }
 
 // Why λ fell (SPEC §10): the prediction λ was computed from (SPEC §5.4: the previous step's),
@@ -418,7 +407,7 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
   const View v = make_view(sc, s, ui, frame, max);
   const bool has_vehicle = s.x.size() >= 3;
   const Eigen::Vector3d p = has_vehicle ? Eigen::Vector3d(s.x.head<3>()) : Eigen::Vector3d::Zero();
-  const double vehicle_size = 0.35;  // [m] arms and rotors, with a margin
+  const double vehicle_size = kVehicleSightRadius;
   draw_world(dl, v, sc);
 
   // The obstacles, far to near: shaded, dimmer with distance, with shadows and drop lines to
@@ -468,6 +457,8 @@ void draw_arena(const Scene& sc, const History& h, UiState& ui, ImVec2 min, ImVe
     ImVec2 pb;
     if (s.reference.size() >= 3 && v.project(s.reference.head<3>(), pb)) {
       const float r = float(v.pixels(sc.ball_radius, s.reference.head<3>()));
+      ui.marks.ball_centre = pb;  // what the tour points at
+      ui.marks.ball_radius = r;
       dl->AddCircleFilled(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 28), 32);
       dl->AddCircle(pb, r, colour::rgb(0xEE, 0xEE, 0xEE, 150), 32, scaled(1.5f));
     }

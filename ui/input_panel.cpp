@@ -13,6 +13,11 @@ namespace mixpilot::ui {
 
 namespace {
 
+// What the item just drawn does, on hover (every control has one).
+void tip(const char* text) {
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", text);
+}
+
 // One axis's response: raw stick (x) → shaped output (y), both in [-1, 1], with the live stick
 // as a dot on the curve.
 void axis_curve(const char* id, const input::AxisSettings& a, double live, ImVec2 size) {
@@ -20,6 +25,7 @@ void axis_curve(const char* id, const input::AxisSettings& a, double live, ImVec
   const ImVec2 min = ImGui::GetCursorScreenPos();
   const ImVec2 max(min.x + size.x, min.y + size.y);
   ImGui::InvisibleButton(id, size);
+  tip("The axis's response: the stick (across) to the command (up), with the stick now as a dot");
   dl->AddRectFilled(min, max, colour::kBackground);
   const auto px = [&](double x, double y) {
     return ImVec2(float(min.x + (x + 1) * 0.5 * size.x), float(max.y - (y + 1) * 0.5 * size.y));
@@ -38,10 +44,13 @@ float labelled_width(const char* label, float field) {
   return field + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(label, nullptr, true).x;
 }
 
-bool slider(const char* label, double& v, double lo, double hi, const char* format) {
+bool slider(const char* label, double& v, double lo, double hi, const char* format,
+            const char* what) {
   float f = float(v);
-  if (!ImGui::SliderFloat(label, &f, float(lo), float(hi), format, ImGuiSliderFlags_AlwaysClamp))
-    return false;
+  const bool changed =
+      ImGui::SliderFloat(label, &f, float(lo), float(hi), format, ImGuiSliderFlags_AlwaysClamp);
+  tip(what);
+  if (!changed) return false;
   v = double(f);
   return true;
 }
@@ -101,9 +110,11 @@ void draw_input_settings(const RunInfo& run, UiState& ui, Requests& out) {
       ImGui::BeginDisabled(dev.instance == in.active);
       const std::string use = (dev.instance == in.active ? "selected##" : "Select##") + dev.name;
       if (ImGui::Button(use.c_str())) out.push_back(UseGamepad{dev.instance});
+      tip("Fly the gamepad flights with this one");
       ImGui::EndDisabled();
-    } else if (ImGui::Button(("Map it...##" + dev.name).c_str())) {
-      out.push_back(MapGamepad{dev.instance});
+    } else {
+      if (ImGui::Button(("Map it...##" + dev.name).c_str())) out.push_back(MapGamepad{dev.instance});
+      tip("Teach SDL this joystick: move each stick as asked, then save the mapping");
     }
     ImGui::SameLine();
     ImGui::TextWrapped("%s%s", dev.name.c_str(), dev.mapped ? "" : "  (SDL has no mapping for it)");
@@ -119,12 +130,15 @@ void draw_input_settings(const RunInfo& run, UiState& ui, Requests& out) {
   ImGui::SetNextItemWidth(std::min(28.0f * em, ImGui::GetContentRegionAvail().x -
                                                    labelled_width("stick mode", 0.0f)));
   if (ImGui::Combo("stick mode", &mode, modes, 4)) s.mode = mode + 1;
+  tip("Which stick moves what (mode 2 is the common one)");
   const float wide = 13.0f * em, narrow = 10.5f * em;
   ImGui::SetNextItemWidth(wide);
-  slider("max tilt [deg]", s.max_tilt_deg, 5, 60, "%.0f");
+  slider("max tilt [deg]", s.max_tilt_deg, 5, 60, "%.0f",
+         "The roll and pitch a full stick asks for");
   same_line_or_wrap(labelled_width("thrust range (x hover)", wide));
   ImGui::SetNextItemWidth(wide);
-  slider("thrust range (x hover)", s.thrust_range, 0.05, 1, "%.2f");
+  slider("thrust range (x hover)", s.thrust_range, 0.05, 1, "%.2f",
+         "How far a full thrust stick moves the rotors from hover (a share of hover)");
 
   // Each axis: its shaping and its curve with the live stick.
   const input::Controls raw = input::assign(in.live, s.mode);
@@ -141,38 +155,46 @@ void draw_input_settings(const RunInfo& run, UiState& ui, Requests& out) {
       axis_curve("curve", a, live[i], ImVec2(w, w * 0.75f));
       const float field = -labelled_width("deadzone", 0.0f);  // the longest label's room
       ImGui::SetNextItemWidth(field);
-      slider("deadzone", a.deadzone, 0, 0.5, "%.2f");
+      slider("deadzone", a.deadzone, 0, 0.5, "%.2f", "Stick travel around the centre that does nothing");
       ImGui::SetNextItemWidth(field);
-      slider("expo", a.expo, 0, 1, "%.2f");
+      slider("expo", a.expo, 0, 1, "%.2f", "Softer near the centre, full at the end (0: linear)");
       ImGui::SetNextItemWidth(field);
-      slider("rate", a.rate, 0.1, 2, "%.2f");
+      slider("rate", a.rate, 0.1, 2, "%.2f", "A factor on the whole axis");
       ImGui::Checkbox("invert", &a.invert);
+      tip("The axis the other way round");
       ImGui::PopID();
     }
     ImGui::EndTable();
   }
   ImGui::Separator();
   ImGui::SetNextItemWidth(narrow);
-  slider("input timeout [s]", s.input_timeout_s, 0.02, 1, "%.2f");
+  slider("input timeout [s]", s.input_timeout_s, 0.02, 1, "%.2f",
+         "A device silent this long is lost: the planner flies until it is back");
   same_line_or_wrap(labelled_width("return time [s]", narrow));
   ImGui::SetNextItemWidth(narrow);
-  slider("return time [s]", s.return_time_s, 0, 5, "%.1f");
+  slider("return time [s]", s.return_time_s, 0, 5, "%.1f",
+         "How long the controls take to come back to you after a loss");
   ImGui::Checkbox("haptic cue", &s.haptic.enabled);
+  tip("The gamepad rumbles as the planner takes over");
   ImGui::BeginDisabled(!s.haptic.enabled);
   same_line_or_wrap(labelled_width("below lambda", narrow));
   ImGui::SetNextItemWidth(narrow);
-  slider("below lambda", s.haptic.threshold, 0.05, 1, "%.2f");
+  slider("below lambda", s.haptic.threshold, 0.05, 1, "%.2f",
+         "The rumble starts when your authority λ falls below this");
   same_line_or_wrap(labelled_width("strength", narrow));
   ImGui::SetNextItemWidth(narrow);
-  slider("strength", s.haptic.strength, 0, 1, "%.2f");
+  slider("strength", s.haptic.strength, 0, 1, "%.2f", "The strongest rumble");
   ImGui::EndDisabled();
   ImGui::Separator();
   ImGui::TextDisabled("Changes apply from the next flight.");
   if (ImGui::Button("Apply")) out.push_back(ApplySettings{s, false});
+  tip("Use these settings from the next flight on (not saved)");
   ImGui::SameLine();
   if (ImGui::Button("Save")) out.push_back(ApplySettings{s, true});
+  tip("Use these settings and keep them for the next start");
   ImGui::SameLine();
   if (ImGui::Button("Defaults")) s = input::InputSettings{};
+  tip("Put back the default settings here (Apply or Save to use them)");
   // Where Save writes: after the buttons, wrapping where the path is long.
   const std::string to = "Save writes to " + in.settings_path;
   same_line_or_wrap(std::min(ImGui::CalcTextSize(to.c_str()).x, 12.0f * em));
@@ -239,17 +261,22 @@ void draw_mapping_wizard(const RunInfo& run, Requests& out) {
   if (!w.mapping.empty() && w.done) ImGui::TextWrapped("%s", w.mapping.c_str());
   ImGui::BeginDisabled(w.done || !w.optional);
   if (ImGui::Button("Skip")) out.push_back(WizardSkip{});
+  tip("Leave this control unbound (only the optional ones)");
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(w.step == 0);
   if (ImGui::Button("Back")) out.push_back(WizardBack{});
+  tip("Bind the previous control again");
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(w.mapping.empty());
   if (ImGui::Button("Save")) out.push_back(WizardSave{});
+  tip("Write the mapping into your mappings and use the pad at once");
   ImGui::EndDisabled();
   ImGui::SameLine();
-  if (ImGui::Button("Cancel") || key_pressed(Key::escape)) out.push_back(WizardCancel{});
+  const bool cancel = ImGui::Button("Cancel");
+  tip("Stop mapping; nothing is written (Esc)");
+  if (cancel || key_pressed(Key::escape)) out.push_back(WizardCancel{});
   ImGui::End();
 }
 

@@ -20,7 +20,7 @@ enum class Key : int {
   f1, f2, f3, f4, f5, f6, f7, f8, f9, f10, f11, f12,
   space, enter, keypad_enter, escape, tab, backspace, insert, del,
   left, right, up, down, page_up, page_down, home, end,
-  left_bracket, right_bracket,
+  left_bracket, right_bracket, minus, equal, keypad_subtract, keypad_add, keypad_0,
   left_shift, right_shift, left_ctrl, right_ctrl, left_alt, right_alt, left_super, right_super,
   count
 };

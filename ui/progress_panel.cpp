@@ -157,7 +157,21 @@ void flights_table(const ProgressView& v, float height, Requests& out) {
   ImGui::TableSetupColumn("D");
   ImGui::TableSetupColumn("ended");
   ImGui::TableSetupColumn("recording", ImGuiTableColumnFlags_WidthStretch);
-  ImGui::TableHeadersRow();
+  // The headers, each saying what its column means.
+  static const char* const kColumnMeanings[] = {
+      "The attempt: its place among the trainee's flights of this scenario",
+      "When it was flown (local time)",
+      "assisted: the planner shared the controls; probe: the pilot alone (SPEC §10)",
+      "The score, 0-100: progress x quality / (1 + collisions)",
+      "Assistance dependence: the share of the flight the planner flew (0-1)",
+      "How the flight ended: completed, interrupted or lost",
+      "Its recording, replayed by its button"};
+  ImGui::TableNextRow(ImGuiTableRowFlags_Headers);
+  for (int c = 0; c < 7; ++c) {
+    ImGui::TableSetColumnIndex(c);
+    ImGui::TableHeader(ImGui::TableGetColumnName(c));
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", kColumnMeanings[c]);
+  }
   const int n = int(v.flights.size());
   ImGuiListClipper clip;
   clip.Begin(n);
@@ -245,6 +259,7 @@ void draw_progress_panel(const HistoryView& h, bool& open, ImVec2 display, Reque
       if (!b.recording.empty()) {
         ImGui::SameLine();
         if (ImGui::SmallButton("Replay best")) out.push_back(ReplayRecording{b.recording});
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("replay %s", b.recording.c_str());
         tooltip("Opens its recording in the replay, as File > Open does");
       }
     }

@@ -50,10 +50,14 @@ struct PickLesson {
 struct ChooseLesson {         // a lesson by its name ("beginner"): what a first launch offers
   std::string name;
 };
+struct FlyWith {              // a shipped scenario by its name and a pilot by theirs, flown next
+  std::string scenario;       // "mi_helix" ("" the one chosen)
+  std::string pilot;          // "novice", "gamepad", "keyboard"
+};
 using LiveRequest = std::variant<StartFlight, TogglePause, SetFlightSpeed, RestartFlight,
                                  CancelVehicleWait, HeldFlightKeys, PickScenario, PickPilot,
                                  SetRecord, SetTrainee, SetAssist, FlyFromStart, PickGhost,
-                                 PickLesson, ChooseLesson>;
+                                 PickLesson, ChooseLesson, FlyWith>;
 
 // A replay's transport.
 struct TogglePlay {};
@@ -119,8 +123,21 @@ inline ExportClip clip_around(double t, double duration, double half_width = kCl
 // Fly from here (SPEC §10): the replay's moment at the playhead becomes a live flight, READY
 // there, which the trainee's pilot flies on.
 struct FlyFromHere {};
-using AppRequest =
-    std::variant<OpenFile, LeaveReplay, ReplayRecording, ExportClip, FlyFromHere>;
+
+// The first launch (ui/first_launch.hpp): one of its three ways in, and the welcome done with
+// (its tour ended or skipped, or "not now"): it does not come back.
+enum class WayIn { watch, fly, course };
+struct FirstLaunchChoice {
+  WayIn way;
+  std::string trainee;            // the course's trainee ("" the login name)
+};
+struct FirstLaunchDone {};
+// The text size, a factor on the display's scale (1: as the display's), kept for next time.
+struct SetTextScale {
+  float scale;
+};
+using AppRequest = std::variant<OpenFile, LeaveReplay, ReplayRecording, ExportClip, FlyFromHere,
+                                FirstLaunchChoice, FirstLaunchDone, SetTextScale>;
 
 // Any request converts to a Request: `requests.push_back(ui::Seek{t})`.
 using Request = std::variant<LiveRequest, ReplayRequest, InputRequest, WizardRequest, AppRequest>;

@@ -7,10 +7,13 @@
 
 #include <imgui_internal.h>  // the panes' sizes of the last frame (FindWindowByName)
 
+#include "ui/chase_camera.hpp"
+#include "ui/first_launch.hpp"
 #include "ui/ghost.hpp"
 #include "ui/panels.hpp"
 #include "ui/instructor_hud.hpp"
 #include "ui/reason.hpp"
+#include "ui/shortcuts.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -63,6 +66,11 @@ ImU32 state_colour(RunState s) {
   }
 }
 
+// What the item just drawn does, on hover (every control has one).
+void tip(const char* text) {
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", text);
+}
+
 // The status pill: as tall as a button, so the first row lines up.
 void pill(const char* text, ImU32 c) {
   const ImVec2 p = ImGui::GetCursorScreenPos();
@@ -94,6 +102,7 @@ float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui
   // A replay has its controls and its time in the transport bar: here only the way back.
   if (run.replay) {
     if (ImGui::Button("Back to live (Esc)")) out.push_back(LeaveReplay{});
+    tip("Leave the replay: back to the live flight and its session panel");
     ImGui::SameLine();
   }
   // File and help at the right end; the title gives way to them (elided, full text on hover).
@@ -110,8 +119,10 @@ float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui
     ImGui::SetTooltip("%s", title.c_str());
   ImGui::SameLine(std::max(ImGui::GetCursorPosX(), right_x));
   if (ImGui::Button("Open... (Ctrl+O)")) ui.open_dialog.open = true;
+  tip("Open a scenario (.toml) to fly or a recording (.mcap) to replay");
   ImGui::SameLine();
   if (ImGui::Button("Help (F1)")) ui.show_help = !ui.show_help;
+  tip("Every key, the text size, and the welcome again");
 
   // The second row: what the flight does now, the buttons first.
   if (!run.replay) {
@@ -123,20 +134,29 @@ float top_bar(const Scene& sc, const History& h, const RunInfo& run, UiState& ui
     };
     if (run.state == RunState::ready) {
       if (button("Start (Space)")) out.push_back(StartFlight{});
+      tip("Start the flight: the clock runs and the pilot flies");
+      ui.marks.start_min = ImGui::GetItemRectMin();
+      ui.marks.start_max = ImGui::GetItemRectMax();
     } else if (run.state == RunState::waiting) {
       if (button("Cancel (Esc)")) out.push_back(CancelVehicleWait{});
+      tip("Stop waiting for the remote vehicle");
     } else if (run.state == RunState::flying || run.state == RunState::paused) {
       if (button(run.state == RunState::paused ? "Resume (Space)" : "Pause (Space)"))
         out.push_back(TogglePause{});
+      tip(run.state == RunState::paused ? "Go on flying" : "Freeze the flight (the clock stops)");
     }
-    if (run.can_restart && run.state != RunState::ready && button("Restart (R)"))
-      out.push_back(RestartFlight{});
+    if (run.can_restart && run.state != RunState::ready) {
+      if (button("Restart (R)")) out.push_back(RestartFlight{});
+      tip("Fly the same flight again from its start");
+    }
     for (double sp : {0.25, 0.5, 1.0}) {
       char label[16];
       std::snprintf(label, sizeof label, "%gx", sp);
       if (!first) same_line_or_wrap(radio_width(label));
       first = false;
       if (ImGui::RadioButton(label, run.speed == sp)) out.push_back(SetFlightSpeed{sp});
+      tip(sp < 1.0 ? "Slow motion: the flight runs at this share of real time"
+                   : "Real time");
     }
     const Telemetry* s = h.empty() ? nullptr : &h.newest();
     ImGui::PushFont(mono_font());
@@ -177,7 +197,7 @@ constexpr const char* kWidestHudItem = "in B 100.0 % of the last 60 s";
 // short view): a thinner bar without the shares' names under it, and fewer lines.
 // Returns the screen y of its bottom edge.
 float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, float width,
-          bool compact) {
+          bool compact, TourMarks& marks) {
   ImGui::SetNextWindowPos(pos);
   ImGui::SetNextWindowSize(ImVec2(width, 0.0f));
   // A translucent backing keeps its text readable over the scene.
@@ -193,6 +213,8 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
     const float bar_h = (compact ? 1.4f : 2.0f) * ImGui::GetFontSize();
     draw_authority_bar(s ? s->lambda : 1.0, bar_min, ImVec2(bar_min.x + w, bar_min.y + bar_h),
                        !compact, sc.probe, s ? s->instructor.bounds : AuthorityBounds{});
+    marks.bar_min = bar_min;
+    marks.bar_max = ImVec2(bar_min.x + w, bar_min.y + bar_h);
     ImGui::Dummy(ImVec2(w, bar_h + (compact ? scaled(5) : scaled(4) + ImGui::GetTextLineHeight())));
     // Why λ fell, while it matters and a moment after (ui/reason.hpp); the safe hold has its
     // own line below.
@@ -436,121 +458,6 @@ void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
   if (!open) ui.score_card_closed = true;
 }
 
-// The shortcut sheet (F1 or ?), UI.md §10.
-void help_sheet(UiState& ui, ImVec2 display) {
-  begin_centred("Keyboard and mouse (F1)", &ui.show_help, display);
-  static const char* const kKeys[][2] = {
-      {"Space", "start / pause / resume the flight; play / pause a replay"},
-      {"R", "restart the flight"},
-      {"Ctrl+R", "record the next flight or not"},
-      {"Ctrl+O", "open a scenario (.toml) or a recording (.mcap)"},
-      {"1  2  3  4", "camera: chase, orbit, top, side"},
-      {"mouse drag, wheel", "orbit the arena, zoom"},
-      {"D", "show / hide the sticks"},
-      {"P", "pause / resume the plots"},
-      {"H", "progress: this trainee's flights of this scenario, best run, trend"},
-      {"Left / Right", "replay: step 100 ms (Shift 10 ms, Alt 500 ms)"},
-      {"Home / End", "replay: start / end"},
-      {"Up / Down", "replay: faster / slower (0.25x to 8x)"},
-      {"[  ]", "replay: previous / next event of the debrief (selects it, the playhead at its "
-               "start)"},
-      {kDebriefKeyName, "replay: show / hide the Debrief panel, the list of what happened"},
-      {kExportClipKeyName, "replay: export a clip beside the recording: the selected event ± 5 s, "
-                           "else the playhead ± 5 s"},
-      {"T", "replay: fly from here - a new flight from the playhead's moment, with the pilot "
-            "you pick (READY there; Space starts), scored from there on"},
-      {"Esc", "leave the replay; close this sheet or the progress"},
-      {"F1  ?", "this sheet"},
-  };
-  std::vector<const char*> what;
-  float key_w = 0.0f;
-  ImGui::PushFont(mono_font());
-  for (const auto& k : kKeys) {
-    what.push_back(k[1]);
-    key_w = std::max(key_w, ImGui::CalcTextSize(k[0]).x);
-  }
-  ImGui::PopFont();
-  const float what_w = wrapped_column(what.data(), what.size(), key_w, display);
-  if (ImGui::BeginTable("##keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
-    ImGui::TableSetupColumn("key", ImGuiTableColumnFlags_WidthFixed, key_w);
-    ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed, what_w);
-    for (const auto& k : kKeys) {
-      ImGui::TableNextRow();
-      ImGui::TableNextColumn();
-      ImGui::PushFont(mono_font());
-      ImGui::TextUnformatted(k[0]);
-      ImGui::PopFont();
-      ImGui::TableNextColumn();
-      ImGui::TextWrapped("%s", k[1]);
-    }
-    ImGui::EndTable();
-  }
-  ImGui::End();
-}
-
-// The replay speeds, slowest first (↑ / ↓ move along them).
-constexpr double kReplaySpeeds[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
-
-void replay_keys(const RunInfo& run, UiState& ui, Requests& out) {
-  const ReplayInfo& r = *run.replay;
-  const ImGuiIO& io = ImGui::GetIO();
-  const double step = io.KeyShift ? 0.01 : io.KeyAlt ? 0.5 : 0.1;
-  if (key_pressed(Key::left)) out.push_back(Seek{std::max(0.0, r.t - step)});
-  if (key_pressed(Key::right)) out.push_back(Seek{std::min(r.loaded * r.duration, r.t + step)});
-  if (key_pressed(Key::home)) out.push_back(Seek{0.0});
-  if (key_pressed(Key::end)) out.push_back(Seek{r.loaded * r.duration});
-  const auto at = std::find(std::begin(kReplaySpeeds), std::end(kReplaySpeeds), run.speed);
-  const bool known = at != std::end(kReplaySpeeds);
-  const double faster = known && at + 1 != std::end(kReplaySpeeds) ? *(at + 1) : 8.0;
-  const double slower = known && at != std::begin(kReplaySpeeds) ? *(at - 1) : 0.25;
-  if (key_pressed(Key::up)) out.push_back(SetPlaySpeed{faster});
-  if (key_pressed(Key::down)) out.push_back(SetPlaySpeed{slower});
-  if (key_pressed(Key::left_bracket)) out.push_back(JumpToEvent{-1});
-  if (key_pressed(Key::right_bracket)) out.push_back(JumpToEvent{+1});
-  if (key_pressed(kExportClipKey)) out.push_back(clip_of(r));
-  if (key_pressed(kFlyFromHereKey) && r.can_fly_from_here && r.taking_over < 0.0)
-    out.push_back(FlyFromHere{});
-  if (key_pressed(kDebriefKey)) ui.show_debrief = !ui.show_debrief;
-  if (key_pressed(Key::escape) && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId))
-    out.push_back(LeaveReplay{});
-}
-
-void keys(UiState& ui, Requests& out, const RunInfo& run, const History& h) {
-  const ImGuiIO& io = ImGui::GetIO();
-  if (io.WantCaptureKeyboard || ui.open_dialog.open) return;
-  if (key_pressed(Key::f1)) ui.show_help = !ui.show_help;
-  for (int i = 0; i < io.InputQueueCharacters.Size; ++i)
-    if (io.InputQueueCharacters[i] == '?') ui.show_help = !ui.show_help;
-  if (io.KeyCtrl) {
-    if (key_pressed(Key::o)) ui.open_dialog.open = true;
-    if (key_pressed(Key::r) && run.session) out.push_back(SetRecord{!run.session->record});
-    return;
-  }
-  if (key_pressed(Key::escape) && ui.show_help) ui.show_help = false;
-  else if (key_pressed(Key::escape) && ui.show_progress) ui.show_progress = false;
-  else if (run.replay) replay_keys(run, ui, out);
-  else if (key_pressed(Key::escape) && run.state == RunState::waiting) out.push_back(CancelVehicleWait{});
-  // Space is the transport's: a replay plays or pauses, a live flight starts, pauses or resumes.
-  if (key_pressed(Key::space) && run.state != RunState::waiting) {
-    if (run.replay) out.push_back(TogglePlay{});
-    else if (run.state == RunState::ready) out.push_back(StartFlight{});
-    else out.push_back(TogglePause{});
-  }
-  if (key_pressed(Key::r) && run.can_restart && !run.replay) out.push_back(RestartFlight{});
-  if (key_pressed(Key::digit1)) ui.camera = Camera::chase;
-  if (key_pressed(Key::digit2)) ui.camera = Camera::orbit;
-  if (key_pressed(Key::digit3)) ui.camera = Camera::top;
-  if (key_pressed(Key::digit4)) ui.camera = Camera::side;
-  const bool keyboard_flies = run.input && run.input->pilot == "keyboard" && !run.replay;
-  if (key_pressed(Key::d) && !keyboard_flies) ui.show_sticks = !ui.show_sticks;
-  if (key_pressed(Key::i) && run.input) {
-    ui.show_settings = !ui.show_settings;
-    ui.draft_loaded = false;
-  }
-  if (key_pressed(Key::p)) set_plots_paused(ui, h, !ui.plots_paused);
-  if (key_pressed(Key::h)) ui.show_progress = !ui.show_progress;
-}
-
 }  // namespace
 
 namespace {
@@ -585,12 +492,21 @@ bool session_panel_shown(const RunInfo& run) {
          run.state != RunState::paused;
 }
 
+// The HUD's least width: its longest item's.
+float hud_least_width() {
+  return mono_font()->CalcTextSizeA(ImGui::GetFontSize(), FLT_MAX, 0.0f, kWidestHudItem).x +
+         2 * ImGui::GetStyle().WindowPadding.x;
+}
+
 // The session panel's width in a view `view_w` wide: narrower (down to what its buttons need)
-// where the view is narrow, to leave the scene some room.
+// where the view is narrow, to leave the scene some room and the HUD its place beside it (READY
+// shows the authority bar the flight starts with).
 float session_panel_width(float view_w) {
-  const float em = ImGui::GetFontSize();
-  return std::min(std::clamp(view_w - 10.0f * em, 14.0f * em, 20.0f * em),
-                  view_w - 2.0f * ImGui::GetStyle().WindowPadding.x);
+  const float em = ImGui::GetFontSize(), m = ImGui::GetStyle().WindowPadding.x;
+  return std::min(
+      std::clamp(std::min(view_w - 10.0f * em, view_w - 3.0f * m - hud_least_width()), 14.0f * em,
+                 20.0f * em),
+      view_w - 2.0f * m);
 }
 
 // A replay's Debrief panel (its window's name: the layout reads its last frame by it).
@@ -638,6 +554,14 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   const ImVec2 d = ImGui::GetIO().DisplaySize;
   const ImGuiStyle& st = ImGui::GetStyle();
   const float em = ImGui::GetFontSize();
+  focus_panels(ui);
+  ui.marks = TourMarks{};  // drawn again below
+  // READY: the chase camera turns, where it must, so that no obstacle hides the vehicle.
+  if (run.state == RunState::ready && !h.empty()) {
+    const ChasePose pose = clear_chase_pose(sc, h.newest());
+    ui.chase_turn = pose.turn;
+    ui.chase_rise = pose.rise;
+  }
   // The panes take their heights from their content (top bar, transport), the view the rest.
   const float top = top_bar(sc, h, run, ui, out, d.x);
   float bottom = 0.0f;
@@ -672,8 +596,7 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
     ImGui::End();
   }
 
-  const float hud_least =
-      mono_font()->CalcTextSizeA(em, FLT_MAX, 0.0f, kWidestHudItem).x + 2 * st.WindowPadding.x;
+  const float hud_least = hud_least_width();
   // A replay's Debrief panel (L) at the view's left like the session panel, the HUD beside it
   // where both fit; else under the HUD (which the authority bar keeps first), where there is
   // room for a few rows of it.
@@ -704,7 +627,7 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
     const float w = std::min(std::clamp(0.6f * view_w, 28.0f * em, 43.0f * em), room);
     if (w >= hud_least) {
       const float x = std::max(lo, std::min(vmin.x + 0.5f * (view_w - w), vmax.x - m - w));
-      hud_bottom = hud(sc, h, run, ImVec2(x, top + m), w, vmax.y - vmin.y < 24.0f * em);
+      hud_bottom = hud(sc, h, run, ImVec2(x, top + m), w, vmax.y - vmin.y < 24.0f * em, ui.marks);
     }
   }
   if (debrief && !debrief_beside) {
@@ -759,6 +682,8 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
     ImGui::SetNextWindowPos(sticks_min);
     ImGui::SetNextWindowSize(sticks_size);
     ImGui::Begin("##sticks", nullptr, kOverlay);
+    ui.marks.sticks_min = sticks_min;
+    ui.marks.sticks_max = ImVec2(sticks_min.x + sticks_size.x, sticks_min.y + sticks_size.y);
     const ImVec2 p = ImGui::GetCursorScreenPos();
     draw_sticks(h.newest(), sc.hover_rotor_speed, p,
                 ImVec2(p.x + sticks_size.x - 2 * st.WindowPadding.x,
@@ -775,7 +700,7 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
 
   if (run.metrics.empty()) ui.score_card_closed = false;
   else if (!ui.score_card_closed) score_card(run, ui, d);
-  if (ui.show_help) help_sheet(ui, d);
+  if (ui.show_help) draw_help_sheet(run, ui, out, d);
   if (ui.show_progress) {
     static const HistoryView kOff = [] {
       HistoryView v;
@@ -789,7 +714,11 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   draw_input_settings(run, ui, out);
   draw_mapping_wizard(run, out);
   draw_open_dialog(ui, out);
-  keys(ui, out, run, h);
+  // The keys before the welcome and the tour, which take theirs (a key that ends them is not
+  // acted on again here).
+  handle_keys(ui, out, run, h);
+  draw_first_launch(run, ui, out, d);
+  update_keyboard_focus(ui, run);
   if (run.input && run.input->pilot == "keyboard" && !run.replay)
     out.push_back(HeldFlightKeys{held_flight_keys()});
 }

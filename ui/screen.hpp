@@ -166,6 +166,7 @@ struct RunInfo {
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
   const HistoryView* history = nullptr;     // trainees and progress (nullptr: no history)
   bool instructor_paused = false;  // the instructor paused the flight (SPEC §10)
+  float text_scale = 1.0f;  // the user's text size: a factor on the display's scale
 };
 
 // What a field of a mode's report means, with its unit ("" for a field it does not know).
@@ -185,6 +186,18 @@ struct OpenDialog {
   std::vector<std::string> entries;  // sub-folders (ending in '/') then .toml and .mcap files
   std::string error;                 // why the folder could not be listed
   char path[1024] = "";              // the path being typed or picked
+};
+
+// The first launch (ui/first_launch.hpp): the welcome with its three ways in, then the tour.
+enum class FirstLaunch { none, welcome, tour };
+
+// Where the last frame drew what the tour points at (screen pixels; empty: not drawn).
+struct TourMarks {
+  ImVec2 bar_min{0, 0}, bar_max{0, 0};        // the authority bar
+  ImVec2 ball_centre{0, 0};                   // the ball B around the reference point
+  float ball_radius = 0.0f;
+  ImVec2 sticks_min{0, 0}, sticks_max{0, 0};  // the sticks overlay
+  ImVec2 start_min{0, 0}, start_max{0, 0};    // the Start button
 };
 
 // The UI's own state: kept by the app between frames, changed only by the UI.
@@ -208,6 +221,19 @@ struct UiState {
   input::InputSettings draft;        // the settings being edited there
   bool draft_loaded = false;
   float session_choices_h = 0.0f;    // [px] the session panel's choices, as last drawn
+  // The keyboard in the panels (ImGui's navigation) rather than on the flight (ui/shortcuts.hpp),
+  // and the panel to give it to in this frame.
+  bool keyboard_in_panels = false;
+  bool focus_panels = false;
+  // The first launch (ui/first_launch.hpp): what shows, the tour's step, the course's trainee.
+  FirstLaunch first_launch = FirstLaunch::none;
+  int tour_step = 0;
+  char course_trainee[64] = "";
+  TourMarks marks;
+  // The chase camera's turn about the vertical from behind the vehicle [rad] and its rise [m],
+  // chosen at READY so that no obstacle stands between it and the vehicle
+  // (ui/chase_camera.hpp), kept in flight.
+  double chase_turn = 0.0, chase_rise = 0.0;
 };
 
 // The index of the next (direction +1) or previous (−1) event starting after / before `t`,

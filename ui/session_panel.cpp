@@ -12,6 +12,11 @@ namespace mixpilot::ui {
 
 namespace {
 
+// What the item just drawn does, on hover (every control has one).
+void tip(const char* text) {
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", text);
+}
+
 bool combo(const char* label, const std::vector<std::string>& items, int current, int& chosen) {
   bool changed = false;
   const char* preview = current >= 0 && current < int(items.size()) ? items[std::size_t(current)].c_str() : "";
@@ -144,12 +149,13 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float ma
   ImGui::SetNextItemWidth(fields);
   int chosen = -1;
   if (combo("scenario", c.scenarios, c.scenario, chosen)) out.push_back(PickScenario{chosen});
-  if (lesson && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-    ImGui::SetTooltip("The lesson's step sets the scenario (lesson: none to choose one)");
+  tip(lesson ? "The lesson's step sets the scenario (lesson: none to choose one)"
+             : "What the next flight flies: a shipped scenario, or a file opened (Ctrl+O)");
   ImGui::EndDisabled();
   if (!c.pilots.empty()) {
     ImGui::SetNextItemWidth(fields);
     if (combo("pilot", c.pilots, c.pilot, chosen)) out.push_back(PickPilot{chosen});
+    tip("Who flies: an emulated pilot of the scenario, your gamepad or your keyboard");
   }
   if (run.input && !run.input->pilot.empty()) {
     if (run.input->pilot == "keyboard")
@@ -159,11 +165,15 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float ma
     else
       ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCaution), "no gamepad connected");
   }
-  if (run.input && ImGui::Button("Input settings... (I)")) {
-    ui.show_settings = true;
-    ui.draft_loaded = false;
+  if (run.input) {
+    if (ImGui::Button("Input settings... (I)")) {
+      ui.show_settings = true;
+      ui.draft_loaded = false;
+    }
+    tip("Stick mode, curves, deadzones, input loss and the haptic cue; map a gamepad");
   }
   if (ImGui::Button("Open file... (Ctrl+O)")) ui.open_dialog.open = true;
+  tip("Open a scenario (.toml) to fly or a recording (.mcap) to replay");
   if (run.history) {
     same_line_or_wrap(button_width("Progress (H)"));
     if (ImGui::Button("Progress (H)")) ui.show_progress = !ui.show_progress;
@@ -209,6 +219,7 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float ma
   }
   bool record = c.record;
   if (ImGui::Checkbox("record (Ctrl+R)", &record)) out.push_back(SetRecord{record});
+  tip("Record the next flight (MCAP) to replay it, debrief it or race it as a ghost");
   if (c.record && !c.record_to.empty()) ImGui::TextDisabled("to %s", c.record_to.c_str());
   ImGui::PopTextWrapPos();
   ImGui::EndDisabled();
@@ -223,6 +234,9 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float ma
                                   ? "Start step " + std::to_string(c.lesson_view.step + 1) + " (Space)"
                                   : std::string("Start flight (Space)");
     if (ImGui::Button(start.c_str(), ImVec2(-1, 0))) out.push_back(StartFlight{});
+    tip(lesson_closed ? "This step cannot be flown now (see above)" : "Start the flight");
+    ui.marks.start_min = ImGui::GetItemRectMin();  // what the tour points at
+    ui.marks.start_max = ImGui::GetItemRectMax();
     ImGui::EndDisabled();
   } else if (run.can_restart) {
     const std::string again = !flying && lesson && !c.lesson_view.next.empty()
@@ -230,6 +244,7 @@ void draw_session_panel(const RunInfo& run, UiState& ui, Requests& out, float ma
                                   : std::string(flying ? "Restart (R)" : "Fly again (R)");
     ImGui::BeginDisabled(!flying && lesson_closed);
     if (ImGui::Button(again.c_str(), ImVec2(-1, 0))) out.push_back(RestartFlight{});
+    tip("Fly again from the start (a lesson: its step now)");
     ImGui::EndDisabled();
   }
 }
@@ -279,7 +294,9 @@ void draw_open_dialog(UiState& ui, Requests& out) {
   ImGui::TextUnformatted(folder.c_str());
   if (folder != d.folder && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", d.folder.c_str());
   ImGui::SameLine();
-  if (ImGui::SmallButton("up")) {
+  const bool up = ImGui::SmallButton("up");
+  tip("The folder above");
+  if (up) {
     d.folder = std::filesystem::path(d.folder).parent_path().string();
     list_folder(d);
   }
@@ -288,7 +305,9 @@ void draw_open_dialog(UiState& ui, Requests& out) {
   if (!d.error.empty()) ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(colour::kCritical), "%s", d.error.c_str());
   std::string enter, open;  // a folder to enter, a file to open
   for (const std::string& e : d.entries) {
-    if (ImGui::Selectable(e.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick)) {
+    const bool picked = ImGui::Selectable(e.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick);
+    tip(e.ends_with("/") ? "Open this folder" : "Pick this file; a double click opens it");
+    if (picked) {
       const std::string full = (std::filesystem::path(d.folder) / e).string();
       if (e.ends_with("/")) {
         enter = (std::filesystem::path(d.folder) / e.substr(0, e.size() - 1)).string();
@@ -306,10 +325,15 @@ void draw_open_dialog(UiState& ui, Requests& out) {
   const float button_w = std::max(button_width("Open"), button_width("Cancel"));
   ImGui::SetNextItemWidth(-2 * (button_w + ImGui::GetStyle().ItemSpacing.x));
   const bool typed = ImGui::InputText("##path", d.path, sizeof d.path, ImGuiInputTextFlags_EnterReturnsTrue);
+  tip("The file to open: picked above, or typed (Enter opens it)");
   ImGui::SameLine();
-  if ((ImGui::Button("Open", ImVec2(button_w, 0)) || typed) && d.path[0] != '\0') open = d.path;
+  const bool open_pressed = ImGui::Button("Open", ImVec2(button_w, 0));
+  tip("Fly the scenario or replay the recording");
+  if ((open_pressed || typed) && d.path[0] != '\0') open = d.path;
   ImGui::SameLine();
-  if (ImGui::Button("Cancel", ImVec2(button_w, 0)) || key_pressed(Key::escape)) d.open = false;
+  const bool cancel = ImGui::Button("Cancel", ImVec2(button_w, 0));
+  tip("Close without opening anything (Esc)");
+  if (cancel || key_pressed(Key::escape)) d.open = false;
   if (!open.empty()) {
     out.push_back(OpenFile{std::move(open)});
     d.open = false;

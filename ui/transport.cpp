@@ -135,11 +135,17 @@ void draw_transport(const RunInfo& run, Requests& out) {
   dl->AddCircleFilled(ImVec2(x_of(r.t), ty), scaled(7.0f), colour::kText, 16);
 
   // The controls, wrapping onto more rows where the bar is narrow.
+  const auto tip = [](const char* text) {
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", text);
+  };
   if (ImGui::Button(r.playing ? "Pause (Space)" : "Play (Space)")) out.push_back(TogglePlay{});
+  tip(r.playing ? "Stop the playhead" : "Play the recording from the playhead");
   same_line_or_wrap(button_width("< previous event ["));
   if (ImGui::Button("< previous event [")) out.push_back(JumpToEvent{-1});
+  tip("Select the debrief's event before the playhead and go to its start");
   same_line_or_wrap(button_width("] next event >"));
   if (ImGui::Button("] next event >")) out.push_back(JumpToEvent{+1});
+  tip("Select the debrief's event after the playhead and go to its start");
   // "Export clip" saves the selected event with kClipHalfWidth either side, or the playhead's.
   const bool event_clip = r.selected >= 0 && std::size_t(r.selected) < r.events.size();
   const char* clip_label = event_clip ? "Export event clip (E)" : "Export clip (E)";
@@ -174,6 +180,7 @@ void draw_transport(const RunInfo& run, Requests& out) {
     std::snprintf(label, sizeof label, "%gx", sp);
     same_line_or_wrap(radio_width(label));
     if (ImGui::RadioButton(label, run.speed == sp)) out.push_back(SetPlaySpeed{sp});
+    tip("Replay speed (Up / Down)");
   }
   const float slider_w = 7.5f * ImGui::GetFontSize();
   same_line_or_wrap(slider_w);

@@ -303,6 +303,8 @@ ImU32 role_colour(SeriesRole role, int i) {
 void draw_plots(const Scene& sc, const History& h, UiState& ui) {
   bool paused = ui.plots_paused;
   if (ImGui::Checkbox("pause plots (P)", &paused)) set_plots_paused(ui, h, paused);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Freeze the plots to read them (the flight goes on)");
   if (h.empty()) return;
   const double t_end = ui.plots_paused ? ui.plots_paused_at : h.newest().t;
   // The plots share the pane's height; below a readable height each (its two axis labels and
