@@ -21,6 +21,7 @@
 #include "app/take_over.hpp"
 #include "app/wizard_controller.hpp"
 #include "ui/requests.hpp"
+#include "ui/score_card.hpp"
 #include "ui/screen.hpp"
 
 namespace mixpilot::cli {
@@ -71,6 +72,9 @@ class Trainer {
   void leave_replay();
   void fly_from_here();    // the replay's playhead: a moment made ready for a live flight
   void poll_take_over();   // ... and once it is, the live flight READY there
+  // The score card of the flight on screen (ui/score_card.hpp), made again when what it is
+  // made of changes (the history's snapshot, the debrief, the flight).
+  void update_card();
 
   // Declared before the controllers, which say things into it and outlive none of it.
   ui::RunInfo run_;  // the frame's snapshot
@@ -87,6 +91,19 @@ class Trainer {
   ReplayController replay_;
   std::unique_ptr<TakeOver> take_over_;  // after replay_: it outlives no replay
   ui::UiState ui_;
+  ui::ScoreCard card_;
+  // What card_ was made of: the flight or replay, its metrics, its debrief, the history.
+  struct CardKey {
+    const void* flight = nullptr;
+    std::size_t metrics = 0;
+    const void* events = nullptr;
+    std::size_t event_count = 0;
+    bool events_ready = false;
+    const void* history = nullptr;
+    std::string verdict;  // a lesson step's, once the session panel has it
+    bool operator==(const CardKey&) const = default;
+  };
+  CardKey card_for_;
   ui::Requests requests_;  // this frame's; cleared each frame, its capacity kept
 };
 
