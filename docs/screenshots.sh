@@ -56,6 +56,12 @@ MIXPILOT_SHOT_DIR="$tmp" "$tests/test_fly_from_here_app" \
 cp "$tmp/input_settings.png" $out/input_settings.png
 cp "$tmp/progress.png" $out/progress.png
 cp "$tmp/fly_from_here.png" $out/fly_from_here.png
+# The score card after a trainee's first and third flight of mi_helix (novice, experienced,
+# reckless), each compared with the history the test keeps in its own data folder.
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_score_card" \
+  --gtest_filter='ScoreCardApp.TheSecondFlightShowsTheChangeSinceTheFirstAndTheBest' >/dev/null
+cp "$tmp/score_card_1_100.png" $out/score_card_first.png
+cp "$tmp/score_card_3_100.png" $out/score_card_third.png
 # The lesson picker: the beginner course of a trainee two steps in, after a failed attempt at
 # the third (the test fills a history of its own).
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_lesson" \
