@@ -484,6 +484,9 @@ void draw_score_card(const ScoreCard& c, bool replay, bool& open, ImVec2 display
   // The change since the last flight and against the best: an arrow's shape and a sign, not
   // colour alone.
   ImGui::Spacing();
+  // Two lines whatever the comparison says: the card keeps its height when the history's answer
+  // comes (ImGui fits a window to what it held the frame before).
+  const float compare_y = ImGui::GetCursorPosY();
   if (c.comparison == Comparison::compared) {
     const auto line = [](double change, const std::string& text) {
       ImGui::TextUnformatted(change > 0 ? "▲" : change < 0 ? "▼" : "=");
@@ -495,6 +498,9 @@ void draw_score_card(const ScoreCard& c, bool replay, bool& open, ImVec2 display
   } else {
     ImGui::TextUnformatted(c.note.c_str());
   }
+  const float two_lines = 2.0f * ImGui::GetTextLineHeightWithSpacing();
+  if (ImGui::GetCursorPosY() + st.ItemSpacing.y < compare_y + two_lines)
+    ImGui::Dummy(ImVec2(0.0f, compare_y + two_lines - ImGui::GetCursorPosY() - st.ItemSpacing.y));
   if (!c.dependence.empty()) {
     ImGui::Spacing();
     ImGui::TextUnformatted(c.dependence.c_str());

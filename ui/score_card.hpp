@@ -56,7 +56,7 @@ namespace mixpilot::ui {
 
 inline constexpr double kGoodSkill = 65.0;    // the beginner course's first bar
 inline constexpr double kLeaning = 0.25;      // the planner flew a quarter of the flight or more
-inline constexpr double kDominantCost = 2.0;  // [skill points] below it, no kind dominates
+inline constexpr double kDominantCost = 5.0;  // [skill points] below it, no kind dominates
 
 // What a mode's card puts first: its score field and which way is better.
 struct Headline {
