@@ -160,6 +160,10 @@ class FlightRig {
                                                                    std::string& error,
                                                                    bool hash = true) const;
   std::string recording_path() const { return record_path_; }
+  // Who flies it as remember() was told ("" the account's login name), and when start() was
+  // called (Unix ms; 0 before): a live flight's history row has both.
+  const std::string& trainee() const { return trainee_; }
+  std::int64_t started_unix_ms() const { return started_unix_ms_; }
 
   Mode& mode() { return *flight_.mode; }
   const Mode& mode() const { return *flight_.mode; }

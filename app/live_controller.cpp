@@ -114,6 +114,7 @@ std::unique_ptr<LiveFlight> LiveController::make_live(std::string& error, int& s
   }
   f->rig->pace(8192);
   const Mode& mode = f->rig->mode();
+  f->debrief.setup(debrief_settings(mode));
   std::string source = flight.pilot.empty() ? std::string("the thesis's controller")
                                              : "pilot " + flight.pilot;
   if (from_) source += ", " + fly_from_text(*from_);
@@ -154,7 +155,10 @@ void LiveController::update_vehicle_wait(LiveFlight& f) {
 
 void LiveController::close_live(LiveFlight& f) {
   f.rig->stop();
-  while (f.runner().telemetry().pop(f.sample)) f.history.push(f.sample);
+  while (f.runner().telemetry().pop(f.sample)) {
+    f.history.push(f.sample);
+    f.debrief.add(f.sample);
+  }
   const bool flown = f.started();
   const FlightRig::Closed& c = f.closing = f.rig->close(!f.mode().finished());
   if (flown && f.rig->session().ended_by_instructor())
@@ -906,6 +910,7 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
   if (!f.closed()) {
     while (f.runner().telemetry().pop(f.sample)) {
       f.history.push(f.sample);
+      f.debrief.add(f.sample);
       ui::count_step(f.sample, f.counts);
     }
   }
@@ -916,8 +921,12 @@ void LiveController::update(bool pad_connected, ui::RunInfo& run) {
   const bool over = f.started() && !f.runner().running();
   // The run is over: its recording is completed at once, and the score card shows.
   if (over && !f.closed()) close_live(f);
-  if (over && f.metrics.empty())
+  if (over && f.metrics.empty()) {
     f.metrics = f.rig->metrics();
+    f.debrief.finish();
+    f.events = ui::debrief_rows(f.debrief.events(), f.debrief.settings().ball_radius);
+    f.events_ready = true;
+  }
   run.state = f.awaiting_vehicle ? ui::RunState::waiting
               : !f.started() ? ui::RunState::ready
               : mode.lost() ? ui::RunState::lost

@@ -15,6 +15,7 @@
 #include "app/input_controller.hpp"
 #include "app/lesson.hpp"
 #include "app/status_line.hpp"
+#include "core/modes/debrief.hpp"
 #include "core/runtime/realtime_runner.hpp"
 #include "ui/requests.hpp"
 #include "ui/screen.hpp"
@@ -36,6 +37,11 @@ struct LiveFlight {
   bool awaiting_vehicle = false, no_vehicle = false;
   FlightRig::Closed closing;  // what closing the flight did (its recording, the publisher)
   Metrics metrics;   // once the run is over
+  // The flight's debrief (SPEC §10), built from the telemetry as the screen takes it (the same
+  // builder as the recorder's), and its rows once the run is over: the score card's events.
+  DebriefBuilder debrief;
+  std::vector<ui::DebriefRow> events;
+  bool events_ready = false;
   // What a ghost of this flight must be a flight of (app/ghost.hpp); nullopt: it has none.
   std::optional<GhostTarget> ghost_target;
 

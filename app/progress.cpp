@@ -81,6 +81,8 @@ ui::ProgressView progress_view(const std::vector<history::StoredFlight>& rows,
     // and column are the assisted flights'.
     if (!f.probe) f.dependence = metric_of(r, "assistance_dependence").value_or(ui::kNoValue);
     f.duration_s = r.duration_s;
+    f.started_unix_ms = r.started_unix_ms;
+    f.metrics = r.metrics;
     f.when = local_minutes(r.started_unix_ms);
     f.ended = history::to_string(r.ended);
     f.from_step = r.parent_step;

@@ -85,6 +85,7 @@ void Trainer::build_frame(double wall_dt) {
   else if (live_.flight()) live_.update(input_.info().connected, run_);
   update_welcome();
   run_.text_scale = window_settings_.text_scale;
+  update_card();
   requests_.clear();
   if (replay_.is_open()) {
     ui::draw_screen(replay_.scene(), replay_.shown(), run_, ui_, requests_);
@@ -201,6 +202,48 @@ void Trainer::leave_replay() {
   replay_.close();
   status_.say("");
   live_.reopen();
+}
+
+void Trainer::update_card() {
+  const LiveFlight* f = replay_.is_open() ? nullptr : live_.flight();
+  if (run_.metrics.empty() || (!f && !replay_.is_open())) {
+    run_.card = nullptr;
+    card_for_ = {};
+    return;
+  }
+  const std::vector<ui::DebriefRow>& events = f ? f->events : run_.replay->events;
+  CardKey key;
+  key.flight = f ? static_cast<const void*>(f) : static_cast<const void*>(replay_.tape());
+  key.metrics = run_.metrics.size();
+  key.events = events.data();
+  key.event_count = events.size();
+  key.events_ready = f ? f->events_ready : run_.replay->events_ready;
+  key.history = history_view_.get();
+  if (f && f->closing.verdict && run_.session) key.verdict = run_.session->lesson_view.verdict;
+  run_.card = &card_;
+  if (key == card_for_) return;
+  card_for_ = key;
+  ui::FlightOutcome o;
+  o.metrics = run_.metrics;
+  o.events = events;
+  o.events_ready = key.events_ready;
+  o.history = history_view_.get();
+  const ui::Scene& scene = f ? f->scene : replay_.scene();
+  o.mode = scene.mode;
+  o.probe = scene.probe;
+  o.scenario = scene.title;
+  if (f) {
+    o.trainee = f->rig->trainee().empty() ? history::login_name() : f->rig->trainee();
+    o.started_unix_ms = f->rig->started_unix_ms();
+    // A lesson step's attempt: the panel's view holds its verdict.
+    if (f->closing.verdict && run_.session) o.lesson = &run_.session->lesson_view;
+  } else {
+    // A replay is compared when its recording is among the flights of the trainee shown.
+    o.replay = true;
+    o.recording = replay_.tape()->path();
+    if (history_view_) o.trainee = history_view_->progress.trainee;
+  }
+  card_ = ui::score_card_of(o);
 }
 
 bool Trainer::over() const { return replay_.is_open() ? replay_.over() : live_.over(); }

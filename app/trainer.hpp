@@ -22,6 +22,7 @@
 #include "app/window_settings.hpp"
 #include "app/wizard_controller.hpp"
 #include "ui/requests.hpp"
+#include "ui/score_card.hpp"
 #include "ui/screen.hpp"
 
 namespace mixpilot::cli {
@@ -80,6 +81,9 @@ class Trainer {
   void update_welcome();
   void first_launch(const ui::FirstLaunchChoice& c);
   void save_window_settings(const char* what);
+  // The score card of the flight on screen (ui/score_card.hpp), made again when what it is
+  // made of changes (the history's snapshot, the debrief, the flight).
+  void update_card();
 
   // Declared before the controllers, which say things into it and outlive none of it.
   ui::RunInfo run_;  // the frame's snapshot
@@ -99,6 +103,19 @@ class Trainer {
   // window.toml: the text size and whether the welcome was done with.
   WindowSettings window_settings_;
   bool welcome_pending_ = false;  // the welcome may show, once the history is read
+  ui::ScoreCard card_;
+  // What card_ was made of: the flight or replay, its metrics, its debrief, the history.
+  struct CardKey {
+    const void* flight = nullptr;
+    std::size_t metrics = 0;
+    const void* events = nullptr;
+    std::size_t event_count = 0;
+    bool events_ready = false;
+    const void* history = nullptr;
+    std::string verdict;  // a lesson step's, once the session panel has it
+    bool operator==(const CardKey&) const = default;
+  };
+  CardKey card_for_;
   ui::Requests requests_;  // this frame's; cleared each frame, its capacity kept
 };
 

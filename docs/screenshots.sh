@@ -64,6 +64,12 @@ MIXPILOT_SHOT_DIR="$tmp" "$tests/test_onboarding" \
 for at in 100 150; do cp "$tmp/first_launch_welcome_$at.png" $out/first_launch_$at.png; done
 for step in 1 2 3 4; do cp "$tmp/first_launch_tour_${step}_100.png" $out/tour_${step}_100.png; done
 cp "$tmp/first_launch_tour_1_150.png" $out/tour_1_150.png
+# The score card after a trainee's first and third flight of mi_helix (novice, experienced,
+# reckless), each compared with the history the test keeps in its own data folder.
+MIXPILOT_SHOT_DIR="$tmp" "$tests/test_score_card" \
+  --gtest_filter='ScoreCardApp.TheSecondFlightShowsTheChangeSinceTheFirstAndTheBest' >/dev/null
+cp "$tmp/score_card_1_100.png" $out/score_card_first.png
+cp "$tmp/score_card_3_100.png" $out/score_card_third.png
 # The lesson picker: the beginner course of a trainee two steps in, after a failed attempt at
 # the third (the test fills a history of its own).
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_lesson" \

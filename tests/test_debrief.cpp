@@ -812,9 +812,9 @@ TEST(Debrief, ExportClipSavesTheSelectedEvent) {
   r.duration = 30.0;
   r.t = 20.0;
   r.events_ready = true;
-  r.events = {{2.0, 4.5, DebriefKind::takeover, "planner took over"},
-              {12.0, 12.5, DebriefKind::near_miss, "near miss"},
-              {27.0, 29.0, DebriefKind::near_miss, "near miss"}};
+  r.events = {{2.0, 4.5, DebriefKind::takeover, "planner took over", {}},
+              {12.0, 12.5, DebriefKind::near_miss, "near miss", {}},
+              {27.0, 29.0, DebriefKind::near_miss, "near miss", {}}};
   const ui::ExportClip none = ui::clip_of(r);
   EXPECT_EQ(none.from, 15.0);
   EXPECT_EQ(none.to, 25.0);

@@ -25,6 +25,7 @@
 #include "ui/screen.hpp"
 #include "ui/panels.hpp"
 #include "ui/requests.hpp"
+#include "ui/score_card.hpp"
 #include "ui/theme.hpp"
 
 #include "ui_layout.hpp"
@@ -110,7 +111,7 @@ TEST_F(Ui, AuthorityBarFillMatchesLambda) {
     for (int x = 0; x < kW; ++x) {
       const std::uint8_t* p = &px[(std::size_t(y) * kW + std::size_t(x)) * 4];
       a += near(p, rgb_of(ui::colour::kPilot)) ? 1 : 0;
-      b += near(p, rgb_of(ui::colour::kPlanner)) ? 1 : 0;
+      b += near(p, rgb_of(ui::colour::kPlannerFill)) ? 1 : 0;
     }
     if (a > 100 && b > 0 && a + b > 300) {
       best_row = y;

@@ -666,7 +666,7 @@ void draw_lambda_strip(const History& h, double seconds, ImVec2 min, ImVec2 max)
   const std::size_t first = h.first_at_or_after(t0);
   const float x_first = x_of(h[first].t);
   // The planner's share: the strip's orange, hatched (greyscale tells it from the pilot's).
-  dl->AddRectFilled(ImVec2(x_first, min.y), max, colour::kPlanner);
+  dl->AddRectFilled(ImVec2(x_first, min.y), max, colour::kPlannerFill);
   const float step = scaled(6.0f);
   dl->PushClipRect(ImVec2(x_first, min.y), max, true);
   for (float x = x_first - ht; x < max.x; x += step)

@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <imgui.h>
@@ -24,6 +25,7 @@ struct ProgressFlight {
   double skill = kNoValue;         // 0-100
   double dependence = kNoValue;    // D, the share of the flight the planner flew (0-1)
   double duration_s = 0.0;
+  std::int64_t started_unix_ms = 0;  // when it started (finds a flight just flown in the history)
   std::string when;                // local time, "YYYY-MM-DD HH:MM"
   std::string ended;               // completed | interrupted | lost
   std::string recording;           // its recording ("" none, or no longer on this disk)
@@ -31,6 +33,8 @@ struct ProgressFlight {
                                    // is another scenario to a ghost)
   // A branch (fly from here): flown on from this step of another flight (−1: none).
   std::int64_t from_step = -1;
+  // Every score field of its row (the score card compares the mode's own score with them).
+  std::vector<std::pair<std::string, double>> metrics;
 };
 
 // A least-squares line through the last `over` skills of one kind of flight.

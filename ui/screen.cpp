@@ -14,6 +14,7 @@
 #include "ui/instructor_hud.hpp"
 #include "ui/reason.hpp"
 #include "ui/shortcuts.hpp"
+#include "ui/score_card.hpp"
 #include "ui/theme.hpp"
 
 namespace mixpilot::ui {
@@ -331,135 +332,6 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
 
 }  // namespace
 
-// What each field of every mode's report means (README, Scoring), for the score card.
-const char* score_field_meaning(const std::string& key) {
-  static const std::pair<const char*, const char*> kMeanings[] = {
-      {"duration_s", "time flown [s]"},
-      {"progress", "share of the reference flown"},
-      {"time_in_ball", "share of the time inside the ball B"},
-      {"max_deviation_m", "largest distance from the reference [m]"},
-      {"rms_deviation_m", "RMS distance from the reference [m]"},
-      {"mean_lambda", "mean authority of the pilot (1: all pilot)"},
-      {"min_lambda", "least authority of the pilot"},
-      {"assistance_dependence", "share of the flight the planner flew: mean of 1 - lambda"},
-      {"collisions", "contacts with obstacles, walls or floor"},
-      {"min_clearance_m", "closest approach to an obstacle [m]"},
-      {"override_rms", "RMS of what the MPC changed in the pilot's tilt [rad]"},
-      {"stick_smoothness", "RMS change of the pilot's command per step [rad]"},
-      {"rti_median_us", "median RTI time per step [us]"},
-      {"rti_p99_us", "99th percentile RTI time [us]"},
-      {"deadline_misses", "steps whose control came after their period (real time only)"},
-      {"fallbacks", "steps that applied the previous solution's input"},
-      {"skill", "the score: progress x quality / (1 + collisions), 0-100"},
-      {"input_lost_s", "time the pilot's input was lost: the planner flew [s]"},
-      {"safe_hold_s", "time the safe controller flew: the MPC fell behind [s]"},
-      {"lost", "1: the vehicle was lost"},
-      {"lost_at_s", "when it was lost [s]"},
-      {"rtt_s", "round-trip time to the vehicle (remote: the median sample) [s]"},
-      {"rtt_estimated_s", "the online round-trip estimate at the end [s]"},
-      // Pendubot swing-up (SPEC §5.1).
-      {"swingup_time_s", "when both links reached up-up and stayed there [s]"},
-      {"hold_time_s", "time balanced at up-up after the swing-up [s]"},
-      {"final_angle_norm", "distance of the links from up-up at the end [rad]"},
-      {"max_abs_u", "largest shoulder torque applied [N m]"},
-      {"velocity_violations", "steps whose joint speeds exceeded their bounds"},
-      {"worst_velocity_violation", "largest excess of a joint speed over its bound [rad/s]"},
-      {"tracking_rms", "RMS angle error against the swing-up reference [rad]"},
-      {"rti_max_us", "longest RTI time of a step [us]"},
-      {"nmpc_steps", "steps flown by the NMPC (the others by the LQR)"},
-      {"lqr_entry_time_s", "when the LQR first took over near the top [s]"},
-      {"lqr_time_s", "time flown by the LQR [s]"},
-      {"lqr_entries", "times the LQR took over"},
-      {"quantization", "1: angles read through quantizing encoders"},
-      // Tracking under delay (SPEC §5.2) and obstacle avoidance (SPEC §5.3).
-      {"tracking_rms_m", "RMS distance from the reference [m]"},
-      {"max_error_m", "largest distance from the reference [m]"},
-      {"final_error_m", "distance from the reference at the end [m]"},
-      {"overshoot_m", "how far past the step's target the vehicle went [m]"},
-      {"settle_time_s", "when the vehicle last entered 5 cm of the target [s]"},
-      {"lqr_median_us", "median LQR time per step [us]"},
-      {"lqr_p99_us", "99th percentile LQR time [us]"},
-      {"predictor_median_us", "median time of the delay predictor per step [us]"},
-      {"max_input_violation", "largest excess of a rotor command over its bounds [krpm]"},
-      {"compensation", "1: the state was predicted over the round trip"},
-      {"steps", "control steps flown"},
-      {"min_distance_m", "closest approach to an obstacle's centre [m]"},
-      {"min_margin_m", "closest approach less the clearance d_C [m]"},
-      {"min_distance_control_m", "closest approach at the control instants [m]"},
-      {"clearance_m", "the clearance d_C the constraint keeps [m]"},
-      {"violations", "steps that came closer than d_C"},
-      {"form", "0: the LCL constraint, 1: the squared form"},
-  };
-  for (const auto& [k, v] : kMeanings)
-    if (key == k) return v;
-  return "";
-}
-
-namespace {
-
-// The width of a table's last column, the explanations `texts`: as wide as the widest, or
-// narrower (its text wraps) where the display has less room beside the other columns (`fixed`
-// wide together).
-float wrapped_column(const char* const* texts, std::size_t count, float fixed, ImVec2 display) {
-  const ImGuiStyle& st = ImGui::GetStyle();
-  float widest = 0.0f;
-  for (std::size_t i = 0; i < count; ++i) widest = std::max(widest, ImGui::CalcTextSize(texts[i]).x);
-  const float room = display.x - 2.0f * ImGui::GetFontSize() - 2.0f * st.WindowPadding.x - fixed -
-                     6.0f * st.CellPadding.x - st.ScrollbarSize;
-  return std::max(8.0f * ImGui::GetFontSize(), std::min(widest, room));
-}
-
-// A modal-like window in the display's centre that fits its content, within the display (it
-// scrolls when it would not fit).
-void begin_centred(const char* title, bool* open, ImVec2 display) {
-  const float margin = ImGui::GetFontSize();
-  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, 0.5f * display.y), ImGuiCond_Always,
-                          ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSizeConstraints(
-      ImVec2(0, 0), ImVec2(std::max(1.0f, display.x - 2 * margin), std::max(1.0f, display.y - 2 * margin)));
-  ImGui::Begin(title, open,
-               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
-                   ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);
-}
-
-void score_card(const RunInfo& run, UiState& ui, ImVec2 display) {
-  bool open = true;
-  begin_centred("Score card", &open, display);
-  std::vector<const char*> meanings;
-  float key_w = 0.0f;
-  for (const auto& [key, value] : run.metrics) {
-    meanings.push_back(score_field_meaning(key));
-    key_w = std::max(key_w, ImGui::CalcTextSize(key.c_str()).x);
-  }
-  ImGui::PushFont(mono_font());
-  const float value_w = ImGui::CalcTextSize("-0.0000e+00").x;
-  ImGui::PopFont();
-  const float meaning_w = wrapped_column(meanings.data(), meanings.size(), key_w + value_w, display);
-  if (ImGui::BeginTable("##score", 3, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
-    ImGui::TableSetupColumn("key", ImGuiTableColumnFlags_WidthFixed, key_w);
-    ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthFixed, value_w);
-    ImGui::TableSetupColumn("meaning", ImGuiTableColumnFlags_WidthFixed, meaning_w);
-    for (const auto& [key, value] : run.metrics) {
-      ImGui::TableNextRow();
-      ImGui::TableNextColumn();
-      ImGui::TextUnformatted(key.c_str());
-      ImGui::TableNextColumn();
-      ImGui::PushFont(mono_font());
-      ImGui::Text("%10.4g", value);
-      ImGui::PopFont();
-      ImGui::TableNextColumn();
-      ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
-      ImGui::TextWrapped("%s", score_field_meaning(key));
-      ImGui::PopStyleColor();
-    }
-    ImGui::EndTable();
-  }
-  ImGui::End();
-  if (!open) ui.score_card_closed = true;
-}
-
-}  // namespace
-
 namespace {
 
 // The height ImGui gave the pane `name` in the last frame (its content's), else `fallback`.
@@ -698,8 +570,19 @@ void draw_screen(const Scene& sc, const History& h, const RunInfo& run, UiState&
   draw_plots(sc, h, ui);
   ImGui::End();
 
-  if (run.metrics.empty()) ui.score_card_closed = false;
-  else if (!ui.score_card_closed) score_card(run, ui, d);
+  if (run.metrics.empty()) {
+    ui.score_card_closed = false;
+  } else if (!ui.score_card_closed) {
+    bool open = true;
+    if (run.card) {
+      draw_score_card(*run.card, run.replay != nullptr, open, d, out);
+    } else {  // the score fields alone (a caller that made no card)
+      FlightOutcome o;
+      o.metrics = run.metrics;
+      draw_score_card(score_card_of(o), false, open, d, out);
+    }
+    if (!open) ui.score_card_closed = true;
+  }
   if (ui.show_help) draw_help_sheet(run, ui, out, d);
   if (ui.show_progress) {
     static const HistoryView kOff = [] {

@@ -23,6 +23,8 @@
 
 namespace mixpilot::ui {
 
+struct ScoreCard;  // ui/score_card.hpp
+
 enum class Camera { chase, orbit, top, side };
 const char* to_string(Camera c);
 
@@ -38,6 +40,7 @@ struct DebriefRow {
   double end = 0.0;  // [s] its end (t for a moment: a lost vehicle, a marker)
   DebriefKind kind = DebriefKind::takeover;
   std::string text;  // what happened, in words (describe())
+  DebriefEvent event;  // as the builder made it (the score card weighs what it cost)
 };
 
 // The rows of a flight's debrief events (as the builder lists them: in the order they closed),
@@ -160,7 +163,9 @@ struct RunInfo {
   bool can_restart = false;      // the app can start the flight again (Restart, R)
   std::string message;           // a line for the status area ("" none)
   bool message_is_error = false;
-  Metrics metrics;               // the score card at the end of a flight (empty: none yet)
+  Metrics metrics;               // the score fields at the end of a flight (empty: none yet)
+  // The score card made of them (ui/score_card.hpp; nullptr: one of the metrics alone).
+  const ScoreCard* card = nullptr;
   const SessionChoices* session = nullptr;  // the session panel (nullptr: none, e.g. headless)
   const ReplayInfo* replay = nullptr;       // a replay's transport (nullptr: a live flight)
   const InputInfo* input = nullptr;         // the input devices (nullptr: none, e.g. headless)
@@ -169,8 +174,6 @@ struct RunInfo {
   float text_scale = 1.0f;  // the user's text size: a factor on the display's scale
 };
 
-// What a field of a mode's report means, with its unit ("" for a field it does not know).
-const char* score_field_meaning(const std::string& key);
 
 // Adds step `s` to the run's counts: the live flight, a replay's tape and a headless
 // screenshot count the same events.

@@ -10,6 +10,7 @@ namespace {
 
 ImFont* g_mono = nullptr;
 ImFont* g_heading = nullptr;
+ImFont* g_large = nullptr;
 float g_scale = 1.0f;
 
 // The file fontconfig matches for `family` ("DejaVu Sans") in `style` ("" regular, ":bold"),
@@ -39,7 +40,7 @@ std::string find_font(const char* family, const char* style = "") {
 
 ImU32 authority_colour(double lambda) {
   const double l = std::clamp(lambda, 0.0, 1.0);
-  const ImVec4 a = ImGui::ColorConvertU32ToFloat4(colour::kPlanner);
+  const ImVec4 a = ImGui::ColorConvertU32ToFloat4(colour::kPlannerFill);
   const ImVec4 b = ImGui::ColorConvertU32ToFloat4(colour::kPilot);
   const auto mix = [l](float x, float y) { return float((1.0 - l) * x + l * y); };
   return ImGui::ColorConvertFloat4ToU32(ImVec4(mix(a.x, b.x), mix(a.y, b.y), mix(a.z, b.z), 1.0f));
@@ -78,8 +79,14 @@ std::string load_fonts(float scale) {
   }
   g_mono = nullptr;
   g_heading = nullptr;
+  g_large = nullptr;
   if (main && !mono.empty())
     g_mono = io.Fonts->AddFontFromFileTTF(mono.c_str(), px, nullptr, ranges);
+  // The score card's score: bold at 2.4 times the text, ASCII only (a number and its words).
+  static const ImWchar ascii[] = {0x0020, 0x007E, 0};
+  const std::string bold = main ? find_font("DejaVu Sans", ":bold") : std::string();
+  if (!bold.empty())
+    g_large = io.Fonts->AddFontFromFileTTF(bold.c_str(), std::round(px * kLargeFactor), nullptr, ascii);
   return main ? sans : std::string();
 }
 
@@ -97,5 +104,7 @@ ImFont* add_heading_font(float scale, float factor) {
 }
 
 ImFont* heading_font() { return g_heading; }
+
+ImFont* large_font() { return g_large; }
 
 }  // namespace mixpilot::ui

@@ -14,7 +14,8 @@ namespace mixpilot::ui {
 std::vector<DebriefRow> debrief_rows(const std::vector<DebriefEvent>& events, double ball_radius) {
   std::vector<DebriefRow> rows;
   rows.reserve(events.size());
-  for (const DebriefEvent& e : events) rows.push_back({e.start, e.end, e.kind, describe(e, ball_radius)});
+  for (const DebriefEvent& e : events)
+    rows.push_back({e.start, e.end, e.kind, describe(e, ball_radius), e});
   // The builder lists them as they closed; a list reads by start (ties: as they closed).
   std::stable_sort(rows.begin(), rows.end(),
                    [](const DebriefRow& a, const DebriefRow& b) { return a.t < b.t; });
@@ -40,19 +41,18 @@ ExportClip clip_of(const ReplayInfo& r) {
   return ExportClip{std::max(0.0, e.t - kClipHalfWidth), std::min(r.duration, e.end + kClipHalfWidth)};
 }
 
+// Colour says how serious an event was (its log level: warning, error, note), in colours
+// told apart in greyscale and by the colour blind (colour::kMustTellApart); the mark's shape
+// says which kind it was.
 ImU32 event_colour(DebriefKind k) {
-  switch (k) {
-    case DebriefKind::takeover: return colour::kPlanner;
-    case DebriefKind::near_miss: return colour::kCaution;
-    case DebriefKind::collision: return colour::kCritical;
-    case DebriefKind::fallback: return colour::kCaution;
-    case DebriefKind::input_lost: return colour::kPilot;
-    case DebriefKind::lost: return colour::kCritical;
-    case DebriefKind::safe_hold: return colour::kCritical;
-    case DebriefKind::marker:
-    case DebriefKind::instructor: return colour::kText;
+  switch (log_level(k)) {
+    case LogLevel::warn: return colour::kCaution;
+    case LogLevel::error:
+    case LogLevel::fatal: return colour::kCritical;
+    case LogLevel::debug:
+    case LogLevel::info: return colour::kNote;
   }
-  return colour::kText;
+  return colour::kNote;
 }
 
 // A mark's shape tells its kind without colour: takeover ▼, near miss ◆, collision ▲,

@@ -50,12 +50,13 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool 
                         const AuthorityBounds& bounds) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const double l = std::clamp(lambda, 0.0, 1.0);
-  // The pilot's share λ fills from the left in the pilot's colour, the planner's share 1 − λ
-  // the rest in the planner's colour; the needle sits at λ.
+  // The pilot's share λ fills from the left in the pilot's light blue, the planner's share
+  // 1 − λ the rest in the planner's dark orange (told apart by lightness too: greyscale, colour
+  // blindness); the needle sits at λ, cased in black, and an outline shows the whole bar.
   const auto x_of = [&](double v) { return float(min.x + std::clamp(v, 0.0, 1.0) * (max.x - min.x)); };
   const float x = x_of(l);
   const float round = scaled(4.0f);
-  dl->AddRectFilled(min, max, colour::kPlanner, round);
+  dl->AddRectFilled(min, max, colour::kPlannerFill, round);
   dl->AddRectFilled(min, ImVec2(x, max.y), colour::kPilot, round, ImDrawFlags_RoundCornersLeft);
   // The instructor's bounds: what λ cannot reach shaded and hatched, each bound a tick.
   const bool ceiling = bounds.ceiling < 1.0, floor = bounds.floor > 0.0;
@@ -80,7 +81,11 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool 
   if (floor) bound_tick(bounds.floor);
   const float mid = 0.5f * (min.x + max.x);  // the 0.5 tick
   dl->AddLine(ImVec2(mid, min.y - scaled(3)), ImVec2(mid, max.y + scaled(3)), colour::kText, scaled(1.0f));
-  dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));  // the needle
+  dl->AddRect(ImVec2(min.x - scaled(1), min.y - scaled(1)), ImVec2(max.x + scaled(1), max.y + scaled(1)),
+              colour::kBarOutline, round + scaled(1), 0, scaled(1.0f));
+  // The needle, cased.
+  dl->AddLine(ImVec2(x, min.y - scaled(6)), ImVec2(x, max.y + scaled(6)), colour::kNeedleCasing, scaled(6.0f));
+  dl->AddLine(ImVec2(x, min.y - scaled(5)), ImVec2(x, max.y + scaled(5)), colour::kText, scaled(3.0f));
   char bound_text[64] = "";
   if (floor && ceiling)
     std::snprintf(bound_text, sizeof bound_text, "floor %.2f · ceiling %.2f", bounds.floor,
