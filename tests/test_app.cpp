@@ -36,6 +36,7 @@
 #include "ui/theme.hpp"
 
 #include "app_window_test.hpp"
+#include "record_flight.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -58,19 +59,8 @@ cli::FlyOptions live_options(const char* name, double seconds, const char* pilot
 
 // A recording of `name` flown headless for `seconds`.
 std::string record(const char* name, double seconds, const char* pilot, const std::string& file) {
-  cli::FlyOptions o = live_options(name, seconds, pilot);
-  std::string error;
-  int status = 0;
-  auto rig = cli::FlightRig::assemble(o, error, status);
-  EXPECT_TRUE(rig) << error;
   const std::string path = test::fresh_path("app", file).string();
-  EXPECT_TRUE(rig->record(path, "", {}, false, error)) << error;
-  rig->start();
-  while (rig->step()) {
-  }
-  const cli::FlightRig::Closed closed = rig->close(false);
-  EXPECT_EQ(closed.error, "");
-  EXPECT_EQ(closed.recorded, path);
+  EXPECT_TRUE(test::record_flight(live_options(name, seconds, pilot), path));
   return path;
 }
 

@@ -31,6 +31,7 @@
 
 #include "run_mixpilot.hpp"
 #include "app_window_test.hpp"
+#include "record_flight.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -53,16 +54,8 @@ std::string record(double seconds, const char* pilot, const std::string& file,
   o.pilot = pilot;
   o.duration = seconds;
   o.assist = assist;
-  std::string error;
-  int status = 0;
-  auto rig = cli::FlightRig::assemble(o, error, status);
-  EXPECT_TRUE(rig) << error;
   const std::string path = test::fresh_path("fly_from_here_app", file).string();
-  EXPECT_TRUE(rig->record(path, "", {}, false, error)) << error;
-  rig->start();
-  while (rig->step()) {
-  }
-  EXPECT_EQ(rig->close(false).error, "");
+  EXPECT_TRUE(test::record_flight(o, path));
   return path;
 }
 

@@ -42,6 +42,7 @@
 #include "ui/theme.hpp"
 
 #include "run_mixpilot.hpp"
+#include "record_flight.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot {
@@ -84,18 +85,8 @@ std::string record(const std::string& scenario_file, const char* pilot, double s
   o.scenario_path = scenario_file;
   o.pilot = pilot;
   o.duration = seconds;
-  std::string error;
-  int status = 0;
-  auto rig = cli::FlightRig::assemble(o, error, status);
-  EXPECT_TRUE(rig) << error;
-  if (!rig) return "";
   const std::string path = test::fresh_path("ghost", file).string();
-  EXPECT_TRUE(rig->record(path, "", {}, false, error)) << error;
-  rig->start();
-  while (rig->step()) {
-  }
-  EXPECT_EQ(rig->close(false).error, "");
-  return path;
+  return test::record_flight(o, path) ? path : "";
 }
 
 RecordingContents read(const std::string& path) {

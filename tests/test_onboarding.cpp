@@ -32,6 +32,7 @@
 #include "ui/shortcuts.hpp"
 
 #include "app_window_test.hpp"
+#include "record_flight.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -87,16 +88,8 @@ std::string record(const char* name, double seconds, const std::string& file) {
   o.scenario_path = scenario(name);
   o.pilot = "novice";
   o.duration = seconds;
-  std::string error;
-  int status = 0;
-  auto rig = cli::FlightRig::assemble(o, error, status);
-  EXPECT_TRUE(rig) << error;
   const std::string path = test::fresh_path("onboarding", file).string();
-  EXPECT_TRUE(rig->record(path, "", {}, false, error)) << error;
-  rig->start();
-  while (rig->step()) {
-  }
-  EXPECT_EQ(rig->close(false).error, "");
+  EXPECT_TRUE(test::record_flight(o, path));
   return path;
 }
 

@@ -31,6 +31,7 @@
 #include "ui/theme.hpp"
 
 #include "app_window_test.hpp"
+#include "record_flight.hpp"
 #include "temp_files.hpp"
 #include "ui_layout.hpp"
 
@@ -478,15 +479,8 @@ TEST_F(ScoreCardApp, AReplaysCostlyEventJumpsThereWhenClicked) {
   fly.scenario_path = scenario("mi_helix.toml");
   fly.pilot = "reckless";
   fly.duration = 6.0;
-  int status = 0;
-  auto rig = cli::FlightRig::assemble(fly, error, status);
-  ASSERT_TRUE(rig) << error;
   const std::string path = test::fresh_path("score_card", "reckless.mcap").string();
-  ASSERT_TRUE(rig->record(path, "", {}, false, error)) << error;
-  rig->start();
-  while (rig->step()) {
-  }
-  ASSERT_EQ(rig->close(false).error, "");
+  ASSERT_TRUE(test::record_flight(fly, path));
 
   cli::FlyOptions o;
   o.replay = true;
