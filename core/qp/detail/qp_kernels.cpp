@@ -622,53 +622,13 @@ void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int
 
 void gemm_tn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
              int ldc, bool overwrite) {
-  if (m <= 0 || n <= 0) return;
-#if defined(__AVX2__) && defined(__FMA__)
-  const int k4 = k & ~3, rem = k - k4;
-  const __m256i mask = tail_mask(rem > 0 ? rem : 4);
-  for (int c = 0; c < n; ++c) {
-    const double* b = B + static_cast<ptrdiff_t>(c) * ldb;
+  // Column c of C is Aᵀ times column c of B: one transposed product per column.
+  for (int c = 0; c < n && m > 0; ++c) {
     double* cc = C + static_cast<ptrdiff_t>(c) * ldc;
-    const __m256d bt = rem > 0 ? _mm256_maskload_pd(b + k4, mask) : _mm256_setzero_pd();
-    int r = 0;
-    for (; r + 4 <= m; r += 4) {
-      const double* a0 = A + static_cast<ptrdiff_t>(r) * lda;
-      const double *a1 = a0 + lda, *a2 = a1 + lda, *a3 = a2 + lda;
-      __m256d s0 = _mm256_setzero_pd(), s1 = s0, s2 = s0, s3 = s0;
-      for (int p = 0; p < k4; p += 4) {
-        const __m256d bv = _mm256_loadu_pd(b + p);
-        s0 = _mm256_fmadd_pd(_mm256_loadu_pd(a0 + p), bv, s0);
-        s1 = _mm256_fmadd_pd(_mm256_loadu_pd(a1 + p), bv, s1);
-        s2 = _mm256_fmadd_pd(_mm256_loadu_pd(a2 + p), bv, s2);
-        s3 = _mm256_fmadd_pd(_mm256_loadu_pd(a3 + p), bv, s3);
-      }
-      if (rem > 0) {
-        s0 = _mm256_fmadd_pd(_mm256_maskload_pd(a0 + k4, mask), bt, s0);
-        s1 = _mm256_fmadd_pd(_mm256_maskload_pd(a1 + k4, mask), bt, s1);
-        s2 = _mm256_fmadd_pd(_mm256_maskload_pd(a2 + k4, mask), bt, s2);
-        s3 = _mm256_fmadd_pd(_mm256_maskload_pd(a3 + k4, mask), bt, s3);
-      }
-      __m256d sum = hsum4(s0, s1, s2, s3);
-      if (!overwrite) sum = _mm256_add_pd(_mm256_loadu_pd(cc + r), sum);
-      _mm256_storeu_pd(cc + r, sum);
-    }
-    for (; r < m; ++r) {
-      const double* a = A + static_cast<ptrdiff_t>(r) * lda;
-      double s = 0.0;
-      for (int p = 0; p < k; ++p) s += a[p] * b[p];
-      cc[r] = overwrite ? s : cc[r] + s;
-    }
+    if (overwrite)
+      for (int r = 0; r < m; ++r) cc[r] = 0.0;
+    gemv_t(k, m, A, lda, B + static_cast<ptrdiff_t>(c) * ldb, cc);
   }
-#else
-  for (int c = 0; c < n; ++c)
-    for (int r = 0; r < m; ++r) {
-      double s = 0.0;
-      for (int p = 0; p < k; ++p)
-        s += A[p + static_cast<ptrdiff_t>(r) * lda] * B[p + static_cast<ptrdiff_t>(c) * ldb];
-      double& out = C[r + static_cast<ptrdiff_t>(c) * ldc];
-      out = overwrite ? s : out + s;
-    }
-#endif
 }
 
 void trsv_lt_small(int n, const double* dinv, int lddinv, double* x) {
