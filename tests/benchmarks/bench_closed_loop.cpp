@@ -30,6 +30,13 @@ namespace {
 
 constexpr int kSetSize = 200;
 
+// The counters <prefix>median_us, <prefix>p90_us and <prefix>worst_us.
+void report(benchmark::State& state, const std::string& prefix, const Percentiles& p) {
+  state.counters[prefix + "median_us"] = p.median;
+  state.counters[prefix + "p90_us"] = p.p90;
+  state.counters[prefix + "worst_us"] = p.worst;
+}
+
 void BM_QpSolveClosed(benchmark::State& state, const QpSetSpec& spec) {
   const QpSet& set = cached_closed_loop_set(spec, kSetSize);
   if (set.qps.empty()) {
@@ -78,12 +85,8 @@ void BM_QpSolveClosed(benchmark::State& state, const QpSetSpec& spec) {
     ++measured;
   }
   const Percentiles pt = percentiles(t), pf = percentiles(f);
-  state.counters["median_us"] = pt.median;
-  state.counters["p90_us"] = pt.p90;
-  state.counters["worst_us"] = pt.worst;
-  state.counters["feedback_median_us"] = pf.median;
-  state.counters["feedback_p90_us"] = pf.p90;
-  state.counters["feedback_worst_us"] = pf.worst;
+  report(state, "", pt);
+  report(state, "feedback_", pf);
   state.counters["iterations"] = measured ? it_sum / measured : 0.0;
   state.counters["max_iterations"] = it_max;
   state.counters["qps"] = measured;
@@ -126,12 +129,8 @@ void BM_RtiStepClosed(benchmark::State& state, const QpSetSpec& spec) {
   }
   const double n = double(step.size());
   const Percentiles ps = percentiles(step), pf = percentiles(feedback);
-  state.counters["step_median_us"] = ps.median;
-  state.counters["step_p90_us"] = ps.p90;
-  state.counters["step_worst_us"] = ps.worst;
-  state.counters["feedback_median_us"] = pf.median;
-  state.counters["feedback_p90_us"] = pf.p90;
-  state.counters["feedback_worst_us"] = pf.worst;
+  report(state, "step_", ps);
+  report(state, "feedback_", pf);
   state.counters["qp_iterations"] = n > 0 ? iterations / n : 0.0;
 }
 
