@@ -167,8 +167,9 @@ TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToAScoreCard) {
                                                                       : m.start_max.x > m.start_min.x;
       // The sticks show at READY where there is room for them beside the session panel (not
       // at 150 % of 1280x720): the callout then stands in the centre and says so.
-      if (steps[i].target != ui::TourTarget::sticks || GetParam() == 1.0f)
+      if (steps[i].target != ui::TourTarget::sticks || GetParam() == 1.0f) {
         EXPECT_TRUE(drawn) << "step " << i + 1 << " points at nothing: " << steps[i].title;
+      }
       check_layout("tour");
       save_shot(screen_, "first_launch_tour_" + std::to_string(i + 1) + at());
       key(app, ui::Key::space);
@@ -195,6 +196,23 @@ TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToAScoreCard) {
 
 INSTANTIATE_TEST_SUITE_P(Scales, FirstLaunchAtScale, testing::Values(1.0f, 1.5f));
 
+// Ada's flight of mi_helix (skill 60) in the history of this test's user folders.
+bool remember_a_flight() {
+  std::string error;
+  auto store = history::open_history("", error);
+  EXPECT_TRUE(store) << error;
+  if (!store) return false;
+  history::FlightRecord f;
+  f.trainee = "Ada";
+  f.scenario = "mi_helix";
+  f.mode = "mixed_initiative";
+  f.front_end = "window";
+  f.metrics = {{"skill", 60.0}};
+  const bool added = store->add(f, error).has_value();
+  EXPECT_TRUE(added) << error;
+  return added;
+}
+
 // The welcome is a first launch's: not with a flight in the history, not once dismissed, not
 // when the command line chose (first_launch off); a window.toml that cannot be written is said
 // and costs nothing else.
@@ -203,14 +221,7 @@ TEST_F(FirstLaunch, ShowsOnlyOnAFreshMachine) {
   int status = 0;
   {
     fresh_user_dirs("with_history");
-    auto store = history::open_history("", error);
-    ASSERT_TRUE(store) << error;
-    history::FlightRecord f;
-    f.trainee = "Ada";
-    f.scenario = "mi_helix";
-    f.mode = "mixed_initiative";
-    f.front_end = "window";
-    ASSERT_TRUE(store->add(f, error)) << error;
+    ASSERT_TRUE(remember_a_flight());
     cli::Trainer app(first_launch_options(1.0));
     ASSERT_TRUE(app.open_live(error, status)) << error;
     EXPECT_FALSE(welcome_shows(app)) << "a machine with a flight in its history is no first launch";
@@ -454,18 +465,7 @@ TEST_F(Onboarding, EveryKeyTheWindowHandlesIsInTheSheet) {
 // field; not the windows' own close buttons and scroll bars) brings up a tooltip window.
 TEST_F(Onboarding, EveryControlHasATooltip) {
   fresh_user_dirs("tooltips");
-  {
-    std::string error;
-    auto store = history::open_history("", error);
-    ASSERT_TRUE(store) << error;
-    history::FlightRecord f;
-    f.trainee = "Ada";
-    f.scenario = "mi_helix";
-    f.mode = "mixed_initiative";
-    f.front_end = "window";
-    f.metrics = {{"skill", 60.0}};
-    ASSERT_TRUE(store->add(f, error)) << error;
-  }
+  ASSERT_TRUE(remember_a_flight());
   const std::string rec = record("mi_helix.toml", 2.0, "tips.mcap");
   std::vector<std::string> missing;
   int items = 0;
