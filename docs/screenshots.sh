@@ -60,7 +60,7 @@ cp "$tmp/fly_from_here.png" $out/fly_from_here.png
 # The first launch: the welcome and each callout of its tour at 100 % and 150 %, from the test
 # that drives them with the keyboard alone (in a fresh data and config folder of its own).
 MIXPILOT_SHOT_DIR="$tmp" "$tests/test_onboarding" \
-  --gtest_filter='Scales/FirstLaunchAtScale.TheKeyboardAloneGoesFromTheWelcomeToAScoreCard/*' >/dev/null
+  --gtest_filter='Scales/FirstLaunchAtScale.TheKeyboardAloneGoesFromTheWelcomeToTwoFlightsAndTheImprovement/*' >/dev/null
 for at in 100 150; do cp "$tmp/first_launch_welcome_$at.png" $out/first_launch_$at.png; done
 for step in 1 2 3 4; do cp "$tmp/first_launch_tour_${step}_100.png" $out/tour_${step}_100.png; done
 cp "$tmp/first_launch_tour_1_150.png" $out/tour_1_150.png

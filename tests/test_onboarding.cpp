@@ -3,7 +3,8 @@
 // on a fresh machine and never again once done with; every key the window handles listed in
 // the shortcut sheet's table; a tooltip on every control of every panel; the chase camera's
 // first view clear of obstacles in every shipped scenario; the text size kept and laid out;
-// READY showing what the flight starts with. `ctest -R '(FirstLaunch|Onboarding)'`.
+// READY showing what the flight starts with; window.toml's mutations.
+// `ctest -R '(FirstLaunch|Onboarding)'`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <sys/stat.h>
 
 #include <imgui.h>
 #include <imgui_internal.h>
@@ -126,13 +129,45 @@ class FirstLaunchAtScale : public FirstLaunch, public testing::WithParamInterfac
   void check_layout(const char* state) {
     for (const std::string& p : test::layout_problems()) ADD_FAILURE() << state << at() << ": " << p;
   }
+  static double skill_of(const cli::Trainer& app) {
+    for (const auto& [name, value] : app.run_info().metrics)
+      if (name == "skill") return value;
+    return std::nan("");
+  }
+  // The pilot `name` picked in the session panel by keys alone (Tab, the arrows, Space); the
+  // keyboard stays in the panels. "" done, else what went wrong.
+  std::string pick_pilot_by_keys(cli::Trainer& app, const std::string& name) {
+    const ui::SessionChoices& c = *app.run_info().session;
+    const auto wanted = std::find(c.pilots.begin(), c.pilots.end(), name);
+    if (wanted == c.pilots.end()) return "no pilot " + name;
+    key(app, ui::Key::tab);
+    frame(app);
+    ImGuiContext& g = *GImGui;
+    if (!app.ui_state().keyboard_in_panels || !g.NavWindow) return "Tab did not go into the panels";
+    const ImGuiID box = g.NavWindow->GetID("pilot");
+    for (int i = 0; i < 30 && g.NavId != box; ++i) key(app, ui::Key::down);
+    if (g.NavId != box) return std::string("the arrows never reached the pilot box in ") + g.NavWindow->Name;
+    // The list opens on the pilot flying now; the arrows move through it in order.
+    const int steps = int(wanted - c.pilots.begin()) - app.run_info().session->pilot;
+    key(app, ui::Key::space);
+    if (!ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId)) return "Space did not open the list";
+    for (int i = 0; i < std::abs(steps); ++i) key(app, steps > 0 ? ui::Key::down : ui::Key::up);
+    key(app, ui::Key::space);
+    frame(app);
+    const ui::SessionChoices& now = *app.run_info().session;
+    if (now.pilot < 0 || now.pilots[std::size_t(now.pilot)] != name)
+      return "picked " + (now.pilot < 0 ? std::string("none") : now.pilots[std::size_t(now.pilot)]);
+    return "";
+  }
 };
 
 // A newcomer with the keyboard alone: the welcome shows, Space takes its first way in (watch the
 // novice), Space steps through the tour's callouts, each pointing at what it names, the last
-// one starts the flight, and the flight ends on its score card. The welcome was done with: it is
-// kept in window.toml and a second start shows none.
-TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToAScoreCard) {
+// one starts the flight, and the flight ends on its score card. Then a second flight, the
+// experienced pilot picked in the session panel by keys, whose card shows the improvement
+// since the first. The welcome was done with: it is kept in window.toml and a second start
+// shows none.
+TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToTwoFlightsAndTheImprovement) {
   fresh_user_dirs(("keyboard_only" + at()).c_str());
   {
     cli::Trainer app(first_launch_options(3.0));
@@ -185,6 +220,44 @@ TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToAScoreCard) {
     EXPECT_FALSE(app.run_info().metrics.empty());
     EXPECT_TRUE(window_shown("Score card")) << "no score card at the end of the first flight";
     save_shot(screen_, "first_launch_score_card" + at());
+    const double first_skill = skill_of(app);
+    ASSERT_TRUE(std::isfinite(first_skill));
+    // The second flight, still by keys: Esc closes the card, Tab goes into the session panel,
+    // Down to the pilot box, Space opens it, Down to the experienced pilot, Space picks it; Esc
+    // back to the flight, Space starts it.
+    key(app, ui::Key::escape);
+    frame(app);
+    EXPECT_FALSE(window_shown("Score card")) << "Esc did not close the card";
+    ASSERT_EQ(pick_pilot_by_keys(app, "experienced"), "");
+    key(app, ui::Key::escape);
+    ASSERT_FALSE(app.ui_state().keyboard_in_panels);
+    ASSERT_EQ(app.run_info().state, ui::RunState::ready);
+    key(app, ui::Key::space);
+    ASSERT_TRUE(app.live()->started());
+    until_over(app);
+    ASSERT_TRUE(app.over());
+    // Its card, once the flight is in the history: the change since the first, a new best.
+    const ui::ScoreCard* card = nullptr;
+    for (int i = 0; i < 2000; ++i) {
+      frame(app);
+      card = app.run_info().card;
+      if (card && card->comparison != ui::Comparison::reading) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_TRUE(card);
+    ASSERT_EQ(card->comparison, ui::Comparison::compared) << card->note;
+    const double second_skill = skill_of(app);
+    EXPECT_GT(second_skill, first_skill) << "the experienced pilot's flight is the better one";
+    EXPECT_NEAR(card->since_last, second_skill - first_skill, 1e-9);
+    EXPECT_TRUE(card->new_best);
+    EXPECT_NE(card->last_text.find(" since your last assisted flight ("), std::string::npos)
+        << card->last_text;
+    frame(app);
+    frame(app);
+    EXPECT_TRUE(window_shown("Score card"));
+    check_layout("second card");
+    save_shot(screen_, "first_launch_second_card" + at());
+    std::printf("  skills %.1f then %.1f\n", first_skill, second_skill);
     EXPECT_EQ(app.finish(), 0);
   }
   cli::Trainer again(first_launch_options(1.0));
@@ -264,6 +337,122 @@ TEST_F(FirstLaunch, ShowsOnlyOnAFreshMachine) {
     until_over(app);
     EXPECT_TRUE(app.over());
     EXPECT_EQ(app.finish(), 0);
+  }
+}
+
+// window.toml mutated as the scenario files are (tests/mutate_scenarios.py): each key missing,
+// of another type, 0, negative, tiny, huge, nan, ±inf, integer limits, an empty or unknown
+// string; unknown keys, tables, a key twice, deep nesting, binary bytes, an empty file; not a
+// file (a folder, a FIFO, a device). Each read gives valid settings: the file's, or the
+// defaults with a note that names the file and, for its content, the line and column. What it
+// accepts it writes back as it read it.
+TEST(OnboardingWindowSettings, EveryMutationGivesValidSettingsOrTheDefaultsAndWhere) {
+  const fs::path dir = test::fresh_path("onboarding", "window_mutations");
+  fs::create_directories(dir);
+  const std::string path = (dir / "window.toml").string();
+  std::string error;
+  ASSERT_TRUE(cli::save_window_settings(path, cli::WindowSettings{1.25f, true}, error)) << error;
+  const std::string base = slurp_text(path);
+  const std::vector<std::string> lines = [&] {
+    std::vector<std::string> v;
+    std::stringstream in(base);
+    for (std::string l; std::getline(in, l);) v.push_back(l);
+    return v;
+  }();
+  ASSERT_EQ(lines.size(), 3u) << base;
+  const auto joined = [](const std::vector<std::string>& v) {
+    std::string t;
+    for (const std::string& l : v) t += l + "\n";
+    return t;
+  };
+  std::vector<std::pair<std::string, std::string>> variants = {
+      {"empty", ""},
+      {"unknown key", base + "colour = \"blue\"\n"},
+      {"a table", base + "[text_scale]\nx = 1\n"},
+      {"key twice", base + "text_scale = 2.0\n"},
+      {"nested 33", base + [] { std::string k; for (int i = 0; i < 33; ++i) k += "a."; return k + "b = 1\n"; }()},
+      {"nested array 50000", base + "x = " + std::string(50000, '[') + "\n"},
+      {"binary", base + std::string("\x00\x01\xff\n", 4)},
+      {"no newline at the end", base.substr(0, base.size() - 1)},
+      {"a long comment", base + "# " + std::string(1 << 20, 'x') + "\n"},
+  };
+  const char* const values[] = {"0", "-1.5", "-1", "1e-300", "1e300", "nan", "inf", "-inf",
+                                "2147483647", "-2147483648", "9223372036854775807", "1", "0.5",
+                                "3", "3.0000001", "\"text\"", "true", "[1.0]", "{ x = 1 }"};
+  const char* const strings[] = {"1", "\"\"", "\"no such thing\"", "\"Dismissed\"", "\"show\"",
+                                 "true", "[\"dismissed\"]"};
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::string key = lines[i].substr(0, lines[i].find(' '));
+    std::vector<std::string> v = lines;
+    v.erase(v.begin() + std::ptrdiff_t(i));
+    variants.emplace_back(key + " missing", joined(v));
+    for (const char* value : key == "text_scale" ? std::vector<const char*>(std::begin(values), std::end(values))
+                                                  : std::vector<const char*>(std::begin(strings), std::end(strings))) {
+      v = lines;
+      v[i] = key + " = " + value;
+      variants.emplace_back(key + " = " + value, joined(v));
+    }
+  }
+  int accepted = 0, refused = 0;
+  for (const auto& [label, text] : variants) {
+    SCOPED_TRACE(label);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+    std::string note;
+    const cli::WindowSettings s = cli::load_window_settings(path, note);
+    ASSERT_TRUE(std::isfinite(s.text_scale));
+    EXPECT_GE(s.text_scale, cli::kMinTextScale);
+    EXPECT_LE(s.text_scale, cli::kMaxTextScale);
+    if (note.empty()) {
+      ++accepted;
+      // Written back and read again: the same settings.
+      ASSERT_TRUE(cli::save_window_settings(path, s, error)) << error;
+      std::string again_note;
+      const cli::WindowSettings again = cli::load_window_settings(path, again_note);
+      EXPECT_EQ(again_note, "");
+      EXPECT_EQ(again.text_scale, s.text_scale);
+      EXPECT_EQ(again.welcome_dismissed, s.welcome_dismissed);
+    } else {
+      ++refused;
+      const cli::WindowSettings defaults;
+      EXPECT_EQ(s.text_scale, defaults.text_scale);
+      EXPECT_EQ(s.welcome_dismissed, defaults.welcome_dismissed);
+      // FILE:LINE:COL: what was expected; the window's defaults are used.
+      EXPECT_EQ(note.rfind(path + ":", 0), 0u) << note;
+      const std::string rest = note.substr(path.size() + 1);
+      const std::size_t colon = rest.find(':');
+      ASSERT_NE(colon, std::string::npos) << note;
+      EXPECT_GT(std::atoi(rest.c_str()), 0) << note;
+      EXPECT_GT(std::atoi(rest.c_str() + colon + 1), 0) << note;
+      EXPECT_NE(note.find("; the window's defaults are used"), std::string::npos) << note;
+      EXPECT_EQ(note.find('\n'), std::string::npos) << "one line: " << note;
+    }
+  }
+  EXPECT_GT(accepted, 5);
+  EXPECT_GT(refused, 20);
+  std::printf("  window.toml: %zu variants, %d accepted, %d refused with where\n", variants.size(),
+              accepted, refused);
+  // Not a file: said without a line, the defaults used.
+  const auto not_a_file = [&](const std::string& p, const char* what) {
+    SCOPED_TRACE(what);
+    std::string note;
+    const cli::WindowSettings s = cli::load_window_settings(p, note);
+    EXPECT_EQ(s.text_scale, 1.0f);
+    EXPECT_FALSE(s.welcome_dismissed);
+    EXPECT_NE(note.find(p + ": not a settings file"), std::string::npos) << note;
+  };
+  fs::create_directories(dir / "folder");
+  not_a_file((dir / "folder").string(), "a folder");
+  ASSERT_EQ(mkfifo((dir / "fifo").c_str(), 0600), 0);
+  not_a_file((dir / "fifo").string(), "a FIFO");
+  fs::create_symlink("/dev/zero", dir / "device");
+  not_a_file((dir / "device").string(), "a device");
+  // Missing, or a dangling link: no file, the defaults without a word.
+  fs::create_symlink(dir / "nowhere", dir / "dangling");
+  for (const char* name : {"missing", "dangling"}) {
+    std::string note;
+    const cli::WindowSettings s = cli::load_window_settings((dir / name).string(), note);
+    EXPECT_EQ(note, "") << name;
+    EXPECT_EQ(s.text_scale, 1.0f) << name;
   }
 }
 

@@ -422,6 +422,44 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
       run.state = ui::RunState::flying;
       for (int i = 0; i < 3; ++i) screen.frame([&] { draw(scene, f.history, run, st); });
       for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+      // The HUD with all it can show at once: the safe controller flying, a remote vehicle's
+      // round trip, the instructor's commands in force, counts of five digits.
+      ui::History all = f.history;
+      Telemetry s = all.newest();
+      s.events |= kEventSafeHold;
+      s.set_channel(s.num_channels, "RTT estimate", "s", 0.1234);
+      s.set_channel(s.num_channels, "RTT sample", "s", 0.1250);
+      s.instructor.bounds = AuthorityBounds{0.1, 0.3};
+      s.instructor.gust = Eigen::Vector3d(2.0, 0.0, 0.0);
+      s.instructor.gust_left = 0.4;
+      s.instructor.extra_delay = 0.05;
+      s.instructor.input_loss_left = 1.5;
+      all.push(s);
+      // Flying (the HUD as wide as the view allows) and finished (beside the session panel, at
+      // its least width).
+      ui::SessionChoices session;
+      session.scenarios = {scenario};
+      session.scenario = 0;
+      session.pilots = {"novice", "experienced"};
+      session.pilot = 0;
+      for (const ui::RunState state : {ui::RunState::flying, ui::RunState::finished}) {
+        ui::RunInfo busy = run;
+        busy.state = state;
+        busy.session = &session;
+        busy.fallbacks = busy.deadline_misses = 12345;
+        busy.instructor_paused = true;
+        for (int i = 0; i < 3; ++i) screen.frame([&] { draw(scene, all, busy, st); });
+        for (const std::string& problem : test::layout_problems())
+          ADD_FAILURE() << "with every HUD item, " << (state == ui::RunState::finished ? "finished" : "flying")
+                        << ": " << problem;
+      }
+      // To look at: MIXPILOT_SHOT_DIR/hud_full_<scenario>_<W>x<H>_<percent>.png (finished).
+      if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
+        std::ofstream(std::string(dir) + "/hud_full_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +
+                          "_" + std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
+                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
+                      std::ios::binary)
+            << screen.png();
       // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
       if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
         std::ofstream(std::string(dir) + "/mode_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +

@@ -73,7 +73,7 @@ void draw_welcome(const RunInfo& run, UiState& ui, Requests& out, ImVec2 d) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * d.x, 0.5f * d.y), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(std::min(34.0f * em, d.x - 2.0f * em), 0.0f), ImGuiCond_Always);
   ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(d.x - 2.0f * em, d.y - 2.0f * em));
-  ImGui::SetNextWindowBgAlpha(0.97f);
+  ImGui::SetNextWindowBgAlpha(1.0f);  // opaque: what is behind would show through its text
   ImGui::Begin(kWelcomeWindow, nullptr,
                ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse |
                    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize);
@@ -170,7 +170,7 @@ void draw_tour(UiState& ui, Requests& out, ImVec2 d) {
   }
   ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
   ImGui::SetNextWindowSize(ImVec2(w, 0.0f), ImGuiCond_Always);
-  ImGui::SetNextWindowBgAlpha(0.97f);
+  ImGui::SetNextWindowBgAlpha(1.0f);  // opaque: what is behind would show through its text
   ImGui::Begin(kTourWindow, nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoMove);

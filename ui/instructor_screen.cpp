@@ -421,8 +421,10 @@ void command_pane(const InstructorView& v, InstructorUi& ui, ImVec2 min, ImVec2 
   ImGui::SameLine();
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
   if (ImGui::BeginCombo("##target", target->name.c_str())) {
-    for (const StationTile& t : v.stations)
+    for (const StationTile& t : v.stations) {
       if (ImGui::Selectable(t.name.c_str(), &t == target)) ui.selected = t.name;
+      if (&t == target) ImGui::SetItemDefaultFocus();  // the keyboard starts on it
+    }
     ImGui::EndCombo();
   }
   tooltip("The station these commands go to (also: click its tile, or keys 1-4)");

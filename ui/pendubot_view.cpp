@@ -73,10 +73,14 @@ void draw_pendubot(const Scene& sc, const History& h, ImVec2 min, ImVec2 max, Im
     else
       lines[n++] = part;
   }
-  const float line = ImGui::GetTextLineHeightWithSpacing();
-  for (int i = 0; i < n; ++i)
-    dl->AddText(ImVec2(frame.x + inset, max.y - inset - float(n - i) * line), colour::kText,
-                lines[i].c_str());
+  // A part wider than the view (a narrow view, large text) wraps at its words.
+  const float spacing = ImGui::GetStyle().ItemSpacing.y;
+  float y = max.y - inset;
+  for (int i = n - 1; i >= 0; --i) {
+    y -= ImGui::CalcTextSize(lines[i].c_str(), nullptr, false, width).y + spacing;
+    dl->AddText(ImGui::GetFont(), ImGui::GetFontSize(), ImVec2(frame.x + inset, y), colour::kText,
+                lines[i].c_str(), nullptr, width);
+  }
   dl->PopClipRect();
 }
 

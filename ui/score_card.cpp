@@ -458,6 +458,8 @@ void draw_score_card(const ScoreCard& c, bool replay, bool& open, ImVec2 display
                           ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSizeConstraints(ImVec2(width, 0),
                                       ImVec2(width, std::max(1.0f, display.y - 2.0f * margin)));
+  // Opaque: the plots' and the HUD's text behind it would show through the theme's panels.
+  ImGui::SetNextWindowBgAlpha(1.0f);
   ImGui::Begin("Score card", &open,
                ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove);

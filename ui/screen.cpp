@@ -275,12 +275,15 @@ float hud(const Scene& sc, const History& h, const RunInfo& run, ImVec2 pos, flo
   ImGui::PushFont(mono_font());
   const float gap = ImGui::CalcTextSize("   ").x;
   bool first = true;
+  // An item wider than the HUD (a large text scale) wraps at its words inside it.
   const auto item = [&](const char* text, ImU32 colour) {
     if (!first) same_line_or_wrap(ImGui::CalcTextSize(text).x, gap);
     first = false;
+    ImGui::PushTextWrapPos(0.0f);
     ImGui::PushStyleColor(ImGuiCol_Text, colour);
     ImGui::TextUnformatted(text);
     ImGui::PopStyleColor();
+    ImGui::PopTextWrapPos();
   };
   char text[96];
   if (sc.shared_authority) {

@@ -26,6 +26,8 @@ bool combo(const char* label, const std::vector<std::string>& items, int current
         chosen = i;
         changed = true;
       }
+      // Opened with the keyboard, the list starts on the current choice.
+      if (i == current) ImGui::SetItemDefaultFocus();
     }
     ImGui::EndCombo();
   }
@@ -58,6 +60,7 @@ void trainee_field(const RunInfo& run, UiState& ui, float fields, Requests& out)
         std::snprintf(ui.trainee, sizeof ui.trainee, "%s", name.c_str());
         out.push_back(SetTrainee{name});
       }
+      if (name == c.trainee) ImGui::SetItemDefaultFocus();  // the keyboard starts on it
     }
     ImGui::EndCombo();
   }

@@ -103,11 +103,16 @@ void draw_authority_bar(double lambda, ImVec2 min, ImVec2 max, bool names, bool 
   const float bw = ImGui::CalcTextSize(bound_text).x;
   const bool bound_below = names && bound_text[0] != '\0' && right_start - left_end >= bw;
   char label[128];
-  std::snprintf(label, sizeof label, "%s%s %.2f%s%s", probe ? "PROBE · " : "",
-                l >= 0.5 ? "PILOT" : "PLANNER", l,
-                bound_text[0] != '\0' && !bound_below ? " · " : "",
-                bound_below ? "" : bound_text);
-  const ImVec2 ts = ImGui::CalcTextSize(label);
+  const auto make_label = [&](bool with_bounds) {
+    std::snprintf(label, sizeof label, "%s%s %.2f%s%s", probe ? "PROBE · " : "",
+                  l >= 0.5 ? "PILOT" : "PLANNER", l, with_bounds ? " · " : "",
+                  with_bounds ? bound_text : "");
+    return ImGui::CalcTextSize(label);
+  };
+  ImVec2 ts = make_label(bound_text[0] != '\0' && !bound_below);
+  // Too wide for the bar (a narrow HUD, large text): the ticks alone show the bounds (the HUD
+  // names them on the instructor's line).
+  if (ts.x + scaled(12) > max.x - min.x) ts = make_label(false);
   const ImVec2 at(mid - 0.5f * ts.x, 0.5f * (min.y + max.y) - 0.5f * ts.y);
   dl->AddRectFilled(ImVec2(at.x - scaled(6), at.y - scaled(1)),
                     ImVec2(at.x + ts.x + scaled(6), at.y + ts.y + scaled(1)),
