@@ -49,6 +49,8 @@ class Trainer {
   void seek(double t) { replay_.seek(t); }  // a replay's playhead [s]
   void load_replay() { replay_.load(); }    // flies the whole replay now (headless)
   bool replaying() const { return replay_.is_open(); }
+  // The first launch's welcome is still to be decided: it waits for the history to be read.
+  bool welcome_undecided() const { return welcome_pending_; }
   // The live flight's run is over and every step has been drawn; a replay played to its end.
   bool over() const;
   double shown_time() const;  // [s] of the telemetry on screen (−1: none yet)

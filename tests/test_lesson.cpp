@@ -693,9 +693,11 @@ TEST_P(LessonPicker, ShowsTheTraineesStepOfTheCourse) {
   EXPECT_FALSE(panel->ScrollbarY) << "the session panel scrolls";
   EXPECT_LE(panel->DC.CursorMaxPos.y, panel->InnerClipRect.Max.y + 1.0f)
       << "the start button is under the panel's bottom";
-  for (const ImGuiWindow* w : GImGui->Windows)
-    if (w->ParentWindow == panel && (w->Flags & ImGuiWindowFlags_ChildWindow) && w->Active)
+  for (const ImGuiWindow* w : GImGui->Windows) {
+    if (w->ParentWindow == panel && (w->Flags & ImGuiWindowFlags_ChildWindow) && w->Active) {
       EXPECT_FALSE(w->ScrollbarY) << "the session panel's choices scroll";
+    }
+  }
   save_shot("lesson_picker_" + std::to_string(int(std::lround(GetParam() * 100))));
 }
 

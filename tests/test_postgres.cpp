@@ -838,9 +838,11 @@ TEST(Postgres, PushCarriesEveryTable) {
   }
   const HistoryDump theirs = dump_history(out_file);
   expect_every_column_varies(theirs);
-  for (const auto& [table, rows] : mine.rows)
-    if (table != "schema_version")
+  for (const auto& [table, rows] : mine.rows) {
+    if (table != "schema_version") {
       EXPECT_EQ(theirs.rows.at(table).size(), rows.size()) << table;
+    }
+  }
 }
 
 // `mixpilot history push` as a user runs it: twice, the second adds nothing; the password

@@ -57,7 +57,7 @@ void choose(WayIn way, UiState& ui, Requests& out) {
 }
 
 void done(UiState& ui, Requests& out) {
-  out.push_back(FirstLaunchDone{});
+  out.emplace_back(std::in_place_type<AppRequest>, FirstLaunchDone{});
   ui.first_launch = FirstLaunch::none;
   ui.keyboard_in_panels = false;
 }
@@ -193,7 +193,7 @@ void draw_tour(UiState& ui, Requests& out, ImVec2 d) {
   if (ImGui::Button(last_step ? "Start the flight (Space)###next" : "Next (Space)###next") ||
       space) {
     if (last_step) {
-      out.push_back(StartFlight{});
+      out.emplace_back(std::in_place_type<LiveRequest>, StartFlight{});
       done(ui, out);
     } else {
       ui.tour_step += 1;

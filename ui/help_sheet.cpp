@@ -52,13 +52,17 @@ void draw_help_sheet(const RunInfo& run, UiState& ui, Requests& out, ImVec2 d) {
   ImGui::AlignTextToFramePadding();
   ImGui::Text("Text size %.0f %%", 100.0 * double(run.text_scale));
   ImGui::SameLine();
-  if (ImGui::Button(" - ")) out.push_back(SetTextScale{next_text_scale(run.text_scale, -1)});
+  // Built in place: GCC 12 sees maybe-uninitialized members in a moved nested variant.
+  if (ImGui::Button(" - "))
+    out.emplace_back(std::in_place_type<AppRequest>, SetTextScale{next_text_scale(run.text_scale, -1)});
   tip("Smaller text and controls (Ctrl+-)");
   ImGui::SameLine();
-  if (ImGui::Button(" + ")) out.push_back(SetTextScale{next_text_scale(run.text_scale, +1)});
+  if (ImGui::Button(" + "))
+    out.emplace_back(std::in_place_type<AppRequest>, SetTextScale{next_text_scale(run.text_scale, +1)});
   tip("Larger text and controls (Ctrl+=)");
   same_line_or_wrap(button_width("As the display's"));
-  if (ImGui::Button("As the display's")) out.push_back(SetTextScale{1.0f});
+  if (ImGui::Button("As the display's"))
+    out.emplace_back(std::in_place_type<AppRequest>, SetTextScale{1.0f});
   tip("The text size the display's scale gives (Ctrl+0)");
   if (ImGui::Button("Show the welcome again")) show_welcome(ui);
   tip("The first launch's three ways in and its tour of the screen");
