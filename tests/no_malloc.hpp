@@ -2,7 +2,8 @@
 // "No heap allocation in the control loop", checked two ways: the executable links the engine
 // built with EIGEN_RUNTIME_NO_MALLOC (mixpilot_core_nomalloc), so an Eigen heap allocation
 // inside a NoMalloc scope aborts, and every malloc/calloc/realloc of the process (std::vector
-// growth, operator new, ...) in that scope is counted. Include it in exactly one translation
+// growth, operator new, ...) in that scope is counted. Under the sanitizers neither: the
+// release suite checks the allocations, the sanitized one runs the same flows for memory errors. Include it in exactly one translation
 // unit of a test executable: it defines the process's malloc.
 #include <atomic>
 #include <cstddef>
@@ -85,10 +86,20 @@ struct AllocationCount {
   }
 };
 
+// Whether Eigen's heap allocations abort under a NoMalloc guard: the engine was built for it
+// (mixpilot_core_nomalloc; not under the sanitizers, core/CMakeLists.txt).
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+inline constexpr bool kEigenGuardArmed = true;
+#else
+inline constexpr bool kEigenGuardArmed = false;
+#endif
+
 // RAII guard: Eigen heap allocation aborts and all process allocations are counted.
 struct NoMalloc : AllocationCount {
+#ifdef EIGEN_RUNTIME_NO_MALLOC
   NoMalloc() { Eigen::internal::set_is_malloc_allowed(false); }
   ~NoMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
+#endif
 };
 
 struct GuardedSteps {

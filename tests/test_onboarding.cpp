@@ -371,29 +371,30 @@ TEST(OnboardingWindowSettings, EveryMutationGivesValidSettingsOrTheDefaultsAndWh
     for (const std::string& l : v) t += l + "\n";
     return t;
   };
+  std::string nested;
+  for (int i = 0; i < 33; ++i) nested += "a.";
   std::vector<std::pair<std::string, std::string>> variants = {
       {"empty", ""},
       {"unknown key", base + "colour = \"blue\"\n"},
       {"a table", base + "[text_scale]\nx = 1\n"},
       {"key twice", base + "text_scale = 2.0\n"},
-      {"nested 33", base + [] { std::string k; for (int i = 0; i < 33; ++i) k += "a."; return k + "b = 1\n"; }()},
+      {"nested 33", base + nested + "b = 1\n"},
       {"nested array 50000", base + "x = " + std::string(50000, '[') + "\n"},
       {"binary", base + std::string("\x00\x01\xff\n", 4)},
       {"no newline at the end", base.substr(0, base.size() - 1)},
       {"a long comment", base + "# " + std::string(1 << 20, 'x') + "\n"},
   };
-  const char* const values[] = {"0", "-1.5", "-1", "1e-300", "1e300", "nan", "inf", "-inf",
-                                "2147483647", "-2147483648", "9223372036854775807", "1", "0.5",
-                                "3", "3.0000001", "\"text\"", "true", "[1.0]", "{ x = 1 }"};
-  const char* const strings[] = {"1", "\"\"", "\"no such thing\"", "\"Dismissed\"", "\"show\"",
-                                 "true", "[\"dismissed\"]"};
+  const std::vector<const char*> numbers = {
+      "0", "-1.5", "-1", "1e-300", "1e300", "nan", "inf", "-inf", "2147483647", "-2147483648",
+      "9223372036854775807", "1", "0.5", "3", "3.0000001", "\"text\"", "true", "[1.0]", "{ x = 1 }"};
+  const std::vector<const char*> strings = {"1", "\"\"", "\"no such thing\"", "\"Dismissed\"",
+                                            "\"show\"", "true", "[\"dismissed\"]"};
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const std::string key = lines[i].substr(0, lines[i].find(' '));
     std::vector<std::string> v = lines;
     v.erase(v.begin() + std::ptrdiff_t(i));
     variants.emplace_back(key + " missing", joined(v));
-    for (const char* value : key == "text_scale" ? std::vector<const char*>(std::begin(values), std::end(values))
-                                                  : std::vector<const char*>(std::begin(strings), std::end(strings))) {
+    for (const char* value : key == "text_scale" ? numbers : strings) {
       v = lines;
       v[i] = key + " = " + value;
       variants.emplace_back(key + " = " + value, joined(v));

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang++, -fsanitize=fuzzer,address,undefined) and runs each for
-# SECONDS seconds from its seed corpus (tests/fuzz/corpus/<target>), failing on the first crash,
-# sanitizer report, abort, leak, input slower than 10 s (a hang) or over 2 GB of memory.
+# Builds the libFuzzer targets (clang++, -fsanitize=fuzzer,address,undefined) and runs them side
+# by side, each for SECONDS seconds from its seed corpus (tests/fuzz/corpus/<target>), failing on
+# the first crash, sanitizer report, abort, leak, input slower than 10 s (a hang) or over 2 GB of
+# memory.
 #
 #   tests/fuzz/run.sh SECONDS [PRESET]
 #
@@ -38,8 +39,10 @@ symbolizer=$(command -v llvm-symbolizer || command -v llvm-symbolizer-14 || true
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1${symbolizer:+:external_symbolizer_path=$symbolizer}}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 
-failed=0
-for target in recording scenario; do
+# Both targets at once (a process each, one core each where there are two), then each judged.
+targets=(recording scenario)
+pids=()
+for target in "${targets[@]}"; do
   corpus=$build/fuzz-corpus/$target
   mkdir -p "$corpus"
   echo "fuzz_$target: ${seconds} s from tests/fuzz/corpus/$target"
@@ -47,10 +50,16 @@ for target in recording scenario; do
   # the scenario keys and values, so mutations produce plausible TOML.
   dict=()
   [ -f "tests/fuzz/$target.dict" ] && dict=(-dict="tests/fuzz/$target.dict")
-  if ! "$build/tests/fuzz/fuzz_$target" "${dict[@]}" -max_total_time="$seconds" -timeout=10 \
-      -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
-      -artifact_prefix="$findings/$target-" "$corpus" "tests/fuzz/corpus/$target" \
-      >"$findings/$target.log" 2>&1; then
+  "$build/tests/fuzz/fuzz_$target" "${dict[@]}" -max_total_time="$seconds" -timeout=10 \
+    -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+    -artifact_prefix="$findings/$target-" "$corpus" "tests/fuzz/corpus/$target" \
+    >"$findings/$target.log" 2>&1 &
+  pids+=($!)
+done
+failed=0
+for i in "${!targets[@]}"; do
+  target=${targets[$i]}
+  if ! wait "${pids[$i]}"; then
     echo "fuzz_$target: FAILED (the input is in $findings/$target-*; full log $findings/$target.log)"
     grep -E "ERROR|SUMMARY|Test unit written|^ +#[0-9]+ " "$findings/$target.log" | head -n 30 ||
       tail -n 20 "$findings/$target.log"
@@ -60,6 +69,6 @@ for target in recording scenario; do
     echo "fuzz_$target: no crash"
   fi
 done
-passed=$((2 - failed))
+passed=$((${#targets[@]} - failed))
 echo "fuzz: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
