@@ -422,6 +422,18 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
       run.state = ui::RunState::flying;
       for (int i = 0; i < 3; ++i) screen.frame([&] { draw(scene, f.history, run, st); });
       for (const std::string& problem : test::layout_problems()) ADD_FAILURE() << problem;
+      // To look at: MIXPILOT_SHOT_DIR/<prefix><scenario>_<W>x<H>_<percent>.png.
+      const auto shot = [&](const char* prefix) {
+        const char* dir = std::getenv("MIXPILOT_SHOT_DIR");
+        if (!dir || !*dir) return;
+        const std::string name = std::string(scenario).substr(0, std::string(scenario).find('.'));
+        std::ofstream(std::string(dir) + "/" + prefix + name + "_" + std::to_string(d.w) + "x" +
+                          std::to_string(d.h) + "_" +
+                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
+                      std::ios::binary)
+            << screen.png();
+      };
+      shot("mode_");
       // The HUD with all it can show at once: the safe controller flying, a remote vehicle's
       // round trip, the instructor's commands in force, counts of five digits.
       ui::History all = f.history;
@@ -453,20 +465,7 @@ TEST(UiLayout, EveryModeFitsAtEveryDisplayScale) {
           ADD_FAILURE() << "with every HUD item, " << (state == ui::RunState::finished ? "finished" : "flying")
                         << ": " << problem;
       }
-      // To look at: MIXPILOT_SHOT_DIR/hud_full_<scenario>_<W>x<H>_<percent>.png (finished).
-      if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
-        std::ofstream(std::string(dir) + "/hud_full_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +
-                          "_" + std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
-                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
-                      std::ios::binary)
-            << screen.png();
-      // To look at: MIXPILOT_SHOT_DIR/mode_<scenario>_<W>x<H>_<percent>.png.
-      if (const char* dir = std::getenv("MIXPILOT_SHOT_DIR"); dir && *dir)
-        std::ofstream(std::string(dir) + "/mode_" + std::string(scenario).substr(0, std::string(scenario).find('.')) +
-                          "_" + std::to_string(d.w) + "x" + std::to_string(d.h) + "_" +
-                          std::to_string(int(std::lround(100 * d.scale))) + ".png",
-                      std::ios::binary)
-            << screen.png();
+      shot("hud_full_");  // finished
     }
   }
 }
