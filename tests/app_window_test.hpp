@@ -64,6 +64,18 @@ class AppWindowTest : public testing::Test {
     frame(app, 0.0);
     io.MousePos = ImVec2(-1, -1);
   }
+  // Frames until `done` (what the app loads or flies off the UI thread), at most `limit`;
+  // whether it came.
+  template <class Done>
+  bool frames_until(cli::Trainer& app, Done done,
+                    std::chrono::seconds limit = std::chrono::seconds(20)) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (!done() && std::chrono::steady_clock::now() < deadline) {
+      frame(app);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return done();
+  }
   // Frames until the live flight's run is over (real time), at most `limit`.
   void until_over(cli::Trainer& app, std::chrono::seconds limit = std::chrono::seconds(60)) {
     const auto deadline = std::chrono::steady_clock::now() + limit;

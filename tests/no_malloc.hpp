@@ -3,8 +3,9 @@
 // built with EIGEN_RUNTIME_NO_MALLOC (mixpilot_core_nomalloc), so an Eigen heap allocation
 // inside a NoMalloc scope aborts, and every malloc/calloc/realloc of the process (std::vector
 // growth, operator new, ...) in that scope is counted. Under the sanitizers neither: the
-// release suite checks the allocations, the sanitized one runs the same flows for memory errors. Include it in exactly one translation
-// unit of a test executable: it defines the process's malloc.
+// release suite checks the allocations, the sanitized one runs the same flows for memory
+// errors. Include it in exactly one translation unit of a test executable: it defines the
+// process's malloc.
 #include <atomic>
 #include <cstddef>
 #include <cstdlib>

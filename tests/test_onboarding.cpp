@@ -105,18 +105,10 @@ class FirstLaunch : public test::AppWindowTest {
   // Frames until the welcome is decided (the history is read off the UI thread), at most
   // 10 s: whether it shows.
   bool welcome_shows(cli::Trainer& app) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (std::chrono::steady_clock::now() < deadline) {
-      frame(app);
-      if (app.ui_state().first_launch == ui::FirstLaunch::welcome) return true;
-      if (!app.welcome_undecided()) {
-        frame(app);  // what the decision draws
-        return app.ui_state().first_launch == ui::FirstLaunch::welcome;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ADD_FAILURE() << "the welcome was not decided within 10 s";
-    return false;
+    EXPECT_TRUE(frames_until(app, [&] { return !app.welcome_undecided(); }, std::chrono::seconds(10)))
+        << "the welcome was not decided within 10 s";
+    frame(app);  // what the decision draws
+    return app.ui_state().first_launch == ui::FirstLaunch::welcome;
   }
   bool window_shown(const char* name) {
     const ImGuiWindow* w = ImGui::FindWindowByName(name);
@@ -243,14 +235,11 @@ TEST_P(FirstLaunchAtScale, TheKeyboardAloneGoesFromTheWelcomeToTwoFlightsAndTheI
     until_over(app);
     ASSERT_TRUE(app.over());
     // Its card, once the flight is in the history: the change since the first, a new best.
-    const ui::ScoreCard* card = nullptr;
-    for (int i = 0; i < 2000; ++i) {
-      frame(app);
-      card = app.run_info().card;
-      if (card && card->comparison != ui::Comparison::reading) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ASSERT_TRUE(card);
+    ASSERT_TRUE(frames_until(app, [&] {
+      const ui::ScoreCard* c = app.run_info().card;
+      return c && c->comparison != ui::Comparison::reading;
+    }));
+    const ui::ScoreCard* card = app.run_info().card;
     ASSERT_EQ(card->comparison, ui::Comparison::compared) << card->note;
     const double second_skill = skill_of(app);
     EXPECT_GT(second_skill, first_skill) << "the experienced pilot's flight is the better one";

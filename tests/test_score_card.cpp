@@ -379,16 +379,6 @@ class ScoreCardApp : public test::AppWindowTest {
     setenv("XDG_CONFIG_HOME", (home / "config").c_str(), 1);
     setenv("XDG_DATA_HOME", (home / "data").c_str(), 1);
   }
-  // Frames until `done` or 20 s.
-  template <class F>
-  bool frames_until(cli::Trainer& app, F done) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (!done() && std::chrono::steady_clock::now() < deadline) {
-      frame(app);
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return done();
-  }
   void fly_three(float scale);
 };
 
