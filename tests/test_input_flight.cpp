@@ -267,11 +267,16 @@ TEST(GamepadLatency, AnAxisChangeIsUsedWithinOneControlPeriod) {
               latency_ms.size(), p50, p99, latency_ms.back());
   // Every change reaches the controller within one control period: a change just after a
   // step's read is in the next step's, which the device samples read_lead before it reads (and
-  // at worst one poll earlier, when that sample is late). A controller reading the previous
-  // step's stick gave a median of 22.8 ms.
+  // at worst one poll earlier, when that sample is late). The threads involved sleep between
+  // polls and steps, and a general-purpose kernel may wake a sleeper late: the slowest change
+  // may exceed the bound by that lateness (a change in the last microseconds before a sample
+  // meets a late wake-up), which a millisecond covers. A controller reading the previous step's
+  // stick gave a median of 22.8 ms.
   const input::Gamepad::Options pad;
   const double bound_ms = 1e3 * (ps.mode->dt() + pad.poll_interval_s + pad.read_lead_s);
-  EXPECT_LE(latency_ms.back(), bound_ms);
+  constexpr double kLateWakeupMs = 1.0;
+  EXPECT_LE(p99, bound_ms);
+  EXPECT_LE(latency_ms.back(), bound_ms + kLateWakeupMs);
   EXPECT_LE(p50, bound_ms / 2);
 }
 
