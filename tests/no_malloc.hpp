@@ -1,8 +1,8 @@
 #pragma once
-// "No heap allocation in the control loop", checked two ways: the executable links the engine
-// built with EIGEN_RUNTIME_NO_MALLOC (mixpilot_core_nomalloc), so an Eigen heap allocation
-// inside a NoMalloc scope aborts, and every malloc/calloc/realloc of the process (std::vector
-// growth, operator new, ...) in that scope is counted. Under the sanitizers neither: the
+// "No heap allocation in the control loop": every malloc/calloc/realloc of the process inside
+// a NoMalloc scope is counted (Eigen's heap, std::vector growth, operator new, ...). A Debug
+// build also arms Eigen's own check (EIGEN_RUNTIME_NO_MALLOC), which aborts at the allocating
+// line: the way to find where a counted allocation comes from. Under the sanitizers neither: the
 // release suite checks the allocations, the sanitized one runs the same flows for memory
 // errors. Include it in exactly one translation unit of a test executable: it defines the
 // process's malloc.
@@ -87,15 +87,18 @@ struct AllocationCount {
   }
 };
 
-// Whether Eigen's heap allocations abort under a NoMalloc guard: the engine was built for it
-// (mixpilot_core_nomalloc; not under the sanitizers, core/CMakeLists.txt).
+// Whether allocations are counted (not under the sanitizers, which own malloc).
+inline constexpr bool kAllocationsCounted = MIXPILOT_COUNT_MALLOC != 0;
+
+// Whether Eigen's heap allocations abort under a NoMalloc guard: Debug builds (CMakeLists.txt).
 #ifdef EIGEN_RUNTIME_NO_MALLOC
 inline constexpr bool kEigenGuardArmed = true;
 #else
 inline constexpr bool kEigenGuardArmed = false;
 #endif
 
-// RAII guard: Eigen heap allocation aborts and all process allocations are counted.
+// RAII guard: all process allocations are counted and, in a Debug build, an Eigen heap
+// allocation aborts.
 struct NoMalloc : AllocationCount {
 #ifdef EIGEN_RUNTIME_NO_MALLOC
   NoMalloc() { Eigen::internal::set_is_malloc_allowed(false); }

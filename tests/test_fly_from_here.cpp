@@ -2,8 +2,7 @@
 // pilot's cold start, a branch scored on its own steps, and a branch's recording replayed from
 // its parent bit for bit (core/recording/branch_replay.hpp) — at any depth, as a probe, with its
 // parent moved beside it — while a missing, changed or foreign parent is refused with its name.
-// The take-over and the steps after it allocate nothing: this executable links the engine built
-// with EIGEN_RUNTIME_NO_MALLOC and counts every malloc (no_malloc.hpp).
+// The take-over and the steps after it allocate nothing: every malloc is counted (no_malloc.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,7 +1,6 @@
 // Every mode behind the one Mode interface (core/modes/mode.hpp), made from its shipped
 // scenario through make_mode(): two runs are identical bit for bit, step() allocates nothing
-// (this executable links the engine built with EIGEN_RUNTIME_NO_MALLOC and counts every
-// malloc), the metrics show the thesis behaviour, and a recording of the run reads back with
+// (every malloc is counted, no_malloc.hpp), the metrics show the thesis behaviour, and a recording of the run reads back with
 // one state and one channel message per step.
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 // the recording's pilot commands (ReplayPilot) and into the mode that flew on to its end, the
 // flight then goes on exactly as recorded: state, input, λ, pilot command, prediction, solver
 // status, channels and events of every remaining step, bit for bit, and the same metrics at the
-// end. Saving into a sized snapshot, restoring and stepping allocate nothing (this executable
-// links the engine built with EIGEN_RUNTIME_NO_MALLOC and counts every malloc); a snapshot of
+// end. Saving into a sized snapshot, restoring and stepping allocate nothing (every malloc is
+// counted, no_malloc.hpp); a snapshot of
 // another kind of mode, scenario or pilot is refused and changes nothing.
 #include <gtest/gtest.h>
 
