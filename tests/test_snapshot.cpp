@@ -384,7 +384,7 @@ TEST(Snapshot, SavingIntoASizedSnapshotRestoringAndSteppingAllocateNothing) {
       first_bytes = AllocationCount::bytes();
     }
     // The first save sizes the snapshot (under AddressSanitizer nothing is counted).
-    if (MIXPILOT_COUNT_MALLOC) {
+    if (kAllocationsCounted) {
       EXPECT_GT(first_allocations, 0) << c.name;
     }
     for (int k = 0; k < 5; ++k) ASSERT_TRUE(mode->step());
