@@ -252,9 +252,11 @@ void Gamepad::run() {
     if (for_read) served_read = read;
     if (steady_ns() > next_tick + 1'000'000'000) next_tick = steady_ns();  // no catching up
 
-    // The sticks every poll; SDL's whole event pump (hot-plug) every 10 ms.
+    // The sticks every poll; SDL's whole event pump (hot-plug) every 10 ms. The sample is
+    // stamped before the device is read: whatever changed before the stamp is in it.
     SDL_Event e;
     bool changed_devices = false;
+    const std::int64_t now = steady_ns();
     SDL_JoystickUpdate();
     if (polls_ % pumps_every == 0) SDL_PumpEvents();
     while (SDL_PeepEvents(&e, 1, SDL_GETEVENT, SDL_FIRSTEVENT, SDL_LASTEVENT) > 0) {
@@ -273,7 +275,6 @@ void Gamepad::run() {
     // Hot-plug: a pad that arrives is taken at once; otherwise look again every second.
     if (!controller_ && (changed_devices || rechoose || polls_ % polls_per_second == 0)) open_device(wanted);
 
-    const std::int64_t now = steady_ns();
     reading_.alive_ns = now;
     // Gone before SDL's removal event arrives: lost at once, not a poll of zeros later.
     if (controller_ && !SDL_GameControllerGetAttached(as_controller(controller_))) close_device();

@@ -196,10 +196,12 @@ struct StepLog : TelemetrySink {
   input::DevicePilot* pilot = nullptr;
   input::Gamepad* gamepad = nullptr;
   input::HapticSettings haptic;
-  std::vector<std::int64_t> read_ns;  // steady ns when the step read the device
+  std::vector<std::int64_t> read_ns;    // steady ns when the step read the device
+  std::vector<std::int64_t> sample_ns;  // steady ns when the sample it read was taken
   std::vector<double> roll_stick, lambda;
   void on_sample(const Telemetry& s) override {
     read_ns.push_back(pilot->read_ns());
+    sample_ns.push_back(pilot->reading().alive_ns);
     roll_stick.push_back(pilot->reading().sticks.right_x);
     lambda.push_back(s.lambda);
     if (gamepad) gamepad->set_rumble(input::rumble_intensity(s.lambda, haptic));
@@ -215,11 +217,18 @@ TEST(GamepadLatency, AnAxisChangeIsUsedWithinOneControlPeriod) {
   log.pilot = ps.pilot;
   const std::size_t steps = std::size_t(ps.mode->steps_total());
   log.read_ns.reserve(steps);
+  log.sample_ns.reserve(steps);
   log.roll_stick.reserve(steps);
   log.lambda.reserve(steps);
   session.add_sink(&log);
-  // Changes at random phases: every 3–11 ms a new roll-stick value, stamped when set.
-  std::vector<std::pair<std::int64_t, double>> changes;
+  // Changes at random phases: every 3–11 ms a new roll-stick value, stamped before and after
+  // it is set. The changer may lose its core between the two (the control and poll threads
+  // take precedence), so a change is known to be made between its stamps, not at either.
+  struct Change {
+    std::int64_t begun_ns, made_ns;
+    double value;
+  };
+  std::vector<Change> changes;
   changes.reserve(4000);
   std::atomic<bool> stop{false};
   RealtimeRunner runner(session, 64);
@@ -228,8 +237,9 @@ TEST(GamepadLatency, AnAxisChangeIsUsedWithinOneControlPeriod) {
     std::uniform_int_distribution<int> wait_us(3000, 11000);
     for (int i = 1; !stop.load(); ++i) {
       const double v = 0.001 * double(i % 400 - 200);  // distinct from its neighbours
+      const std::int64_t begun = input::steady_ns();
       ps.pad.set_axis(SDL_CONTROLLER_AXIS_RIGHTX, v);
-      changes.emplace_back(input::steady_ns(), v);
+      changes.push_back({begun, input::steady_ns(), v});
       std::this_thread::sleep_for(std::chrono::microseconds(wait_us(rng)));
     }
   });
@@ -243,41 +253,62 @@ TEST(GamepadLatency, AnAxisChangeIsUsedWithinOneControlPeriod) {
   stop = true;
   changer.join();
   runner.stop();
-  // Change i is used by the first step whose reading holds it or a later change. A step's read
-  // happens at its start, before the solve: its start is at most the recorded end.
-  std::vector<double> latency_ms;
-  std::size_t next = 0;  // the first change not yet used
+  // Change i is used by the first step whose reading holds it or a later change; its latency
+  // runs from when it was certainly made to that step's read.
+  std::vector<double> latency_ms, age_ms;
+  std::size_t next = 0;        // the first change not yet used
+  std::size_t missed = 0;      // changes a sample taken after them did not hold
+  double worst_miss_ms = 0.0;  // by how much the worst of them missed
   for (std::size_t k = 0; k < log.read_ns.size(); ++k) {
-    // The newest change this step saw: the last one set before its end with its value.
+    age_ms.push_back(1e-6 * double(log.read_ns[k] - log.sample_ns[k]));
+    // The newest change this step saw: the last one begun before its read with its value.
     std::size_t seen = next;
     bool found = false;
-    for (std::size_t i = next; i < changes.size() && changes[i].first < log.read_ns[k]; ++i)
-      if (std::abs(changes[i].second - log.roll_stick[k]) < 2e-5) seen = i, found = true;
+    for (std::size_t i = next; i < changes.size() && changes[i].begun_ns < log.read_ns[k]; ++i)
+      if (std::abs(changes[i].value - log.roll_stick[k]) < 2e-5) seen = i, found = true;
     if (!found) continue;
-    for (std::size_t i = next; i <= seen; ++i)
-      latency_ms.push_back(1e-6 * double(log.read_ns[k] - changes[i].first));
+    for (std::size_t i = next; i <= seen; ++i) {
+      latency_ms.push_back(1e-6 * double(log.read_ns[k] - changes[i].made_ns));
+      // A change made before the previous step's sample was taken: that sample, and that
+      // step, had to hold it.
+      if (k > 0 && changes[i].made_ns < log.sample_ns[k - 1]) {
+        ++missed;
+        worst_miss_ms =
+            std::max(worst_miss_ms, 1e-6 * double(log.sample_ns[k - 1] - changes[i].made_ns));
+      }
+    }
     next = seen + 1;
   }
   ASSERT_GT(latency_ms.size(), 400u);
   std::sort(latency_ms.begin(), latency_ms.end());
-  const double p50 = latency_ms[latency_ms.size() / 2];
-  const double p99 = latency_ms[latency_ms.size() * 99 / 100];
+  std::sort(age_ms.begin(), age_ms.end());
+  const auto at = [](const std::vector<double>& v, int percent) {
+    return v[v.size() * std::size_t(percent) / 100];
+  };
   std::printf("axis change → controller: %zu changes, p50 %.2f ms, p99 %.2f ms, max %.2f ms "
-              "(control period 15 ms; to the read of the step that uses it)\n",
-              latency_ms.size(), p50, p99, latency_ms.back());
-  // Every change reaches the controller within one control period: a change just after a
-  // step's read is in the next step's, which the device samples read_lead before it reads (and
-  // at worst one poll earlier, when that sample is late). The threads involved sleep between
-  // polls and steps, and a general-purpose kernel may wake a sleeper late: the slowest change
-  // may exceed the bound by that lateness (a change in the last microseconds before a sample
-  // meets a late wake-up), which a millisecond covers. A controller reading the previous step's
-  // stick gave a median of 22.8 ms.
+              "(control period 15 ms; to the read of the step that uses it)\n"
+              "age of the sample a step reads: p50 %.3f ms, p99 %.3f ms, max %.3f ms; "
+              "changes a later sample missed: %zu (worst by %.3f ms)\n",
+              latency_ms.size(), at(latency_ms, 50), at(latency_ms, 99), latency_ms.back(),
+              at(age_ms, 50), at(age_ms, 99), age_ms.back(), missed, worst_miss_ms);
+  // No change is lost on the way: every sample holds every change set before it was taken, so
+  // a change waits at most for the next step's read after the sample the previous step read.
+  EXPECT_EQ(missed, 0u);
+  // The sample a step reads is fresh: the device is sampled read_lead before each read, and at
+  // worst (that sample late) the regular poll before it is used. Without the sample before the
+  // read the age would spread evenly over a poll interval: the median is held to halfway
+  // between the two designs' medians.
   const input::Gamepad::Options pad;
+  EXPECT_LE(at(age_ms, 50), 1e3 * (pad.read_lead_s + pad.poll_interval_s / 2) / 2);
+  EXPECT_LE(at(age_ms, 99), 1e3 * (pad.poll_interval_s + pad.read_lead_s));
+  // Hence a change reaches the controller within one control period: a change just after a
+  // step's sample is in the next step's. The sleeping threads may wake late under a
+  // general-purpose kernel, which stretches the worst changes (a preemption, not a lost
+  // change: that is `missed` above), not the 99th percentile. A controller reading the
+  // previous step's stick gave a median of 22.8 ms.
   const double bound_ms = 1e3 * (ps.mode->dt() + pad.poll_interval_s + pad.read_lead_s);
-  constexpr double kLateWakeupMs = 1.0;
-  EXPECT_LE(p99, bound_ms);
-  EXPECT_LE(latency_ms.back(), bound_ms + kLateWakeupMs);
-  EXPECT_LE(p50, bound_ms / 2);
+  EXPECT_LE(at(latency_ms, 99), bound_ms);
+  EXPECT_LE(at(latency_ms, 50), bound_ms / 2);
 }
 
 TEST(GamepadHaptic, TheRumbleFollowsLambdaBelowTheThreshold) {
@@ -294,6 +325,7 @@ TEST(GamepadHaptic, TheRumbleFollowsLambdaBelowTheThreshold) {
   log.pilot = ps.pilot;
   log.gamepad = &ps.gamepad;
   log.read_ns.reserve(1000);
+  log.sample_ns.reserve(1000);
   log.roll_stick.reserve(1000);
   log.lambda.reserve(1000);
   session.add_sink(&log);
