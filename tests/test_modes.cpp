@@ -1,7 +1,7 @@
 // Every mode behind the one Mode interface (core/modes/mode.hpp), made from its shipped
 // scenario through make_mode(): two runs are identical bit for bit, step() allocates nothing
-// (every malloc is counted, no_malloc.hpp), the metrics show the thesis behaviour, and a recording of the run reads back with
-// one state and one channel message per step.
+// (every malloc is counted, no_malloc.hpp), the metrics show the thesis behaviour, and a
+// recording of the run reads back with one state and one channel message per step.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -7,8 +7,8 @@
 // flight then goes on exactly as recorded: state, input, λ, pilot command, prediction, solver
 // status, channels and events of every remaining step, bit for bit, and the same metrics at the
 // end. Saving into a sized snapshot, restoring and stepping allocate nothing (every malloc is
-// counted, no_malloc.hpp); a snapshot of
-// another kind of mode, scenario or pilot is refused and changes nothing.
+// counted, no_malloc.hpp); a snapshot of another kind of mode, scenario or pilot is refused and
+// changes nothing.
 #include <gtest/gtest.h>
 
 #include <chrono>
