@@ -1027,27 +1027,20 @@ TEST(QpKernels, GemmNnMatchesEigen) {
         }
 }
 
-// The condensing's Aᵀ B kernel against Eigen: rows 1..13 (blocks of four and a scalar tail),
-// columns 1..5, k = 0..17 (vectors of four and a masked tail), larger leading dimensions,
-// accumulating and overwriting; rows below m untouched.
-TEST(QpKernels, GemmTnMatchesEigen) {
-  std::srand(12);
-  for (int m = 1; m <= 13; ++m)
-    for (int n = 1; n <= 5; ++n)
-      for (int k : {0, 1, 3, 4, 13, 17})
-        for (bool overwrite : {false, true}) {
-          const Eigen::MatrixXd A = Eigen::MatrixXd::Random(k + 3, m);
-          const Eigen::MatrixXd B = Eigen::MatrixXd::Random(k + 2, n);
-          Eigen::MatrixXd C = Eigen::MatrixXd::Random(m + 1, n);
-          const Eigen::MatrixXd C0 = C;
-          Eigen::MatrixXd expected = A.topRows(k).transpose() * B.topRows(k);
-          if (!overwrite) expected += C0.topRows(m);
-          kernels::gemm_tn(m, n, k, A.data(), int(A.rows()), B.data(), int(B.rows()), C.data(),
-                           int(C.rows()), overwrite);
-          EXPECT_LE((C.topRows(m) - expected).cwiseAbs().maxCoeff(), 1e-14 * (k + 1))
-              << m << "x" << n << "x" << k;
-          EXPECT_EQ(C.row(m), C0.row(m));
-        }
+// The transposing copy against Eigen: every shape up to 9 x 9 (4 x 4 blocks, row and column
+// tails), larger leading dimensions; the destination's rows and columns outside Aᵀ untouched.
+TEST(QpKernels, TransposeMatchesEigen) {
+  std::srand(13);
+  for (int m = 0; m <= 9; ++m)
+    for (int n = 0; n <= 9; ++n) {
+      const Eigen::MatrixXd A = Eigen::MatrixXd::Random(m + 2, n);
+      Eigen::MatrixXd B = Eigen::MatrixXd::Random(n + 3, m + 1);
+      const Eigen::MatrixXd B0 = B;
+      kernels::transpose(m, n, A.data(), int(A.rows()), B.data(), int(B.rows()));
+      EXPECT_EQ(B.topLeftCorner(n, m), A.topRows(m).transpose()) << m << "x" << n;
+      EXPECT_EQ(B.bottomRows(3), B0.bottomRows(3));
+      EXPECT_EQ(B.col(m), B0.col(m));
+    }
 }
 
 // Each condensed pair block against the formulas of core/qp/qp_riccati_ipm_pairs.hpp, evaluated

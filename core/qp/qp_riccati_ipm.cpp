@@ -102,8 +102,7 @@ bool QpRiccatiIpm::setup(const OcpQpDims& dims, const Settings& settings) {
   return true;
 }
 
-// Copies the stage data into the solver's layout; false if an index is out of range or a size
-// does not match.
+// Copies the stage data into the solver's layout (indices and sizes were validated).
 void QpRiccatiIpm::load(const OcpQp& qp) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
@@ -112,18 +111,10 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     const OcpQpStage& s = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], nbu = d.nbu[i], nbx = d.nbx[i], ng = d.ng[i];
     const int nc = w.nc[i], ns = d.ns[i];
-    // Plain loops over the source columns: Eigen's transposed and triangular block assignments
-    // cost several times more at these sizes, and this runs for every QP.
     if (i < d.N) {  // [Bᵀ; Aᵀ]
       const int nx1 = d.nx[i + 1], ldb = static_cast<int>(w.BAt[i].rows());
-      double* bat = w.BAt[i].data();
-      const double* B = s.B.data();
-      const double* A = s.A.data();
-      for (int r = 0; r < nu; ++r)
-        for (int c = 0; c < nx1; ++c) bat[r + static_cast<std::ptrdiff_t>(c) * ldb] = B[c + r * nx1];
-      for (int r = 0; r < nx; ++r)
-        for (int c = 0; c < nx1; ++c)
-          bat[nu + r + static_cast<std::ptrdiff_t>(c) * ldb] = A[c + r * nx1];
+      kernels::transpose(nx1, nu, s.B.data(), nx1, w.BAt[i].data(), ldb);
+      kernels::transpose(nx1, nx, s.A.data(), nx1, w.BAt[i].data() + nu, ldb);
       std::copy_n(s.b.data(), nx1, w.bflat.data() + w.off_pi[i]);
     }
     std::copy_n(s.r.data(), nu, w.gflat.data() + w.off_v[i]);
@@ -132,11 +123,8 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
     std::copy_n(s.zu.data(), ns, w.zflat.data() + w.off_s[i] + ns);
     if (ng > 0) {  // [Dᵀ; Cᵀ]
       const int nv = nu + nx;
-      double* dct = w.DCt[i].data();
-      for (int r = 0; r < nu; ++r)
-        for (int k = 0; k < ng; ++k) dct[r + k * nv] = s.D.data()[k + r * ng];
-      for (int r = 0; r < nx; ++r)
-        for (int k = 0; k < ng; ++k) dct[nu + r + k * nv] = s.C.data()[k + r * ng];
+      kernels::transpose(ng, nu, s.D.data(), ng, w.DCt[i].data(), nv);
+      kernels::transpose(ng, nx, s.C.data(), ng, w.DCt[i].data() + nu, nv);
     }
     // Stage Hessian [R S; Sᵀ Q] in (u, x) order, lower triangle (the strict upper stays zero),
     // for the factorization; the residuals read R, S and Q in place.
@@ -144,10 +132,10 @@ void QpRiccatiIpm::load(const OcpQp& qp) {
       const int ldh = static_cast<int>(w.Hbase[i].rows());
       double* h = w.Hbase[i].data();
       double scale = 0.0;
+      kernels::transpose(nu, nx, s.S.data(), nu, h + nu, ldh);
       for (int c = 0; c < nu; ++c) {
         const double* rc = s.R.data() + c * nu;
         for (int r = c; r < nu; ++r) h[r + c * ldh] = rc[r];
-        for (int r = 0; r < nx; ++r) h[nu + r + c * ldh] = s.S.data()[c + r * nu];
         scale = std::max(scale, std::abs(rc[c]));
       }
       for (int c = 0; c < nx; ++c) {

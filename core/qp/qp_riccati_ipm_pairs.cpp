@@ -124,6 +124,7 @@ bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
   }
   Q1A0_.setZero(nx, nx);
   Q1B0_.setZero(nx, nu);
+  BA0t_.setZero(nu + nx, nx);
   g1_.resize(nx);
   x1_.resize(nx);
   constant_.assign(first_.size(), 0.0);
@@ -196,12 +197,19 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   std::copy_n(s1.B.data(), nx2 * nu1, t.B.data() + static_cast<std::ptrdiff_t>(nx2) * nu0);
   t.b = s1.b;
   add_ax(s1.A, s0.b, t.b);
+  // [B0ᵀ; A0ᵀ] once: the products below are then plain A B (register tiles reuse each loaded
+  // column four times; a transposed product reloads it per column).
+  double* BAt = BA0t_.data();
+  const int ldt = static_cast<int>(BA0t_.rows());
+  kernels::transpose(nx1, nu0, B0.data(), nx1, BAt, ldt);
+  kernels::transpose(nx1, nx0, A0.data(), nx1, BAt + nu0, ldt);
+  const double* At = BAt + nu0;
   // Cost. Q = Q0 + A0ᵀQ1A0: its lower triangle (blocks of 4 columns), then mirrored.
   t.Q = s0.Q;
   for (int cb = 0; cb < nx0; cb += 4)
-    kernels::gemm_tn(nx0 - cb, std::min(4, nx0 - cb), nx1, A0.data() + std::ptrdiff_t(cb) * nx1,
-                     nx1, QA + std::ptrdiff_t(cb) * ldq, ldq,
-                     t.Q.data() + cb + std::ptrdiff_t(cb) * nx0, nx0);
+    kernels::gemm_nn(nx0 - cb, std::min(4, nx0 - cb), nx1, At + cb, ldt,
+                     QA + std::ptrdiff_t(cb) * ldq, ldq, t.Q.data() + cb + std::ptrdiff_t(cb) * nx0,
+                     nx0);
   for (int c = 1; c < nx0; ++c) {
     double* qc = t.Q.data() + std::ptrdiff_t(c) * nx0;
     const double* qr = t.Q.data() + c;
@@ -209,15 +217,16 @@ void QpRiccatiIpmPairs::condense_pair(const OcpQp& qp, int j) {
   }
   // S = [S0 + B0ᵀQ1A0; S1A0].
   t.S.topRows(nu0) = s0.S;
-  kernels::gemm_tn(nu0, nx0, nx1, B0.data(), nx1, QA, ldq, t.S.data(), nu);
+  kernels::gemm_nn(nu0, nx0, nx1, BAt, ldt, QA, ldq, t.S.data(), nu);
   // R = [R0 + B0ᵀQ1B0, (S1B0)ᵀ; S1B0, R1].
   t.R.topLeftCorner(nu0, nu0) = s0.R;
-  kernels::gemm_tn(nu0, nu0, nx1, B0.data(), nx1, QB, ldq, t.R.data(), nu);
+  kernels::gemm_nn(nu0, nu0, nx1, BAt, ldt, QB, ldq, t.R.data(), nu);
   t.R.bottomRightCorner(nu1, nu1) = s1.R;
-  t.q = s0.q;
-  add_atx(A0, g1, t.q);
+  // [r; q] += [B0ᵀ; A0ᵀ] g1 (r's tail is stage k+1's).
   t.r.head(nu0) = s0.r;
-  add_atx(B0, g1, t.r.head(nu0));
+  t.q = s0.q;
+  kernels::gemv_n(nu0, nx1, BAt, ldt, g1.data(), t.r.data());
+  kernels::gemv_n(nx0, nx1, At, ldt, g1.data(), t.q.data());
   t.r.tail(nu1) = s1.r;
   if (nu1 > 0 && !is_zero(s1.S)) {
     set_ab(s1.S, A0, t.S.bottomRows(nu1));

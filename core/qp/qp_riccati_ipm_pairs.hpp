@@ -84,6 +84,7 @@ class QpRiccatiIpmPairs : public QpSolver {
   // Condensing workspace, sized for the largest stage.
   Eigen::MatrixXd Q1A0_;  // nx1 x nx0
   Eigen::MatrixXd Q1B0_;  // nx1 x nu0 (same leading dimension as Q1A0_)
+  Eigen::MatrixXd BA0t_;  // (nu0 + nx0) x nx1: [B0ᵀ; A0ᵀ]
   Eigen::VectorXd g1_;    // nx1: Q1 b0 + q1 (first the diagonal of a diagonal Q1)
   Eigen::VectorXd x1_;    // nx1: scratch of the expansion
   std::vector<double> constant_;  // per block: ½b0ᵀQ1b0 + q1ᵀb0

@@ -620,17 +620,6 @@ void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int
 #endif
 }
 
-void gemm_tn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
-             int ldc, bool overwrite) {
-  // Column c of C is Aᵀ times column c of B: one transposed product per column.
-  for (int c = 0; c < n && m > 0; ++c) {
-    double* cc = C + static_cast<ptrdiff_t>(c) * ldc;
-    if (overwrite)
-      for (int r = 0; r < m; ++r) cc[r] = 0.0;
-    gemv_t(k, m, A, lda, B + static_cast<ptrdiff_t>(c) * ldb, cc);
-  }
-}
-
 void trsv_lt_small(int n, const double* dinv, int lddinv, double* x) {
 #if defined(__AVX2__) && defined(__FMA__)
   // z_j = Σ_r M_rj x_r: four independent dot products of length 4 (M is zero outside n x n).
@@ -660,6 +649,36 @@ void trsv_lt_blocked(int n, const double* L, int ldl, const double* dinv, int ld
     }
     trsv_lt_small(4, dinv + jb, lddinv, x + jb);
   }
+}
+
+void transpose(int m, int n, const double* A, int lda, double* B, int ldb) {
+  const auto at = [](const double* M, int ld, int r, int c) -> const double& {
+    return M[r + static_cast<ptrdiff_t>(c) * ld];
+  };
+  int c = 0;
+#if defined(__AVX2__) && defined(__FMA__)
+  // Columns c..c+3 of A, rows r..r+3: unpack pairs, then swap 128-bit halves.
+  for (; c + 4 <= n; c += 4) {
+    int r = 0;
+    for (; r + 4 <= m; r += 4) {
+      const __m256d a0 = _mm256_loadu_pd(&at(A, lda, r, c));
+      const __m256d a1 = _mm256_loadu_pd(&at(A, lda, r, c + 1));
+      const __m256d a2 = _mm256_loadu_pd(&at(A, lda, r, c + 2));
+      const __m256d a3 = _mm256_loadu_pd(&at(A, lda, r, c + 3));
+      const __m256d t0 = _mm256_unpacklo_pd(a0, a1), t1 = _mm256_unpackhi_pd(a0, a1);
+      const __m256d t2 = _mm256_unpacklo_pd(a2, a3), t3 = _mm256_unpackhi_pd(a2, a3);
+      double* b = B + c + static_cast<ptrdiff_t>(r) * ldb;
+      _mm256_storeu_pd(b, _mm256_permute2f128_pd(t0, t2, 0x20));
+      _mm256_storeu_pd(b + ldb, _mm256_permute2f128_pd(t1, t3, 0x20));
+      _mm256_storeu_pd(b + 2 * static_cast<ptrdiff_t>(ldb), _mm256_permute2f128_pd(t0, t2, 0x31));
+      _mm256_storeu_pd(b + 3 * static_cast<ptrdiff_t>(ldb), _mm256_permute2f128_pd(t1, t3, 0x31));
+    }
+    for (; r < m; ++r)
+      for (int j = c; j < c + 4; ++j) B[j + static_cast<ptrdiff_t>(r) * ldb] = at(A, lda, r, j);
+  }
+#endif
+  for (; c < n; ++c)
+    for (int r = 0; r < m; ++r) B[c + static_cast<ptrdiff_t>(r) * ldb] = at(A, lda, r, c);
 }
 
 }  // namespace mixpilot::kernels

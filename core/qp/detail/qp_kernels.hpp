@@ -59,10 +59,8 @@ void gemv_n(int m, int n, const double* A, int lda, const double* x, double* y);
 void gemm_nn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
              int ldc, bool overwrite = false);
 void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y);
-// C += Aᵀ B with A k x m, B k x n, C m x n (column-major): each entry a dot product of two
-// columns, four rows at a time (partial condensing's Aᵀ(Q A) without transposing A). With
-// overwrite, C = Aᵀ B.
-void gemm_tn(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
-             int ldc, bool overwrite = false);
+// B (n x m) = Aᵀ with A m x n (column-major, any leading dimensions): 4 x 4 register blocks,
+// the QP's matrices into the solver's transposed layouts ([Bᵀ; Aᵀ], [Dᵀ; Cᵀ]).
+void transpose(int m, int n, const double* A, int lda, double* B, int ldb);
 
 }  // namespace mixpilot::kernels
