@@ -297,10 +297,11 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
                                    const Eigen::VectorXd& lam, const Eigen::VectorXd& g,
                                    const Eigen::VectorXd& z, const Eigen::VectorXd& b,
                                    Eigen::VectorXd& out_v, Eigen::VectorXd& out_s,
-                                   Eigen::VectorXd& out_pi) {
+                                   Eigen::VectorXd& out_pi, int first, int last) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
-  for (int i = 0; i <= d.N; ++i) {
+  if (last < 0) last = d.N;
+  for (int i = first; i <= last; ++i) {
     const OcpQpStage& st = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
     const int nb = d.nbu[i] + d.nbx[i];
@@ -343,12 +344,12 @@ void QpRiccatiIpm::linear_residual(const OcpQp& qp, const Eigen::VectorXd& v,
   }
 }
 
-void QpRiccatiIpm::residuals(const OcpQp& qp) {
+void QpRiccatiIpm::stage_residuals(const OcpQp& qp, int first, int last) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
   linear_residual(qp, w.v, w.pi, w.s, w.lam, w.gflat, w.zflat, w.bflat, w.res_v, w.res_s,
-                  w.res_pi);
-  for (int i = 0; i <= d.N; ++i) {
+                  w.res_pi, first, last);
+  for (int i = first; i <= last; ++i) {
     const int ns = d.ns[i], nc = w.nc[i];
     const int os = w.off_s[i], om = w.off_m[i], oc = w.off_c[i];
     eval_constraints(w, i, w.v, w.dd);
@@ -365,6 +366,10 @@ void QpRiccatiIpm::residuals(const OcpQp& qp) {
           w.mask[om + 2 * nc + ns + j] * (w.s[os + ns + j] - w.t[om + 2 * nc + ns + j]);
     }
   }
+}
+
+void QpRiccatiIpm::residual_norms() {
+  const Workspace& w = ws_;
   res_stat_ = stationarity_norm(w.res_v, w.res_s);
   res_eq_ = w.res_pi.size() > 0 ? w.res_pi.lpNorm<Eigen::Infinity>() : 0.0;
   res_ineq_ = w.res_t.size() > 0 ? w.res_t.lpNorm<Eigen::Infinity>() : 0.0;
@@ -449,12 +454,28 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
                                    const Eigen::VectorXd& rs, const Eigen::VectorXd& rpi,
                                    const Eigen::VectorXd& rt, const Eigen::VectorXd& rc,
                                    Eigen::VectorXd& dv, Eigen::VectorXd& dpi, Eigen::VectorXd& ds,
-                                   Eigen::VectorXd& dt, Eigen::VectorXd& dlam, bool with_pi) {
+                                   Eigen::VectorXd& dt, Eigen::VectorXd& dlam, bool with_pi,
+                                   int backward_from) {
   Workspace& w = ws_;
   const OcpQpDims& d = w.dims;
-  w.rho = (rc + w.lam.cwiseProduct(rt)).cwiseProduct(w.inv_t);
-  // Reduced gradients g̃ and the backward pass l_i = L_i⁻¹(g̃_i + Y_i y).
-  for (int i = d.N; i >= 0; --i) {
+  backward_pass(qp, rv, rs, rpi, rt, rc, 0, backward_from < 0 ? d.N : backward_from);
+  forward_pass(qp, rs, rpi, rt, rc, dv, dpi, ds, dt, dlam, with_pi);
+}
+
+// Reduced gradients g̃ and the backward pass l_i = L_i⁻¹(g̃_i + Y_i y), stages last down to first
+// (stage last + 1's l is there already when last < N); ρ of those stages.
+void QpRiccatiIpm::backward_pass(const OcpQp& qp, const Eigen::VectorXd& rv,
+                                 const Eigen::VectorXd& rs, const Eigen::VectorXd& rpi,
+                                 const Eigen::VectorXd& rt, const Eigen::VectorXd& rc, int first,
+                                 int last) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
+  const int m0 = w.off_m[first];
+  const int m1 = last < d.N ? w.off_m[last + 1] : static_cast<int>(w.t.size());
+  w.rho.segment(m0, m1 - m0) =
+      (rc.segment(m0, m1 - m0) + w.lam.segment(m0, m1 - m0).cwiseProduct(rt.segment(m0, m1 - m0)))
+          .cwiseProduct(w.inv_t.segment(m0, m1 - m0));
+  for (int i = last; i >= first; --i) {
     const OcpQpStage& st = qp.stage[i];
     const int nu = d.nu[i], nx = d.nx[i], ns = d.ns[i], nc = w.nc[i], ng = d.ng[i];
     const int nb = d.nbu[i] + d.nbx[i];
@@ -496,7 +517,17 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
     kernels::trsv_ln(nf, w.L[i].data(), static_cast<int>(w.L[i].rows()), w.Dinv[i].data(),
                      static_cast<int>(w.Dinv[i].rows()), g.data());
   }
-  // Forward pass.
+}
+
+// The forward pass from the backward pass's l, then the slack, inequality-slack and multiplier
+// directions.
+void QpRiccatiIpm::forward_pass(const OcpQp& qp, const Eigen::VectorXd& rs,
+                                const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
+                                const Eigen::VectorXd& rc, Eigen::VectorXd& dv,
+                                Eigen::VectorXd& dpi, Eigen::VectorXd& ds, Eigen::VectorXd& dt,
+                                Eigen::VectorXd& dlam, bool with_pi) {
+  Workspace& w = ws_;
+  const OcpQpDims& d = w.dims;
   for (int i = 0; i <= d.N; ++i) {
     const int nu = d.nu[i], nx = d.nx[i];
     const int ov = w.off_v[i];
@@ -566,10 +597,10 @@ void QpRiccatiIpm::solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv,
   dlam = -(rc + w.lam.cwiseProduct(dt)).cwiseProduct(w.inv_t);
 }
 
-void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine) {
+void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine, int backward_from) {
   Workspace& w = ws_;
   solve_direction(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, w.dv, w.dpi, w.ds, w.dt, w.dlam,
-                  final);
+                  final, backward_from);
   int refinement_steps = final && refine ? settings_.refinement_steps : 0;
   // Iterative refinement: Δλ = −W ∇dΔv − ρ cancels to O(λ) from terms of O(W), so rounding in Δv
   // is amplified by W = λ/t → ∞; the error of the unreduced Newton equations is computed and
@@ -665,8 +696,19 @@ void QpRiccatiIpm::prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmSt
   if (!loaded_ || warm != QpWarmStart::primal_dual || ws_.dims.N == 0) return;
   // Stages 1..N start from `start` whatever x0 is; stage 0 (x_0 = x0) is initialized again in
   // solve(). Their factorization needs W = λ/t and the Hessian only.
-  for (int i = 1; i <= ws_.dims.N; ++i) initialize_stage(qp, start, warm, i);
-  prefactored_ = factorize(qp, 1, ws_.dims.N);
+  Workspace& w = ws_;
+  const int N = w.dims.N;
+  for (int i = 1; i <= N; ++i) initialize_stage(qp, start, warm, i);
+  prefactored_ = factorize(qp, 1, N);
+  if (!prefactored_) return;
+  // ... and their share of the first iteration's residuals and of its predictor's backward pass
+  // (stage 1's residual reads π_0, which stage 0's initialization sets to the same start).
+  w.pi.segment(w.off_pi[0], w.dims.nx[1]) = start.pi[0];
+  stage_residuals(qp, 1, N);
+  const int m1 = w.off_m[1], m = static_cast<int>(w.t.size()) - m1;
+  w.rc.segment(m1, m) =
+      w.mask.segment(m1, m).cwiseProduct(w.lam.segment(m1, m).cwiseProduct(w.t.segment(m1, m)));
+  backward_pass(qp, w.res_v, w.res_s, w.res_pi, w.res_t, w.rc, 1, N);
 }
 
 QpStatus QpRiccatiIpm::solve(const OcpQp& qp, OcpQpSolution& sol, QpWarmStart warm) {
@@ -700,7 +742,12 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, boo
   const Settings& cfg = settings_;
   QpStatus status = QpStatus::max_iterations;
   for (it = 0;; ++it) {
-    residuals(qp);
+    const bool prepared = it == 0 && prefactored;  // stages N..1 of this iteration done
+    if (prepared)
+      stage_residuals(qp, 0, 0);
+    else
+      stage_residuals(qp, 0, w.dims.N);
+    residual_norms();
     if (!(std::isfinite(res_stat_) && std::isfinite(res_eq_) && std::isfinite(res_ineq_) &&
           std::isfinite(mu_))) {
       status = QpStatus::nan_detected;  // cannot happen from finite data; kept as a guard
@@ -715,8 +762,7 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, boo
       status = QpStatus::max_iterations;
       break;
     }
-    const bool factorized = it == 0 && prefactored ? factorize(qp, 0, 0)
-                                                   : factorize(qp, 0, w.dims.N);
+    const bool factorized = prepared ? factorize(qp, 0, 0) : factorize(qp, 0, w.dims.N);
     if (!factorized) {
       status = QpStatus::factorization_failed;
       break;
@@ -726,7 +772,7 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, boo
     // Refinement only pays once the barrier weights W = λ/t ≳ λ²/μ are large, i.e. near the
     // end; the predictor only sets σ and the second-order term and is never refined.
     const bool refine = mu_ < qp_defaults::kRefineMuRatio * cfg.tol_comp;
-    newton_direction(qp, w.m_total == 0, refine);
+    newton_direction(qp, w.m_total == 0, refine, prepared ? 0 : w.dims.N);
     double target = 0.0;  // centring target of the corrector
     if (w.m_total > 0) {
       double a_aff = max_step(w.t, w.dt, 1.0);

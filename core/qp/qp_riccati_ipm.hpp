@@ -95,8 +95,8 @@ class QpRiccatiIpm final : public QpSolver {
   // Takes qp's data into the solver's layout (the x0-free part of a solve): the next solve()
   // of qp — only x0 may have changed — starts from it.
   void prepare(const OcpQp& qp) override;
-  // ... and, for a primal-dual warm start, initializes from `start` and factorizes the first
-  // Newton system of stages N..1 (QpSolver::prepare).
+  // ... and, for a primal-dual warm start, initializes from `start`, factorizes the first
+  // Newton system of stages N..1 and does their part of its predictor (QpSolver::prepare).
   void prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) override;
 
   // Solves qp (whose dims must equal the setup dims) into sol (sized with the same dims; read
@@ -118,27 +118,38 @@ class QpRiccatiIpm final : public QpSolver {
   void initialize_stage(const OcpQp& qp, const OcpQpSolution& sol, QpWarmStart warm, int i);
   // Mehrotra iterations from the initialized point until a status, at most max_iterations;
   // `it` receives the number taken. prefactored: the first iteration's stages N..1 are
-  // factorized already (prepare()), stage 0 is left.
+  // factorized, their residuals computed and their predictor's backward pass done (prepare());
+  // stage 0 is left.
   QpStatus iterate(const OcpQp& qp, int max_iterations, int& it, bool prefactored = false);
   void linear_residual(const OcpQp& qp, const Eigen::VectorXd& v, const Eigen::VectorXd& pi,
                        const Eigen::VectorXd& s, const Eigen::VectorXd& lam,
                        const Eigen::VectorXd& g, const Eigen::VectorXd& z,
                        const Eigen::VectorXd& b, Eigen::VectorXd& out_v, Eigen::VectorXd& out_s,
-                       Eigen::VectorXd& out_pi);
-  void residuals(const OcpQp& qp);
+                       Eigen::VectorXd& out_pi, int first = 0, int last = -1);
+  void stage_residuals(const OcpQp& qp, int first, int last);  // res_v, res_s, res_pi, res_t
+  void residual_norms();  // res_stat_, res_eq_, res_ineq_, mu_ from the whole vectors
   double stationarity_norm(const Eigen::VectorXd& rv, const Eigen::VectorXd& rs) const;
   // The Riccati factorization of the Newton system, stages `last` down to `first` (stage last + 1
   // factorized already when last < N).
   bool factorize(const OcpQp& qp, int first, int last);
   // Newton direction for the right-hand side (r_v, r_s, r_π, r_t, r_c) into (dv, dπ, ds, dt, dλ).
+  // backward_from < N: the backward pass of stages N..backward_from + 1 is done already, for
+  // this right-hand side (−1: N).
   void solve_direction(const OcpQp& qp, const Eigen::VectorXd& rv, const Eigen::VectorXd& rs,
                        const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
                        const Eigen::VectorXd& rc, Eigen::VectorXd& dv, Eigen::VectorXd& dpi,
                        Eigen::VectorXd& ds, Eigen::VectorXd& dt, Eigen::VectorXd& dlam,
-                       bool with_pi);
+                       bool with_pi, int backward_from = -1);
+  void backward_pass(const OcpQp& qp, const Eigen::VectorXd& rv, const Eigen::VectorXd& rs,
+                     const Eigen::VectorXd& rpi, const Eigen::VectorXd& rt,
+                     const Eigen::VectorXd& rc, int first, int last);
+  void forward_pass(const OcpQp& qp, const Eigen::VectorXd& rs, const Eigen::VectorXd& rpi,
+                    const Eigen::VectorXd& rt, const Eigen::VectorXd& rc, Eigen::VectorXd& dv,
+                    Eigen::VectorXd& dpi, Eigen::VectorXd& ds, Eigen::VectorXd& dt,
+                    Eigen::VectorXd& dlam, bool with_pi);
   // Direction for the current residuals and w.rc (Δπ only if final), refined if final and
-  // refine.
-  void newton_direction(const OcpQp& qp, bool final, bool refine);
+  // refine; backward_from as for solve_direction.
+  void newton_direction(const OcpQp& qp, bool final, bool refine, int backward_from = -1);
   void write_solution(const OcpQp& qp, OcpQpSolution& sol);
 
   Settings settings_{};

@@ -64,7 +64,8 @@ class QpSolver {
   // solution, known before x̄_0): a solver may also do the x0-free part of its first iteration.
   // The Riccati IPM, warm-started primal-dual, factorizes the first Newton system of every stage
   // but stage 0 here (their W = λ/t and Hessians do not involve x0; x_0 only enters stage 0's
-  // constraints), so the feedback phase factorizes one stage before its first direction. The
+  // constraints) and computes those stages' residuals and the predictor's backward pass through
+  // them (neither reads x_0), so the feedback phase starts its first iteration at stage 0. The
   // next solve() must be given the same start and warm.
   virtual void prepare(const OcpQp& qp, const OcpQpSolution& start, QpWarmStart warm) {
     (void)start;
