@@ -529,6 +529,34 @@ TEST(HistoryStore, MissingFoldersAreMadePrivate) {
 // ---- Writers at once, and killed ----------------------------------------------------------
 
 // Eight processes write 50 flights each into one file at once: 400 rows, none lost.
+// Processes that open the same new file together: one switches it to WAL and creates the
+// schema, the others wait for it (SQLite refuses the switch at once, without its busy handler,
+// while another opener holds a lock): every opener succeeds, in every round.
+TEST(HistoryStore, EightProcessesOpenANewFileAtOnce) {
+  constexpr int kRounds = 25, kProcs = 8;
+  for (int round = 0; round < kRounds; ++round) {
+    const fs::path p =
+        test::fresh_path("history", "opened_together_" + std::to_string(round) + ".sqlite");
+    std::vector<pid_t> kids;
+    for (int k = 0; k < kProcs; ++k) {
+      const pid_t pid = ::fork();
+      ASSERT_GE(pid, 0);
+      if (pid == 0) {
+        std::string error;
+        auto store = history::open_sqlite(p.string(), error);
+        if (!store) std::fprintf(stderr, "round %d, child %d: %s\n", round, k, error.c_str());
+        ::_exit(store ? 0 : 2);
+      }
+      kids.push_back(pid);
+    }
+    for (pid_t pid : kids) {
+      int st = 0;
+      ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+      EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "round " << round;
+    }
+  }
+}
+
 TEST(HistoryStore, EightProcessesWriteAtOnce) {
   const fs::path p = test::fresh_path("history", "parallel.sqlite");
   constexpr int kProcs = 8, kEach = 50;

@@ -145,11 +145,21 @@ bool SqliteHistory::init(const SqliteSettings& s, std::string& error) {
   sqlite3_extended_result_codes(db_, 1);
   sqlite3_busy_timeout(db_, s.busy_timeout_ms);
   if (!exec("PRAGMA foreign_keys = ON", error, "cannot switch foreign keys on")) return false;
-  // WAL: readers (a `history` listing) never wait for a writer (a flight closing).
+  // WAL: readers (a `history` listing) never wait for a writer (a flight closing). Switching a
+  // new file to WAL needs its exclusive lock, and SQLite answers SQLITE_BUSY at once, without the
+  // busy handler, when another process opening the same new file holds a lock it must wait for:
+  // retried here for as long as the busy timeout.
   {
     Stmt wal;
     if (!prepare(wal, "PRAGMA journal_mode = WAL", error)) return false;
-    const int rc = sqlite3_step(wal.get());
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(s.busy_timeout_ms);
+    int rc = sqlite3_step(wal.get());
+    while ((rc & 0xFF) == SQLITE_BUSY && std::chrono::steady_clock::now() < deadline) {
+      sqlite3_reset(wal.get());
+      sqlite3_sleep(5);
+      rc = sqlite3_step(wal.get());
+    }
     if (rc != SQLITE_ROW) {
       error = fail("cannot open");
       return false;
