@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -50,6 +51,42 @@ inline void expect_same_flight(const history::FlightRecord& f, const history::St
     else
       EXPECT_TRUE(std::isnan(r.metrics[i].second)) << f.metrics[i].first;
   }
+}
+
+// Runs child(k), k = 0..n-1, in n processes forked at once, each ending with child(k)'s value as
+// its exit status; returns how many did not end with status 0 (or could not be forked).
+inline int failed_children(int n, const std::function<int(int)>& child) {
+  std::vector<pid_t> kids;
+  for (int k = 0; k < n; ++k) {
+    const pid_t pid = ::fork();
+    if (pid == 0) ::_exit(child(k));
+    if (pid > 0) kids.push_back(pid);
+  }
+  int failed = n - static_cast<int>(kids.size());
+  for (pid_t pid : kids) {
+    int st = 0;
+    if (::waitpid(pid, &st, 0) != pid || !WIFEXITED(st) || WEXITSTATUS(st) != 0) ++failed;
+  }
+  return failed;
+}
+
+// Writer k of the many-writers tests, in its own process: opens the store at `location`
+// (open_history; a new one or not) and adds `count` flights flight(k, i). Its exit status: 0,
+// 2 when the store does not open, 3 when a flight is not added (said on stderr).
+inline int write_flights(const std::string& location, int k, int count,
+                         const std::function<history::FlightRecord(int k, int i)>& flight) {
+  std::string error;
+  auto store = history::open_history(location, error);
+  if (!store) {
+    std::fprintf(stderr, "child %d: %s\n", k, error.c_str());
+    return 2;
+  }
+  for (int i = 0; i < count; ++i)
+    if (store->add(flight(k, i), error) != history::HistoryStore::Added::added) {
+      std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
+      return 3;
+    }
+  return 0;
 }
 
 // A writer process killed inside a transaction: it opens its store (`open`, in the child) and

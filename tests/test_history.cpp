@@ -528,7 +528,6 @@ TEST(HistoryStore, MissingFoldersAreMadePrivate) {
 
 // ---- Writers at once, and killed ----------------------------------------------------------
 
-// Eight processes write 50 flights each into one file at once: 400 rows, none lost.
 // Processes that open the same new file together: one switches it to WAL and creates the
 // schema, the others wait for it (SQLite refuses the switch at once, without its busy handler,
 // while another opener holds a lock): every opener succeeds, in every round.
@@ -537,57 +536,31 @@ TEST(HistoryStore, EightProcessesOpenANewFileAtOnce) {
   for (int round = 0; round < kRounds; ++round) {
     const fs::path p =
         test::fresh_path("history", "opened_together_" + std::to_string(round) + ".sqlite");
-    std::vector<pid_t> kids;
-    for (int k = 0; k < kProcs; ++k) {
-      const pid_t pid = ::fork();
-      ASSERT_GE(pid, 0);
-      if (pid == 0) {
-        std::string error;
-        auto store = history::open_sqlite(p.string(), error);
-        if (!store) std::fprintf(stderr, "round %d, child %d: %s\n", round, k, error.c_str());
-        ::_exit(store ? 0 : 2);
-      }
-      kids.push_back(pid);
-    }
-    for (pid_t pid : kids) {
-      int st = 0;
-      ASSERT_EQ(::waitpid(pid, &st, 0), pid);
-      EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "round " << round;
-    }
+    EXPECT_EQ(test::failed_children(kProcs,
+                                    [&](int k) {
+                                      std::string error;
+                                      if (history::open_sqlite(p.string(), error)) return 0;
+                                      std::fprintf(stderr, "round %d, child %d: %s\n", round, k,
+                                                   error.c_str());
+                                      return 2;
+                                    }),
+              0)
+        << "round " << round;
   }
 }
 
+// Eight processes write 50 flights each into one file at once: 400 rows, none lost.
 TEST(HistoryStore, EightProcessesWriteAtOnce) {
   const fs::path p = test::fresh_path("history", "parallel.sqlite");
   constexpr int kProcs = 8, kEach = 50;
-  std::vector<pid_t> kids;
-  for (int k = 0; k < kProcs; ++k) {
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      std::string error;
-      auto store = history::open_sqlite(p.string(), error);  // each its own, new file or not
-      if (!store) {
-        std::fprintf(stderr, "child %d: %s\n", k, error.c_str());
-        ::_exit(2);
-      }
-      for (int i = 0; i < kEach; ++i) {
-        FlightRecord f = sample_flight("writer " + std::to_string(k), i);
-        f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
-        if (store->add(f, error) != HistoryStore::Added::added) {
-          std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
-          ::_exit(3);
-        }
-      }
-      ::_exit(0);
-    }
-    kids.push_back(pid);
-  }
-  for (pid_t pid : kids) {
-    int st = 0;
-    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
-    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "a writer failed: " << st;
-  }
+  const int failed = test::failed_children(kProcs, [&](int k) {
+    return test::write_flights(p.string(), k, kEach, [](int k, int i) {
+      FlightRecord f = sample_flight("writer " + std::to_string(k), i);
+      f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+      return f;
+    });
+  });
+  EXPECT_EQ(failed, 0) << "writers failed";
   auto store = open_store(p);
   ASSERT_TRUE(store);
   const auto rows = all(*store);

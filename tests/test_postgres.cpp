@@ -434,36 +434,16 @@ TEST(Postgres, EightProcessesWriteAtOnce) {
   MIXPILOT_REQUIRE_POSTGRES(server);
   const std::string url = fresh_database(*server, "parallel");
   constexpr int kProcs = 8, kEach = 50;
-  std::vector<pid_t> kids;
-  for (int k = 0; k < kProcs; ++k) {
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      std::string error;
-      auto store = history::open_history(url, error);  // each its own, new database or not
-      if (!store) {
-        std::fprintf(stderr, "child %d: %s\n", k, error.c_str());
-        ::_exit(2);
-      }
-      for (int i = 0; i < kEach; ++i) {
-        // Two trainees shared by all writers: their rows are made at once too.
-        FlightRecord f = sample_flight(k % 2 ? "Ben" : "Ada", i);
-        f.station = "station " + std::to_string(k);
-        f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
-        if (store->add(f, error) != HistoryStore::Added::added) {
-          std::fprintf(stderr, "child %d flight %d: %s\n", k, i, error.c_str());
-          ::_exit(3);
-        }
-      }
-      ::_exit(0);
-    }
-    kids.push_back(pid);
-  }
-  for (pid_t pid : kids) {
-    int st = 0;
-    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
-    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "a writer failed: " << st;
-  }
+  const int failed = test::failed_children(kProcs, [&](int k) {
+    return test::write_flights(url, k, kEach, [](int k, int i) {
+      // Two trainees shared by all writers: their rows are made at once too.
+      FlightRecord f = sample_flight(k % 2 ? "Ben" : "Ada", i);
+      f.station = "station " + std::to_string(k);
+      f.recording_hash = sha256_hex(std::to_string(k) + "/" + std::to_string(i));
+      return f;
+    });
+  });
+  EXPECT_EQ(failed, 0) << "writers failed";
   auto store = open_store(url);
   ASSERT_TRUE(store);
   const auto rows = all(*store);
