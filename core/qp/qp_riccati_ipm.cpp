@@ -743,10 +743,7 @@ QpStatus QpRiccatiIpm::iterate(const OcpQp& qp, int max_iterations, int& it, boo
   QpStatus status = QpStatus::max_iterations;
   for (it = 0;; ++it) {
     const bool prepared = it == 0 && prefactored;  // stages N..1 of this iteration done
-    if (prepared)
-      stage_residuals(qp, 0, 0);
-    else
-      stage_residuals(qp, 0, w.dims.N);
+    stage_residuals(qp, 0, prepared ? 0 : w.dims.N);
     residual_norms();
     if (!(std::isfinite(res_stat_) && std::isfinite(res_eq_) && std::isfinite(res_ineq_) &&
           std::isfinite(mu_))) {
