@@ -204,6 +204,24 @@ struct Dual {
   }
 };
 
+// A dependent variable from its partial derivatives: r = value, dr = Σ_k c_k da_k. For a
+// hand-written tangent of a function whose Jacobian is sparse (a model's dynamics_tangent):
+// one pass over the derivatives per nonzero, none for the intermediate terms the AD of the
+// same formula differentiates.
+template <int n, int K>
+Dual<n> chain(double value, const double (&c)[K], const Dual<n>* const (&a)[K]) {
+  Dual<n> r;
+  r.v = value;
+#pragma GCC unroll 16
+  for (int j = 0; j < Dual<n>::blocks; ++j) {
+    typename Dual<n>::Block s = c[0] * a[0]->d[j];
+#pragma GCC unroll 16
+    for (int k = 1; k < K; ++k) s += c[k] * a[k]->d[j];
+    r.d[j] = s;
+  }
+  return r;
+}
+
 }  // namespace mixpilot::models
 
 // Eigen: Dual is a real scalar, and mixes with double in expressions (x + h * k).

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include "models/dual.hpp"
+
 namespace mixpilot::models {
 
 struct MikroKopterParams {
@@ -84,6 +86,79 @@ struct MikroKopter {
     xdot(13) = (u(1) - p.C_D * s2 - p.D * x(13)) * inv_jm;
     xdot(14) = (u(2) - p.C_D * s3 - p.D * x(14)) * inv_jm;
     xdot(15) = (u(3) - p.C_D * s4 - p.D * x(15)) * inv_jm;
+  }
+
+  // The same f on dual numbers, ∂f/∂z from the Jacobian's nonzeros (models/model.hpp); the
+  // values are dynamics<double>'s. With a = sφ ω_y + cφ ω_z, b = cφ ω_y − sφ ω_z:
+  //   ∂ṗ/∂v = R,  ∂ṗ/∂φ = (r_i2 v_y − r_i1 v_z)_i,  ∂ṗ/∂θ = (cψ T, sψ T, −(cθ v_x + sθ sφ v_y +
+  //   sθ cφ v_z)) with T = −sθ v_x + cθ sφ v_y + cθ cφ v_z,  ∂ṗ/∂ψ = (−ṗ_y, ṗ_x, 0);
+  //   φ̇: ∂φ = tθ b, ∂θ = a/cθ²;  θ̇: ∂φ = −a;  ψ̇: ∂φ = b/cθ, ∂θ = a tθ/cθ;
+  //   v̇ and ω̇ are bilinear in (v, ω) plus gravity's R row and the rotor terms ∂Ω_i² = 2Ω_i.
+  template <int n>
+  void dynamics_tangent(const Eigen::Matrix<Dual<n>, nx, 1>& x,
+                        const Eigen::Matrix<Dual<n>, nu, 1>& u,
+                        Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
+    State xv, f;
+    Input uv;
+    for (int i = 0; i < nx; ++i) xv(i) = x(i).v;
+    for (int i = 0; i < nu; ++i) uv(i) = u(i).v;
+    dynamics(xv, uv, f);
+    const double vx = xv(6), vy = xv(7), vz = xv(8), wx = xv(9), wy = xv(10), wz = xv(11);
+    const double cph = std::cos(xv(3)), sph = std::sin(xv(3));
+    const double cth = std::cos(xv(4)), sth = std::sin(xv(4));
+    const double cps = std::cos(xv(5)), sps = std::sin(xv(5));
+    const double r00 = cps * cth, r01 = cps * sth * sph - sps * cph;
+    const double r02 = cps * sth * cph + sps * sph, r10 = sps * cth;
+    const double r11 = sps * sth * sph + cps * cph, r12 = sps * sth * cph - cps * sph;
+    const double r20 = -sth, r21 = cth * sph, r22 = cth * cph;
+    using P = const Dual<n>*;  // the tangents of the state's components
+    const P dph = &x(3), dth = &x(4), dps = &x(5), dvx = &x(6), dvy = &x(7), dvz = &x(8);
+    const P dwx = &x(9), dwy = &x(10), dwz = &x(11);
+    const P dO1 = &x(12), dO2 = &x(13), dO3 = &x(14), dO4 = &x(15);
+
+    const double T = -sth * vx + cth * sph * vy + cth * cph * vz;
+    xdot(0) = chain(f(0), {r00, r01, r02, r02 * vy - r01 * vz, cps * T, -f(1)},
+                    {dvx, dvy, dvz, dph, dth, dps});
+    xdot(1) = chain(f(1), {r10, r11, r12, r12 * vy - r11 * vz, sps * T, f(0)},
+                    {dvx, dvy, dvz, dph, dth, dps});
+    xdot(2) = chain(f(2), {r20, r21, r22, r22 * vy - r21 * vz,
+                           -(cth * vx + sth * sph * vy + sth * cph * vz)},
+                    {dvx, dvy, dvz, dph, dth});
+
+    const double a = sph * wy + cph * wz, b = cph * wy - sph * wz;
+    const double tth = sth / cth, icth = 1.0 / cth;
+    xdot(3) = chain(f(3), {1.0, sph * tth, cph * tth, tth * b, a * icth * icth},
+                    {dwx, dwy, dwz, dph, dth});
+    xdot(4) = chain(f(4), {cph, -sph, -a}, {dwy, dwz, dph});
+    xdot(5) = chain(f(5), {sph * icth, cph * icth, b * icth, a * tth * icth},
+                    {dwy, dwz, dph, dth});
+
+    const double g = p.g;
+    xdot(6) = chain(f(6), {g * cth, wz, -wy, -vz, vy}, {dth, dvy, dvz, dwy, dwz});
+    xdot(7) = chain(f(7), {-g * r22, g * sth * sph, -wz, wx, vz, -vx},
+                    {dph, dth, dvx, dvz, dwx, dwz});
+    const double o1 = xv(12), o2 = xv(13), o3 = xv(14), o4 = xv(15);
+    const double kt = 2.0 * p.C_T / p.m;
+    xdot(8) = chain(f(8), {g * r21, g * sth * cph, wy, -wx, -vy, vx, kt * o1, kt * o2, kt * o3,
+                           kt * o4},
+                    {dph, dth, dvx, dvy, dwx, dwy, dO1, dO2, dO3, dO4});
+
+    const double kl = 2.0 * p.C_T * p.l, kd = 2.0 * p.C_D;
+    const double ex = (p.Jzz - p.Jyy) / p.Jxx, ey = (p.Jxx - p.Jzz) / p.Jyy,
+                 ez = (p.Jyy - p.Jxx) / p.Jzz;
+    xdot(9) = chain(f(9), {kl * o2 / p.Jxx, -kl * o4 / p.Jxx, -ex * wz, -ex * wy},
+                    {dO2, dO4, dwy, dwz});
+    xdot(10) = chain(f(10), {kl * o3 / p.Jyy, -kl * o1 / p.Jyy, -ey * wz, -ey * wx},
+                     {dO3, dO1, dwx, dwz});
+    xdot(11) = chain(f(11), {kd * o1 / p.Jzz, -kd * o2 / p.Jzz, kd * o3 / p.Jzz,
+                             -kd * o4 / p.Jzz, -ez * wy, -ez * wx},
+                     {dO1, dO2, dO3, dO4, dwx, dwy});
+
+    const double inv_jm = 1.0 / p.J_m;
+    for (int i = 0; i < nu; ++i) {
+      const double o = xv(12 + i);
+      xdot(12 + i) = chain(f(12 + i), {-(kd * o + p.D) * inv_jm, inv_jm}, {&x(12 + i), &u(i)});
+    }
   }
 
   // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's

@@ -4,9 +4,14 @@
 // Jacobians come from forward-mode automatic differentiation (models/dual.hpp, a dual number
 // with a fixed-size derivative array) rather than hand-written formulas: they are exact to
 // rounding, cannot drift from the model when it changes, and the fixed size lets the compiler
-// unroll and vectorize the derivative arithmetic, which exploits the sparsity of f for free
-// (each elementary operation costs one short vector update). See core/numerics/integrator_erk4.hpp for
-// the same technique applied to a whole ERK4 step, which is what the NMPC uses.
+// unroll and vectorize the derivative arithmetic (each elementary operation costs one short
+// vector update). See core/numerics/integrator_erk4.hpp for the same technique applied to a
+// whole ERK4 step, which is what the NMPC uses.
+//
+// A model may also give dynamics_tangent(): the same f on dual numbers with ∂f/∂z written out
+// from its Jacobian's nonzeros (models::chain), which skips the derivative arithmetic of every
+// intermediate term (a rotation matrix's nine entries, say). The NMPC's sensitivities then use
+// it; tests/test_models.cpp holds it to the AD of dynamics() at random points and directions.
 #include <concepts>
 
 #include <Eigen/Core>
@@ -30,6 +35,18 @@ concept DynamicModel = requires(const M& m, const Eigen::Matrix<double, M::nx, 1
 template <class M, class T>
 void project(const M& model, Eigen::Matrix<T, M::nx, 1>& x) {
   if constexpr (requires { model.project(x); }) model.project(x);
+}
+
+// f(x, u) on dual numbers: the model's hand-written tangent where it has one, else the AD of
+// dynamics().
+template <class M, int n>
+void dynamics_dual(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
+                   const Eigen::Matrix<Dual<n>, M::nu, 1>& u,
+                   Eigen::Matrix<Dual<n>, M::nx, 1>& xdot) {
+  if constexpr (requires { model.dynamics_tangent(x, u, xdot); })
+    model.dynamics_tangent(x, u, xdot);
+  else
+    model.dynamics(x, u, xdot);
 }
 
 // Forward-mode AD scalar carrying derivatives with respect to n directions. Constructed and
@@ -78,7 +95,7 @@ void dynamics_jacobians(const M& model, const Eigen::Matrix<double, M::nx, 1>& x
   for (int i = 0; i < nx; ++i) xa(i) = Ad(x(i), nz, i);
   for (int i = 0; i < nu; ++i) ua(i) = Ad(u(i), nz, nx + i);
   Eigen::Matrix<Ad, nx, 1> fa;
-  model.dynamics(xa, ua, fa);
+  dynamics_dual(model, xa, ua, fa);
   for (int i = 0; i < nx; ++i) {
     f(i) = fa(i).value();
     for (int j = 0; j < nx; ++j) fx(i, j) = fa(i).derivative(j);

@@ -3,10 +3,12 @@
 //   k1 = f(x, u), k2 = f(x + Δt/2 k1, u), k3 = f(x + Δt/2 k2, u), k4 = f(x + Δt k3, u),
 //   x⁺ = x + Δt/6 (k1 + 2 k2 + 2 k3 + k4), then the model's projection (models/model.hpp).
 // Sensitivities: the step is evaluated once in forward-mode AD (models/dual.hpp) with nx + nu
-// seeded directions (z = (x, u)), so A and B are the exact derivatives of the discrete map, identical to forward
-// propagation of the variational equations through the same Butcher tableau ("internal
-// numerical differentiation"), without forming dense nx x nx products per stage.
+// seeded directions (z = (x, u)), f by the model's hand-written tangent where it has one
+// (models::dynamics_dual), so A and B are the exact derivatives of the discrete map, identical
+// to forward propagation of the variational equations through the same Butcher tableau
+// ("internal numerical differentiation"), without forming dense nx x nx products per stage.
 // All temporaries are fixed-size and live on the stack: no heap allocation.
+#include "core/numerics/finite.hpp"
 #include "core/numerics/integrator.hpp"
 #include "models/model.hpp"
 
@@ -55,13 +57,13 @@ class IntegratorErk4 final : public Integrator {
     AdInput ua;
     for (int i = 0; i < kNx; ++i) xz(i) = Ad::variable(x(i), i);
     for (int i = 0; i < kNu; ++i) ua(i) = Ad::variable(u(i), kNx + i);
-    model_.dynamics(xz, ua, k);  // k1
+    models::dynamics_dual(model_, xz, ua, k);  // k1
     stage<true>(xz, 0.5 * dt, 1.0, k, acc, xs);
-    model_.dynamics(xs, ua, k);  // k2
+    models::dynamics_dual(model_, xs, ua, k);  // k2
     stage<false>(xz, 0.5 * dt, 2.0, k, acc, xs);
-    model_.dynamics(xs, ua, k);  // k3
+    models::dynamics_dual(model_, xs, ua, k);  // k3
     stage<false>(xz, dt, 2.0, k, acc, xs);
-    model_.dynamics(xs, ua, k);  // k4
+    models::dynamics_dual(model_, xs, ua, k);  // k4
     finish(xz, dt / 6.0, k, acc, xs);
     models::project(model_, xs);
     for (int i = 0; i < kNx; ++i) {
@@ -81,7 +83,7 @@ class IntegratorErk4 final : public Integrator {
     State xn;
     step<double>(State(x), Input(u), dt, xn);
     x_next = xn;
-    return xn.allFinite() ? IntegratorStatus::success : IntegratorStatus::non_finite;
+    return all_finite(xn) ? IntegratorStatus::success : IntegratorStatus::non_finite;
   }
 
   IntegratorStatus step_sensitivities(const Eigen::Ref<const Eigen::VectorXd>& x,
@@ -96,7 +98,7 @@ class IntegratorErk4 final : public Integrator {
     x_next = xn;
     A = a;
     B = b;
-    const bool finite = xn.allFinite() && a.allFinite() && b.allFinite();
+    const bool finite = all_finite(xn) && all_finite(a) && all_finite(b);
     return finite ? IntegratorStatus::success : IntegratorStatus::non_finite;
   }
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/numerics/finite.hpp"
+
 namespace mixpilot {
 
 OcpQpDims::OcpQpDims(int horizon)
@@ -132,10 +134,6 @@ void OcpQpSolution::resize(const OcpQpDims& d) {
 
 
 namespace {
-// Σ x·0 is 0 for finite data and NaN as soon as one entry is NaN or ±inf; a plain vectorized sum
-// (Eigen's allFinite costs several instructions per entry, and this scan runs every solve).
-bool finite(const Eigen::MatrixXd& m) { return (m.array() * 0.0).sum() == 0.0; }
-bool finite(const Eigen::VectorXd& m) { return (m.array() * 0.0).sum() == 0.0; }
 // Bounds: NaN is invalid; ±inf or |b| ≥ inf_bound means the side is absent.
 bool bound_ok(const Eigen::VectorXd& b) {
   for (Eigen::Index k = 0; k < b.size(); ++k)
@@ -180,12 +178,13 @@ QpStatus OcpQpSolution::set_invalid_data() {
 }
 
 bool ocp_qp_data_finite(const OcpQp& qp) {
-  if (!finite(qp.x0)) return false;
+  if (!all_finite(qp.x0)) return false;
   for (int i = 0; i <= qp.dims.N; ++i) {
     const OcpQpStage& s = qp.stage[i];
-    if (!(finite(s.A) && finite(s.B) && finite(s.b) && finite(s.Q) && finite(s.S) &&
-          finite(s.R) && finite(s.q) && finite(s.r) && finite(s.C) && finite(s.D) &&
-          finite(s.Zl) && finite(s.Zu) && finite(s.zl) && finite(s.zu)))
+    if (!(all_finite(s.A) && all_finite(s.B) && all_finite(s.b) && all_finite(s.Q) &&
+          all_finite(s.S) && all_finite(s.R) && all_finite(s.q) && all_finite(s.r) &&
+          all_finite(s.C) && all_finite(s.D) && all_finite(s.Zl) && all_finite(s.Zu) &&
+          all_finite(s.zl) && all_finite(s.zu)))
       return false;
     if (!(bound_ok(s.lbu) && bound_ok(s.ubu) && bound_ok(s.lbx) && bound_ok(s.ubx) &&
           bound_ok(s.lg) && bound_ok(s.ug)))
