@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "core/numerics/integrator_erk4.hpp"
+#include "core/numerics/matrix_checks.hpp"
 #include "models/crazyflie.hpp"
 #include "models/mikrokopter.hpp"
 #include "models/pendubot.hpp"
@@ -155,6 +157,40 @@ TEST(Erk4, NonFiniteInputIsReported) {
   Eigen::MatrixXd A(13, 13), B(13, 4);
   EXPECT_EQ(erk4.step(x, u, 0.015, xn), IntegratorStatus::non_finite);
   EXPECT_EQ(erk4.step_sensitivities(x, u, 0.015, xn, A, B), IntegratorStatus::non_finite);
+}
+
+// The whole-matrix checks (core/numerics/matrix_checks.hpp) on every kind of entry, at each
+// position: ±0 passes, a subnormal, ±inf or NaN anywhere counts; the diagonal is not looked at
+// by is_diagonal, and entries outside the n x n block of a larger leading dimension are ignored.
+TEST(MatrixChecks, EveryEntryKindAtEveryPosition) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  for (const int n : {1, 3, 5, 8}) {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n + 2, n);  // leading dimension n + 2
+    m.topRows(n).diagonal().setLinSpaced(n, 1.0, 2.0);
+    m(n, 0) = nan;  // outside the n x n block
+    const auto diagonal = [&] { return is_diagonal(m.data(), n, n + 2); };
+    EXPECT_TRUE(diagonal());
+    for (int r = 0; r < n; ++r)
+      for (int c = 0; c < n; ++c)
+        for (const double v : {-0.0, tiny, -1.0, inf, -inf, nan}) {
+          const double kept = m(r, c);
+          m(r, c) = v;
+          const bool expected = r == c || v == 0.0;
+          EXPECT_EQ(diagonal(), expected) << n << " x " << n << " (" << r << ", " << c << ") = " << v;
+          m(r, c) = kept;
+        }
+    Eigen::MatrixXd z = Eigen::MatrixXd::Zero(n, n + 1);
+    EXPECT_TRUE(is_zero(z) && all_finite(z));
+    for (Eigen::Index k = 0; k < z.size(); ++k)
+      for (const double v : {-0.0, tiny, -1.0, inf, -inf, nan}) {
+        z.data()[k] = v;
+        EXPECT_EQ(is_zero(z), v == 0.0) << k << " = " << v;
+        EXPECT_EQ(all_finite(z), std::isfinite(v)) << k << " = " << v;
+        z.data()[k] = 0.0;
+      }
+  }
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/numerics/matrix_checks.hpp"
+
 namespace mixpilot {
 
 namespace {
@@ -145,15 +147,10 @@ void RtiSolver::linearize_cost(int i) {
       s.r.setZero();
     }
     // A diagonal W (the controllers' usual weights) contributes its diagonal only: one pass
-    // over the off-diagonal entries (contiguous runs, no branches) instead of a branch on each
-    // of the ny² entries. The same additions in the same order as the general loop below.
-    double off = 0.0;
-    for (int l = 0; l < ny; ++l) {
-      const double* col = W.data() + std::ptrdiff_t(l) * W.rows();
-      for (int k = 0; k < l; ++k) off += std::abs(col[k]);
-      for (int k = l + 1; k < ny; ++k) off += std::abs(col[k]);
-    }
-    const bool diagonal = off == 0.0;  // NaN or ∞ anywhere off the diagonal: the general loop
+    // over the entries (no branches) instead of a branch on each of the ny² entries. The same
+    // additions in the same order as the general loop below; NaN or ∞ anywhere off the
+    // diagonal takes the general loop.
+    const bool diagonal = is_diagonal(W.data(), ny, static_cast<int>(W.rows()));
     auto wr = ws_.y.head(ny);
     if (diagonal)
       wr = W.diagonal().cwiseProduct(r);

@@ -8,7 +8,7 @@
 // to forward propagation of the variational equations through the same Butcher tableau
 // ("internal numerical differentiation"), without forming dense nx x nx products per stage.
 // All temporaries are fixed-size and live on the stack: no heap allocation.
-#include "core/numerics/finite.hpp"
+#include "core/numerics/matrix_checks.hpp"
 #include "core/numerics/integrator.hpp"
 #include "models/model.hpp"
 

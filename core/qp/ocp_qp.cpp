@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/numerics/finite.hpp"
+#include "core/numerics/matrix_checks.hpp"
 
 namespace mixpilot {
 

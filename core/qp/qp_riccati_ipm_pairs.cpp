@@ -4,6 +4,7 @@
 #include <array>
 #include <tuple>
 
+#include "core/numerics/matrix_checks.hpp"
 #include "core/qp/detail/qp_kernels.hpp"
 
 namespace mixpilot {
@@ -133,23 +134,6 @@ bool QpRiccatiIpmPairs::setup(const OcpQpDims& dims, const Settings& settings) {
 }
 
 namespace {
-// Is the n x n matrix M diagonal (every off-diagonal entry exactly 0; NaN counts as not)? A sum
-// of magnitudes per run of off-diagonal entries: no early exit, so it vectorizes.
-bool is_diagonal(const Eigen::MatrixXd& M) {
-  const int n = static_cast<int>(M.rows());
-  double off = 0.0;
-  for (int c = 0; c < n; ++c) {
-    const double* col = M.data() + static_cast<std::ptrdiff_t>(c) * n;
-    for (int r = 0; r < c; ++r) off += std::abs(col[r]);
-    for (int r = c + 1; r < n; ++r) off += std::abs(col[r]);
-  }
-  return off == 0.0;
-}
-bool is_zero(const Eigen::MatrixXd& M) {
-  double s = 0.0;
-  for (Eigen::Index k = 0; k < M.size(); ++k) s += std::abs(M.data()[k]);
-  return s == 0.0;
-}
 // M (rows x cols, ld ldm) = diag(q) X (ld ldx).
 void scale_rows(int rows, int cols, const double* q, const double* X, int ldx, double* M,
                 int ldm) {
