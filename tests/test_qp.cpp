@@ -7,9 +7,11 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <random>
 
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/qp/ocp_qp_io.hpp"
 #include "core/qp/qp_condensed_dense.hpp"
@@ -1041,6 +1043,41 @@ TEST(QpKernels, TransposeMatchesEigen) {
       EXPECT_EQ(B.bottomRows(3), B0.bottomRows(3));
       EXPECT_EQ(B.col(m), B0.col(m));
     }
+}
+
+// The fraction-to-boundary search against its definition (the smallest −z_k/dz_k over dz_k < 0,
+// capped at alpha; the first index attaining it), for every length up to 13 (the vector blocks
+// and every tail): random signs, repeated ratios (ties: the first wins), NaN components (never
+// block), nothing blocking, and the cap.
+TEST(QpKernels, MaxStepMatchesItsDefinition) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  int blocked = 0, capped = 0;
+  for (int m = 0; m <= 13; ++m)
+    for (int trial = 0; trial < 200; ++trial) {
+      std::vector<double> z(static_cast<std::size_t>(m)), dz(static_cast<std::size_t>(m));
+      for (int k = 0; k < m; ++k) {
+        z[k] = 0.1 + unit(rng);
+        dz[k] = unit(rng) < 0.5 ? -4.0 * unit(rng) : unit(rng);
+        if (trial % 5 == 1 && k > 0) z[k] = z[k - 1], dz[k] = dz[k - 1];  // ties
+        if (trial % 7 == 2 && unit(rng) < 0.3) (unit(rng) < 0.5 ? z[k] : dz[k]) = nan;
+        if (trial % 11 == 3) dz[k] = std::abs(dz[k]);  // nothing blocks
+      }
+      const double cap = trial % 3 == 0 ? 1.0 : 1e3;
+      double expected = cap;
+      int expected_block = -1;
+      for (int k = 0; k < m; ++k)
+        if (dz[k] < 0.0 && -z[k] / dz[k] < expected) expected = -z[k] / dz[k], expected_block = k;
+      int block = -2;
+      const double a = kernels::max_step(m, z.data(), dz.data(), cap, &block);
+      EXPECT_EQ(a, expected) << m << " / " << trial;
+      EXPECT_EQ(block, expected_block) << m << " / " << trial;
+      blocked += expected_block >= 0;
+      capped += expected_block < 0;
+    }
+  EXPECT_GT(blocked, 500);  // both outcomes were exercised
+  EXPECT_GT(capped, 500);
 }
 
 // Each condensed pair block against the formulas of core/qp/qp_riccati_ipm_pairs.hpp, evaluated

@@ -631,22 +631,18 @@ void QpRiccatiIpm::newton_direction(const OcpQp& qp, bool final, bool refine, in
 }
 
 namespace {
-// Largest α ∈ (0, 1] with z + α dz ≥ 0 componentwise (z > 0).
-double max_step(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alpha) {
-  const Eigen::Index m = z.size();
-  for (Eigen::Index k = 0; k < m; ++k)
-    if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k];
-  return alpha;
-}
-
-// As max_step, also the blocking index (−1 if no component blocks before alpha).
+// Largest α ≤ alpha with z + α dz ≥ 0 componentwise (z > 0), and the blocking index (−1 if no
+// component blocks before alpha).
 double max_step_index(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alpha,
                       Eigen::Index& block) {
-  block = -1;
-  const Eigen::Index m = z.size();
-  for (Eigen::Index k = 0; k < m; ++k)
-    if (dz[k] < 0.0 && z[k] + alpha * dz[k] < 0.0) alpha = -z[k] / dz[k], block = k;
-  return alpha;
+  int k = -1;
+  const double a = kernels::max_step(static_cast<int>(z.size()), z.data(), dz.data(), alpha, &k);
+  block = k;
+  return a;
+}
+double max_step(const Eigen::VectorXd& z, const Eigen::VectorXd& dz, double alpha) {
+  Eigen::Index ignored;
+  return max_step_index(z, dz, alpha, ignored);
 }
 
 // Step length along (Δt, Δλ), one for primal and dual (the stationarity couples Δv and Δλ), by

@@ -681,4 +681,37 @@ void transpose(int m, int n, const double* A, int lda, double* B, int ldb) {
     for (int r = 0; r < m; ++r) B[c + static_cast<ptrdiff_t>(r) * ldb] = at(A, lda, r, c);
 }
 
+double max_step(int m, const double* z, const double* dz, double alpha, int* block) {
+  double a = alpha;
+  int k = 0;
+#if defined(__AVX2__) && defined(__FMA__)
+  if (m >= 4) {
+    const __m256d zero = _mm256_setzero_pd();
+    __m256d best = _mm256_set1_pd(alpha);
+    for (; k + 4 <= m; k += 4) {
+      const __m256d d = _mm256_loadu_pd(dz + k);
+      const __m256d neg = _mm256_cmp_pd(d, zero, _CMP_LT_OQ);
+      const __m256d ratio = _mm256_div_pd(_mm256_sub_pd(zero, _mm256_loadu_pd(z + k)), d);
+      // min_pd returns its second operand when either is NaN: a NaN ratio never wins.
+      best = _mm256_min_pd(_mm256_blendv_pd(best, ratio, neg), best);
+    }
+    const __m128d h = _mm_min_pd(_mm256_castpd256_pd128(best), _mm256_extractf128_pd(best, 1));
+    a = std::min(_mm_cvtsd_f64(h), _mm_cvtsd_f64(_mm_unpackhi_pd(h, h)));
+  }
+#endif
+  for (; k < m; ++k)
+    if (dz[k] < 0.0) {
+      const double ratio = -z[k] / dz[k];
+      if (ratio < a) a = ratio;
+    }
+  *block = -1;
+  if (a < alpha)  // the same division as above: the minimum is found exactly
+    for (k = 0; k < m; ++k)
+      if (dz[k] < 0.0 && -z[k] / dz[k] == a) {
+        *block = k;
+        break;
+      }
+  return a;
+}
+
 }  // namespace mixpilot::kernels
