@@ -682,35 +682,45 @@ void transpose(int m, int n, const double* A, int lda, double* B, int ldb) {
 }
 
 double max_step(int m, const double* z, const double* dz, double alpha, int* block) {
+  // A component can lower α only where z + α dz ≤ 0 with dz < 0 (an FMA keeps the sign of the
+  // exact value, so this never misses a smaller ratio); only such blocks divide.
   double a = alpha;
+  int found = -1;  // the block (or tail index) of the last strict improvement
   int k = 0;
 #if defined(__AVX2__) && defined(__FMA__)
-  if (m >= 4) {
-    const __m256d zero = _mm256_setzero_pd();
-    __m256d best = _mm256_set1_pd(alpha);
-    for (; k + 4 <= m; k += 4) {
-      const __m256d d = _mm256_loadu_pd(dz + k);
-      const __m256d neg = _mm256_cmp_pd(d, zero, _CMP_LT_OQ);
-      const __m256d ratio = _mm256_div_pd(_mm256_sub_pd(zero, _mm256_loadu_pd(z + k)), d);
-      // min_pd returns its second operand when either is NaN: a NaN ratio never wins.
-      best = _mm256_min_pd(_mm256_blendv_pd(best, ratio, neg), best);
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d best = _mm256_set1_pd(a);
+  for (; k + 4 <= m; k += 4) {
+    const __m256d d = _mm256_loadu_pd(dz + k);
+    const __m256d zk = _mm256_loadu_pd(z + k);
+    const __m256d neg = _mm256_cmp_pd(d, zero, _CMP_LT_OQ);
+    const __m256d hit = _mm256_and_pd(neg, _mm256_cmp_pd(_mm256_fmadd_pd(best, d, zk), zero,
+                                                         _CMP_LE_OQ));
+    if (_mm256_movemask_pd(hit) == 0) continue;
+    const __m256d ratio = _mm256_div_pd(_mm256_sub_pd(zero, zk), d);
+    // min_pd returns its second operand when either is NaN: a NaN ratio never wins.
+    const __m256d lower = _mm256_min_pd(_mm256_blendv_pd(best, ratio, neg), best);
+    const __m128d h = _mm_min_pd(_mm256_castpd256_pd128(lower), _mm256_extractf128_pd(lower, 1));
+    const double b = std::min(_mm_cvtsd_f64(h), _mm_cvtsd_f64(_mm_unpackhi_pd(h, h)));
+    if (b < a) {
+      a = b;
+      found = k;
+      best = _mm256_set1_pd(a);
     }
-    const __m128d h = _mm_min_pd(_mm256_castpd256_pd128(best), _mm256_extractf128_pd(best, 1));
-    a = std::min(_mm_cvtsd_f64(h), _mm_cvtsd_f64(_mm_unpackhi_pd(h, h)));
   }
 #endif
   for (; k < m; ++k)
-    if (dz[k] < 0.0) {
-      const double ratio = -z[k] / dz[k];
-      if (ratio < a) a = ratio;
+    if (dz[k] < 0.0 && -z[k] / dz[k] < a) {
+      a = -z[k] / dz[k];
+      found = k;
     }
   *block = -1;
-  if (a < alpha)  // the same division as above: the minimum is found exactly
-    for (k = 0; k < m; ++k)
-      if (dz[k] < 0.0 && -z[k] / dz[k] == a) {
-        *block = k;
-        break;
-      }
+  // The first component of the improving block that attains α (the same division: exact).
+  for (k = found; k >= 0 && k < m; ++k)
+    if (dz[k] < 0.0 && -z[k] / dz[k] == a) {
+      *block = k;
+      break;
+    }
   return a;
 }
 
