@@ -8,9 +8,12 @@
 // to forward propagation of the variational equations through the same Butcher tableau
 // ("internal numerical differentiation"), without forming dense nx x nx products per stage.
 // All temporaries are fixed-size and live on the stack: no heap allocation.
-#include "core/numerics/matrix_checks.hpp"
 #include "core/numerics/integrator.hpp"
+#include "core/numerics/matrix_checks.hpp"
+#include "models/crazyflie.hpp"
+#include "models/mikrokopter.hpp"
 #include "models/model.hpp"
+#include "models/pendubot.hpp"
 
 namespace mixpilot {
 
@@ -31,47 +34,9 @@ class IntegratorErk4 final : public Integrator {
   // Fixed-size entry points (no virtual dispatch, no copies).
   template <class Scalar>
   void step(const Eigen::Matrix<Scalar, kNx, 1>& x, const Eigen::Matrix<Scalar, kNu, 1>& u,
-            double dt, Eigen::Matrix<Scalar, kNx, 1>& x_next) const {
-    Eigen::Matrix<Scalar, kNx, 1> k, acc, xs;
-    model_.dynamics(x, u, k);  // k1
-    acc = k;
-    xs = x + (0.5 * dt) * k;
-    model_.dynamics(xs, u, k);  // k2
-    acc += 2.0 * k;
-    xs = x + (0.5 * dt) * k;
-    model_.dynamics(xs, u, k);  // k3
-    acc += 2.0 * k;
-    xs = x + dt * k;
-    model_.dynamics(xs, u, k);  // k4
-    acc += k;
-    x_next = x + (dt / 6.0) * acc;
-    models::project(model_, x_next);
-  }
-
-  void step(const State& x, const Input& u, double dt, State& x_next, MatA& A, MatB& B) const {
-    // The same arithmetic as step<double>, on dual numbers seeded with z = (x, u). Stage
-    // updates are written out per derivative block instead of through Eigen expressions: a
-    // Dual is a struct of up to ~200 bytes, and the temporaries Eigen copies around cost more
-    // than the derivative arithmetic itself.
-    AdState xz, xs, k, acc;
-    AdInput ua;
-    for (int i = 0; i < kNx; ++i) xz(i) = Ad::variable(x(i), i);
-    for (int i = 0; i < kNu; ++i) ua(i) = Ad::variable(u(i), kNx + i);
-    models::dynamics_dual(model_, xz, ua, k);  // k1
-    stage<true>(xz, 0.5 * dt, 1.0, k, acc, xs);
-    models::dynamics_dual(model_, xs, ua, k);  // k2
-    stage<false>(xz, 0.5 * dt, 2.0, k, acc, xs);
-    models::dynamics_dual(model_, xs, ua, k);  // k3
-    stage<false>(xz, dt, 2.0, k, acc, xs);
-    models::dynamics_dual(model_, xs, ua, k);  // k4
-    finish(xz, dt / 6.0, k, acc, xs);
-    models::project(model_, xs);
-    for (int i = 0; i < kNx; ++i) {
-      x_next(i) = xs(i).v;
-      for (int j = 0; j < kNx; ++j) A(i, j) = xs(i).derivative(j);
-      for (int j = 0; j < kNu; ++j) B(i, j) = xs(i).derivative(kNx + j);
-    }
-  }
+            double dt, Eigen::Matrix<Scalar, kNx, 1>& x_next) const;
+  // ... with A = ∂x⁺/∂x and B = ∂x⁺/∂u.
+  void step(const State& x, const Input& u, double dt, State& x_next, MatA& A, MatB& B) const;
 
   // Integrator interface.
   int nx() const override { return kNx; }
@@ -137,5 +102,72 @@ class IntegratorErk4 final : public Integrator {
 
   Model model_;
 };
+
+template <models::DynamicModel Model>
+template <class Scalar>
+void IntegratorErk4<Model>::step(const Eigen::Matrix<Scalar, kNx, 1>& x,
+                                 const Eigen::Matrix<Scalar, kNu, 1>& u, double dt,
+                                 Eigen::Matrix<Scalar, kNx, 1>& x_next) const {
+  Eigen::Matrix<Scalar, kNx, 1> k, acc, xs;
+  model_.dynamics(x, u, k);  // k1
+  acc = k;
+  xs = x + (0.5 * dt) * k;
+  model_.dynamics(xs, u, k);  // k2
+  acc += 2.0 * k;
+  xs = x + (0.5 * dt) * k;
+  model_.dynamics(xs, u, k);  // k3
+  acc += 2.0 * k;
+  xs = x + dt * k;
+  model_.dynamics(xs, u, k);  // k4
+  acc += k;
+  x_next = x + (dt / 6.0) * acc;
+  models::project(model_, x_next);
+}
+
+template <models::DynamicModel Model>
+void IntegratorErk4<Model>::step(const State& x, const Input& u, double dt, State& x_next,
+                                 MatA& A, MatB& B) const {
+  // The same arithmetic as step<double>, on dual numbers seeded with z = (x, u). Stage
+  // updates are written out per derivative block instead of through Eigen expressions: a
+  // Dual is a struct of up to ~200 bytes, and the temporaries Eigen copies around cost more
+  // than the derivative arithmetic itself.
+  AdState xz, xs, k, acc;
+  AdInput ua;
+  for (int i = 0; i < kNx; ++i) xz(i) = Ad::variable(x(i), i);
+  for (int i = 0; i < kNu; ++i) ua(i) = Ad::variable(u(i), kNx + i);
+  models::dynamics_dual(model_, xz, ua, k);  // k1
+  stage<true>(xz, 0.5 * dt, 1.0, k, acc, xs);
+  models::dynamics_dual(model_, xs, ua, k);  // k2
+  stage<false>(xz, 0.5 * dt, 2.0, k, acc, xs);
+  models::dynamics_dual(model_, xs, ua, k);  // k3
+  stage<false>(xz, dt, 2.0, k, acc, xs);
+  models::dynamics_dual(model_, xs, ua, k);  // k4
+  finish(xz, dt / 6.0, k, acc, xs);
+  models::project(model_, xs);
+  for (int i = 0; i < kNx; ++i) {
+    x_next(i) = xs(i).v;
+    for (int j = 0; j < kNx; ++j) A(i, j) = xs(i).derivative(j);
+    for (int j = 0; j < kNu; ++j) B(i, j) = xs(i).derivative(kNx + j);
+  }
+}
+
+// The shipped models' steps are compiled once, in core/numerics/integrator_erk4.cpp, and every
+// binary calls that copy: copies inlined into different translation units may fuse multiply-adds
+// differently, and a replay (score, the window, a test's own) must repeat the flight of any other
+// binary bit for bit.
+#define MIXPILOT_ERK4_STEPS(prefix, M)                                                        \
+  prefix template void IntegratorErk4<M>::step<double>(                                     \
+      const Eigen::Matrix<double, M::nx, 1>&, const Eigen::Matrix<double, M::nu, 1>&, double, \
+      Eigen::Matrix<double, M::nx, 1>&) const;                                              \
+  prefix template void IntegratorErk4<M>::step(const IntegratorErk4<M>::State&,             \
+                                               const IntegratorErk4<M>::Input&, double,     \
+                                               IntegratorErk4<M>::State&,                   \
+                                               IntegratorErk4<M>::MatA&,                    \
+                                               IntegratorErk4<M>::MatB&) const;
+MIXPILOT_ERK4_STEPS(extern, models::MikroKopter)
+MIXPILOT_ERK4_STEPS(extern, models::Crazyflie)
+MIXPILOT_ERK4_STEPS(extern, models::Pendubot)
+MIXPILOT_ERK4_STEPS(extern, models::WithExternalForce<models::MikroKopter>)
+MIXPILOT_ERK4_STEPS(extern, models::WithExternalForce<models::Crazyflie>)
 
 }  // namespace mixpilot
