@@ -152,9 +152,9 @@ void IntegratorErk4<Model>::step(const State& x, const Input& u, double dt, Stat
 }
 
 // The shipped models' steps are compiled once, in core/numerics/integrator_erk4.cpp, and every
-// binary calls that copy: copies inlined into different translation units may fuse multiply-adds
-// differently, and a replay (score, the window, a test's own) must repeat the flight of any other
-// binary bit for bit.
+// binary calls that copy: copies compiled in different translation units can differ in their
+// instructions (inlining, fused multiply-adds) and so in rounding, and a replay (score, the
+// window, a test's own) must repeat the flight of any other binary bit for bit.
 #define MIXPILOT_ERK4_STEPS(prefix, M)                                                        \
   prefix template void IntegratorErk4<M>::step<double>(                                     \
       const Eigen::Matrix<double, M::nx, 1>&, const Eigen::Matrix<double, M::nu, 1>&, double, \
