@@ -166,7 +166,7 @@ TEST(MatrixChecks, EveryEntryKindAtEveryPosition) {
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double tiny = std::numeric_limits<double>::denorm_min();
-  for (const int n : {1, 3, 5, 8}) {
+  for (const int n : {1, 3, 4, 5, 8, 11, 16}) {  // whole blocks of 4 rows, and tails
     Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n + 2, n);  // leading dimension n + 2
     m.topRows(n).diagonal().setLinSpaced(n, 1.0, 2.0);
     m(n, 0) = nan;  // outside the n x n block
