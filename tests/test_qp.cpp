@@ -1029,6 +1029,32 @@ TEST(QpKernels, GemmNnMatchesEigen) {
         }
 }
 
+// The matrix-vector kernels against Eigen: rows 0..13 (4-row vectors and masked tails),
+// columns 0..9 (4-column blocks and their tails), a larger leading dimension; y accumulates, and
+// the entries of y past the result are untouched.
+TEST(QpKernels, GemvMatchesEigen) {
+  std::srand(17);
+  for (int m = 0; m <= 13; ++m)
+    for (int n = 0; n <= 9; ++n) {
+      const Eigen::MatrixXd A = Eigen::MatrixXd::Random(m + 3, n);
+      const Eigen::VectorXd xn = Eigen::VectorXd::Random(n), xt = Eigen::VectorXd::Random(m);
+      Eigen::VectorXd yn = Eigen::VectorXd::Random(m + 2), yt = Eigen::VectorXd::Random(n + 2);
+      const Eigen::VectorXd yn0 = yn, yt0 = yt;
+      kernels::gemv_n(m, n, A.data(), int(A.rows()), xn.data(), yn.data());
+      kernels::gemv_t(m, n, A.data(), int(A.rows()), xt.data(), yt.data());
+      const Eigen::VectorXd en = yn0.head(m) + A.topRows(m) * xn;
+      const Eigen::VectorXd et = yt0.head(n) + A.topRows(m).transpose() * xt;
+      if (m > 0) {
+        EXPECT_LE((yn.head(m) - en).cwiseAbs().maxCoeff(), 1e-14 * (n + 1)) << m << "x" << n;
+      }
+      if (n > 0) {
+        EXPECT_LE((yt.head(n) - et).cwiseAbs().maxCoeff(), 1e-14 * (m + 1)) << m << "x" << n;
+      }
+      EXPECT_EQ(yn.tail(2), yn0.tail(2)) << m << "x" << n;
+      EXPECT_EQ(yt.tail(2), yt0.tail(2)) << m << "x" << n;
+    }
+}
+
 // The transposing copy against Eigen: every shape up to 9 x 9 (4 x 4 blocks, row and column
 // tails), larger leading dimensions; the destination's rows and columns outside Aᵀ untouched.
 TEST(QpKernels, TransposeMatchesEigen) {

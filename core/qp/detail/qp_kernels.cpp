@@ -479,11 +479,27 @@ void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y) 
     }
     _mm256_storeu_pd(y + j, _mm256_add_pd(_mm256_loadu_pd(y + j), hsum4(a0, a1, a2, a3)));
   }
-  for (; j < n; ++j) {
-    const double* col = A + static_cast<ptrdiff_t>(j) * lda;
-    double s = 0.0;
-    for (int r = 0; r < m; ++r) s += col[r] * x[r];
-    y[j] += s;
+  if (j < n) {  // the last 1-3 columns as one more block: absent columns repeat c0, unstored
+    const int nc = n - j;
+    const double* c0 = A + static_cast<ptrdiff_t>(j) * lda;
+    const double* c1 = nc > 1 ? c0 + lda : c0;
+    const double* c2 = nc > 2 ? c0 + 2 * static_cast<ptrdiff_t>(lda) : c0;
+    __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0;
+    for (int r = 0; r < m4; r += 4) {
+      const __m256d xr = _mm256_loadu_pd(x + r);
+      a0 = _mm256_fmadd_pd(_mm256_loadu_pd(c0 + r), xr, a0);
+      a1 = _mm256_fmadd_pd(_mm256_loadu_pd(c1 + r), xr, a1);
+      a2 = _mm256_fmadd_pd(_mm256_loadu_pd(c2 + r), xr, a2);
+    }
+    if (rem > 0) {
+      a0 = _mm256_fmadd_pd(_mm256_maskload_pd(c0 + m4, mask), xt, a0);
+      a1 = _mm256_fmadd_pd(_mm256_maskload_pd(c1 + m4, mask), xt, a1);
+      a2 = _mm256_fmadd_pd(_mm256_maskload_pd(c2 + m4, mask), xt, a2);
+    }
+    const __m256i ym = tail_mask(nc);
+    _mm256_maskstore_pd(y + j, ym,
+                        _mm256_add_pd(_mm256_maskload_pd(y + j, ym),
+                                      hsum4(a0, a1, a2, _mm256_setzero_pd())));
   }
 #else
   for (int j = 0; j < n; ++j) {
