@@ -52,6 +52,30 @@ TEST(Crc32, KnownVectors) {
   EXPECT_EQ(crc32(zeros), 0x190A55ADu);
 }
 
+// The 8-byte blocks against the CRC's bitwise definition (reflected polynomial 0xEDB88320): every
+// length up to 40 (whole blocks and every tail) at every alignment, random bytes, chained from a
+// nonzero running value.
+TEST(Crc32, MatchesTheBitwiseDefinition) {
+  const auto bitwise = [](uint32_t crc, const uint8_t* p, std::size_t n) {
+    uint32_t c = crc ^ 0xFFFFFFFFu;
+    for (std::size_t i = 0; i < n; ++i) {
+      c ^= p[i];
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? (0xEDB88320u ^ (c >> 1)) : (c >> 1);
+    }
+    return c ^ 0xFFFFFFFFu;
+  };
+  std::vector<uint8_t> b(64);
+  uint32_t seed = 12345;
+  for (uint8_t& x : b) x = uint8_t((seed = seed * 1103515245u + 12345u) >> 16);
+  for (std::size_t offset = 0; offset < 8; ++offset)
+    for (std::size_t n = 0; n <= 40; ++n) {
+      EXPECT_EQ(crc32_update(0, b.data() + offset, n), bitwise(0, b.data() + offset, n)) << n;
+      EXPECT_EQ(crc32_update(0xDEADBEEFu, b.data() + offset, n),
+                bitwise(0xDEADBEEFu, b.data() + offset, n))
+          << n;
+    }
+}
+
 TEST(Crc32, IncrementalEqualsOneShot) {
   const auto b = bytes_of("The quick brown fox jumps over the lazy dog");
   for (std::size_t cut = 0; cut <= b.size(); ++cut) {
