@@ -13,6 +13,7 @@
 #include "core/modes/session.hpp"
 #include "core/recording/session_recording.hpp"
 #include "core/scenario/scenario_toml.hpp"
+#include "run_mixpilot.hpp"
 #include "temp_files.hpp"
 
 namespace mixpilot::cli {
@@ -165,6 +166,26 @@ TEST(Noise, SeededMeasurementNoiseAndInputDelayReplayBitForBit) {
   EXPECT_TRUE(differs) << "another seed flew the same: no noise?";
   EXPECT_EQ(replay(a, one), "");
   EXPECT_EQ(replay(c, other), "");
+
+  // Recorded by the app, replayed here: another binary draws and adds the same noise (the
+  // noise, like the integrator's steps, is compiled once for every binary).
+  const std::filesystem::path home = test::fresh_path("replay_check", "noisy_app");
+  std::filesystem::create_directories(home);
+  const std::string path = (home / "noisy.mcap").string();
+  ASSERT_EQ(test::run_mixpilot(MIXPILOT_BINARY, "fly --scenario '" + one +
+                                                    "' --pilot novice --headless --duration 1.5"
+                                                    " --record '" + path + "'",
+                               home),
+            0)
+      << test::read_file(home / "out.txt");
+  const auto app = read_recording(path, error);
+  ASSERT_TRUE(app) << error;
+  ASSERT_EQ(app->states.size(), a.states.size());
+  EXPECT_EQ(replay(*app, one), "");
+  bool alike = true;
+  for (std::size_t k = 0; k < a.states.size(); ++k)
+    alike = alike && app->states[k].x == a.states[k].x;
+  EXPECT_TRUE(alike) << "the app flew the seeded noisy flight differently from this binary";
 }
 
 TEST(ReplayCheck, OtherModesReplayToo) {

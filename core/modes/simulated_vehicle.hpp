@@ -76,6 +76,13 @@ class VehiclePlant {
   IntegratorErk4<models::WithExternalForce<Model>> forced_{};  // the model with the gust's force
 };
 
+// y[0..3) += σ·N(0, 1) per axis, drawn from rng in order. Compiled once
+// (core/modes/simulated_vehicle.cpp), not in the template: a copy per translation unit may compile
+// the draw (std::normal_distribution's arithmetic) and the multiply-add to different
+// instructions, and a replay in another binary must repeat the flight bit for bit.
+void add_position_noise(double sigma, std::mt19937_64& rng,
+                        std::normal_distribution<double>& noise, double* y);
+
 template <class Model>
 class SimulatedVehicle {
  public:
@@ -173,9 +180,8 @@ class SimulatedVehicle {
   void measure(std::int64_t k, State& y) {
     const long b = long(k) * settings_.substeps - settings_.measurement_delay - data_.extra_delay;
     y = b <= 0 ? x0_ : at(b);
-    if (settings_.position_noise > 0.0) {
-      for (int i = 0; i < 3; ++i) y(i) += settings_.position_noise * data_.noise(data_.rng);
-    }
+    if (settings_.position_noise > 0.0)
+      add_position_noise(settings_.position_noise, data_.rng, data_.noise, y.data());
   }
 
   // The state of boundary j (integrated, and not yet overwritten in the ring).
