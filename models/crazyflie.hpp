@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include "models/dual.hpp"
+
 namespace mixpilot::models {
 
 struct CrazyflieParams {
@@ -69,6 +71,80 @@ struct Crazyflie {
     xdot(10) = (mx - (wy * jwz - wz * jwy)) / p.Jxx;
     xdot(11) = (my - (wz * jwx - wx * jwz)) / p.Jyy;
     xdot(12) = (mz - (wx * jwy - wy * jwx)) / p.Jzz;
+  }
+
+  // The same f on dual numbers, ∂f/∂z from the Jacobian's nonzeros (models/model.hpp); the
+  // values are dynamics<double>'s. With v = v_b:
+  //   ∂ṗ/∂v = R,  ∂ṗ/∂q_k = (∂R/∂q_k) v, where ∂R/∂qw = 2[0 −qz qy; qz 0 −qx; −qy qx 0],
+  //   ∂R/∂qx = 2[0 qy qz; qy −2qx −qw; qz qw −2qx], ∂R/∂qy = 2[−2qy qx qw; qx 0 qz; −qw qz −2qy],
+  //   ∂R/∂qz = 2[−2qz −qw qx; qw −2qz qy; qx qy 0];
+  //   q̇ is bilinear in (q, ω); v̇ is gravity's third row of R (its q-partials as above) and
+  //   −ω × v, bilinear; ω̇ = J⁻¹(M − ω × Jω) and F_z, M are linear in Ω_i², ∂Ω_i² = 2Ω_i.
+  template <int n>
+  void dynamics_tangent(const Eigen::Matrix<Dual<n>, nx, 1>& x,
+                        const Eigen::Matrix<Dual<n>, nu, 1>& u,
+                        Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
+    State xv, f;
+    Input uv;
+    for (int i = 0; i < nx; ++i) xv(i) = x(i).v;
+    for (int i = 0; i < nu; ++i) uv(i) = u(i).v;
+    dynamics(xv, uv, f);
+    const double qw = xv(3), qx = xv(4), qy = xv(5), qz = xv(6);
+    const double vx = xv(7), vy = xv(8), vz = xv(9), wx = xv(10), wy = xv(11), wz = xv(12);
+    const double r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
+                 r02 = 2.0 * (qx * qz + qw * qy);
+    const double r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
+                 r12 = 2.0 * (qy * qz - qw * qx);
+    const double r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
+                 r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    using P = const Dual<n>*;  // the tangents of the state's and input's components
+    const P dqw = &x(3), dqx = &x(4), dqy = &x(5), dqz = &x(6);
+    const P dvx = &x(7), dvy = &x(8), dvz = &x(9), dwx = &x(10), dwy = &x(11), dwz = &x(12);
+    const P du1 = &u(0), du2 = &u(1), du3 = &u(2), du4 = &u(3);
+
+    xdot(0) = chain(f(0), {r00, r01, r02, 2.0 * (qy * vz - qz * vy), 2.0 * (qy * vy + qz * vz),
+                           2.0 * (-2.0 * qy * vx + qx * vy + qw * vz),
+                           2.0 * (-2.0 * qz * vx - qw * vy + qx * vz)},
+                    {dvx, dvy, dvz, dqw, dqx, dqy, dqz});
+    xdot(1) = chain(f(1), {r10, r11, r12, 2.0 * (qz * vx - qx * vz),
+                           2.0 * (qy * vx - 2.0 * qx * vy - qw * vz), 2.0 * (qx * vx + qz * vz),
+                           2.0 * (qw * vx - 2.0 * qz * vy + qy * vz)},
+                    {dvx, dvy, dvz, dqw, dqx, dqy, dqz});
+    xdot(2) = chain(f(2), {r20, r21, r22, 2.0 * (qx * vy - qy * vx),
+                           2.0 * (qz * vx + qw * vy - 2.0 * qx * vz),
+                           2.0 * (-qw * vx + qz * vy - 2.0 * qy * vz), 2.0 * (qx * vx + qy * vy)},
+                    {dvx, dvy, dvz, dqw, dqx, dqy, dqz});
+
+    xdot(3) = chain(f(3), {-0.5 * wx, -0.5 * wy, -0.5 * wz, -0.5 * qx, -0.5 * qy, -0.5 * qz},
+                    {dqx, dqy, dqz, dwx, dwy, dwz});
+    xdot(4) = chain(f(4), {0.5 * wx, 0.5 * wz, -0.5 * wy, 0.5 * qw, -0.5 * qz, 0.5 * qy},
+                    {dqw, dqy, dqz, dwx, dwy, dwz});
+    xdot(5) = chain(f(5), {0.5 * wy, -0.5 * wz, 0.5 * wx, 0.5 * qz, 0.5 * qw, -0.5 * qx},
+                    {dqw, dqx, dqz, dwx, dwy, dwz});
+    xdot(6) = chain(f(6), {0.5 * wz, 0.5 * wy, -0.5 * wx, -0.5 * qy, 0.5 * qx, 0.5 * qw},
+                    {dqw, dqx, dqy, dwx, dwy, dwz});
+
+    const double g2 = 2.0 * p.g;
+    xdot(7) = chain(f(7), {g2 * qy, -g2 * qz, g2 * qw, -g2 * qx, wz, -wy, -vz, vy},
+                    {dqw, dqx, dqy, dqz, dvy, dvz, dwy, dwz});
+    xdot(8) = chain(f(8), {-g2 * qx, -g2 * qw, -g2 * qz, -g2 * qy, -wz, wx, vz, -vx},
+                    {dqw, dqx, dqy, dqz, dvx, dvz, dwx, dwz});
+    const double o1 = uv(0), o2 = uv(1), o3 = uv(2), o4 = uv(3);
+    const double kt = 2.0 * p.C_T / p.m;
+    xdot(9) = chain(f(9), {2.0 * g2 * qx, 2.0 * g2 * qy, wy, -wx, -vy, vx, kt * o1, kt * o2,
+                           kt * o3, kt * o4},
+                    {dqx, dqy, dvx, dvy, dwx, dwy, du1, du2, du3, du4});
+
+    const double kx = 2.0 * p.C_T * p.l / p.Jxx, ky = 2.0 * p.C_T * p.l / p.Jyy,
+                 kz = 2.0 * p.C_D / p.Jzz;
+    const double ex = (p.Jzz - p.Jyy) / p.Jxx, ey = (p.Jxx - p.Jzz) / p.Jyy,
+                 ez = (p.Jyy - p.Jxx) / p.Jzz;
+    xdot(10) = chain(f(10), {-kx * o1, -kx * o2, kx * o3, kx * o4, -ex * wz, -ex * wy},
+                     {du1, du2, du3, du4, dwy, dwz});
+    xdot(11) = chain(f(11), {-ky * o1, ky * o2, ky * o3, -ky * o4, -ey * wz, -ey * wx},
+                     {du1, du2, du3, du4, dwx, dwz});
+    xdot(12) = chain(f(12), {-kz * o1, kz * o2, -kz * o3, kz * o4, -ez * wy, -ez * wx},
+                     {du1, du2, du3, du4, dwx, dwy});
   }
 
   // A world-frame force F [N] on the centre of mass besides gravity and thrust (an instructor's

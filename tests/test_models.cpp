@@ -203,6 +203,11 @@ TEST(Jacobians, MikroKopterTangentMatchesItsAd) {
   expect_tangent_matches_ad<MikroKopter, 3>(MikroKopter{}, 5);  // one block, one padding lane
 }
 
+TEST(Jacobians, CrazyflieTangentMatchesItsAd) {
+  expect_tangent_matches_ad<Crazyflie, Crazyflie::nx + Crazyflie::nu>(Crazyflie{}, 6);
+  expect_tangent_matches_ad<Crazyflie, 3>(Crazyflie{}, 7);  // one block, one padding lane
+}
+
 // Dual numbers (models/dual.hpp): every operation against Eigen's AutoDiffScalar (to rounding)
 // and against central differences of the same expression in double. The operands a(z), b(z)
 // are affine in z ∈ R⁵ with dense gradients, so each direction and the padding lanes of the
