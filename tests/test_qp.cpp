@@ -1110,9 +1110,11 @@ TEST(QpKernels, MaxStepMatchesItsDefinition) {
 // with Eigen: for dense Hessians with cross terms S, and for the controllers' structure (Q
 // diagonal, S = 0: Q1 A0 as a row scaling, no S1 products); Q exactly symmetric.
 TEST(QpRiccatiIpmPairs, CondensedBlocksMatchTheirDefinition) {
-  for (const bool structured : {false, true}) {
+  for (const auto& [nx_max, structured] :  // blocks of 4 states and their tails
+       {std::pair{6, false}, std::pair{6, true}, std::pair{13, false}, std::pair{13, true}}) {
     SCOPED_TRACE(structured ? "diagonal Q, S = 0" : "dense Q, S");
-    OcpQp qp = testing_qp::random_qp(spec(9, 3, 6, 2, 2, 0.3), 61);
+    SCOPED_TRACE("nx up to " + std::to_string(nx_max));
+    OcpQp qp = testing_qp::random_qp(spec(9, 3, nx_max, 2, 2, 0.3), 61);
     if (structured)
       for (OcpQpStage& s : qp.stage) {
         s.Q = Eigen::MatrixXd(s.Q.diagonal().asDiagonal());
