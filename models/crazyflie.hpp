@@ -1,11 +1,13 @@
 #pragma once
 // Crazyflie 2.1, SPEC §3.2. ξ = (p, q, v_b, ω) ∈ R¹³ with q = (qw, qx, qy, qz),
 // u = Ω propeller speeds [krpm] ∈ R⁴.
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
 
 #include "models/dual.hpp"
+#include "models/model.hpp"
 
 namespace mixpilot::models {
 
@@ -31,6 +33,14 @@ struct Crazyflie {
 
   CrazyflieParams p{};
 
+  // Body-to-world rotation R(q) of the unit quaternion q = (qw, qx, qy, qz), row by row.
+  template <class T>
+  static std::array<T, 9> rotation(const T& qw, const T& qx, const T& qy, const T& qz) {
+    return {1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qw * qz), 2.0 * (qx * qz + qw * qy),
+            2.0 * (qx * qy + qw * qz), 1.0 - 2.0 * (qx * qx + qz * qz), 2.0 * (qy * qz - qw * qx),
+            2.0 * (qx * qz - qw * qy), 2.0 * (qy * qz + qw * qx), 1.0 - 2.0 * (qx * qx + qy * qy)};
+  }
+
   // ṗ = R(q) v_b;  q̇ = ½ q ⊗ (0, ω);  v̇_b = (0,0,F_z/m) − R(q)ᵀ(0,0,g) − ω × v_b;
   // ω̇ = J⁻¹(M − ω × Jω)  (SPEC §3.2).
   template <class T>
@@ -40,13 +50,7 @@ struct Crazyflie {
     const T &vx = x(7), &vy = x(8), &vz = x(9);
     const T &wx = x(10), &wy = x(11), &wz = x(12);
 
-    // Body-to-world rotation of the unit quaternion.
-    const T r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
-            r02 = 2.0 * (qx * qz + qw * qy);
-    const T r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
-            r12 = 2.0 * (qy * qz - qw * qx);
-    const T r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
-            r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    const auto [r00, r01, r02, r10, r11, r12, r20, r21, r22] = rotation(qw, qx, qy, qz);
 
     xdot(0) = r00 * vx + r01 * vy + r02 * vz;
     xdot(1) = r10 * vx + r11 * vy + r12 * vz;
@@ -86,17 +90,10 @@ struct Crazyflie {
                         Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
     State xv, f;
     Input uv;
-    for (int i = 0; i < nx; ++i) xv(i) = x(i).v;
-    for (int i = 0; i < nu; ++i) uv(i) = u(i).v;
-    dynamics(xv, uv, f);
+    values_and_dynamics(*this, x, u, xv, uv, f);
     const double qw = xv(3), qx = xv(4), qy = xv(5), qz = xv(6);
     const double vx = xv(7), vy = xv(8), vz = xv(9), wx = xv(10), wy = xv(11), wz = xv(12);
-    const double r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
-                 r02 = 2.0 * (qx * qz + qw * qy);
-    const double r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
-                 r12 = 2.0 * (qy * qz - qw * qx);
-    const double r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
-                 r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    const auto [r00, r01, r02, r10, r11, r12, r20, r21, r22] = rotation(qw, qx, qy, qz);
     using P = const Dual<n>*;  // the tangents of the state's and input's components
     const P dqw = &x(3), dqx = &x(4), dqy = &x(5), dqz = &x(6);
     const P dvx = &x(7), dvy = &x(8), dvz = &x(9), dwx = &x(10), dwy = &x(11), dwz = &x(12);
@@ -154,12 +151,7 @@ struct Crazyflie {
   void add_external_force(const Eigen::Matrix<T, nx, 1>& x, const Eigen::Vector3d& force,
                           Eigen::Matrix<T, nx, 1>& xdot) const {
     const T &qw = x(3), &qx = x(4), &qy = x(5), &qz = x(6);
-    const T r00 = 1.0 - 2.0 * (qy * qy + qz * qz), r01 = 2.0 * (qx * qy - qw * qz),
-            r02 = 2.0 * (qx * qz + qw * qy);
-    const T r10 = 2.0 * (qx * qy + qw * qz), r11 = 1.0 - 2.0 * (qx * qx + qz * qz),
-            r12 = 2.0 * (qy * qz - qw * qx);
-    const T r20 = 2.0 * (qx * qz - qw * qy), r21 = 2.0 * (qy * qz + qw * qx),
-            r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
+    const auto [r00, r01, r02, r10, r11, r12, r20, r21, r22] = rotation(qw, qx, qy, qz);
     const double fx = force.x() / p.m, fy = force.y() / p.m, fz = force.z() / p.m;
     xdot(7) += r00 * fx + r10 * fy + r20 * fz;
     xdot(8) += r01 * fx + r11 * fy + r21 * fz;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "models/dual.hpp"
+#include "models/model.hpp"
 
 namespace mixpilot::models {
 
@@ -100,9 +101,7 @@ struct MikroKopter {
                         Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
     State xv, f;
     Input uv;
-    for (int i = 0; i < nx; ++i) xv(i) = x(i).v;
-    for (int i = 0; i < nu; ++i) uv(i) = u(i).v;
-    dynamics(xv, uv, f);
+    values_and_dynamics(*this, x, u, xv, uv, f);
     const double vx = xv(6), vy = xv(7), vz = xv(8), wx = xv(9), wy = xv(10), wz = xv(11);
     const double cph = std::cos(xv(3)), sph = std::sin(xv(3));
     const double cth = std::cos(xv(4)), sth = std::sin(xv(4));

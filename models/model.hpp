@@ -49,6 +49,17 @@ void dynamics_dual(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
     model.dynamics(x, u, xdot);
 }
 
+// For a dynamics_tangent: the values of its dual arguments, and f at them by dynamics<double>
+// (the tangent's values; its derivatives come from the Jacobian's nonzeros).
+template <class M, int n>
+void values_and_dynamics(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
+                         const Eigen::Matrix<Dual<n>, M::nu, 1>& u, typename M::State& xv,
+                         typename M::Input& uv, typename M::State& f) {
+  for (int i = 0; i < M::nx; ++i) xv(i) = x(i).v;
+  for (int i = 0; i < M::nu; ++i) uv(i) = u(i).v;
+  model.dynamics(xv, uv, f);
+}
+
 // Forward-mode AD scalar carrying derivatives with respect to n directions. Constructed and
 // read like Eigen's AutoDiffScalar: Ad(value, n, i), .value(), .derivatives().
 template <int n>

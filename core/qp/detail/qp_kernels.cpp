@@ -459,10 +459,14 @@ void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y) 
   const int m4 = m & ~3, rem = m - m4;
   const __m256i mask = tail_mask(rem > 0 ? rem : 4);
   const __m256d xt = rem > 0 ? _mm256_maskload_pd(x + m4, mask) : _mm256_setzero_pd();
-  int j = 0;
-  for (; j + 4 <= n; j += 4) {
+  // Columns in blocks of 4; a last block of 1-3 repeats column c0 where a column is absent and
+  // stores only the present sums.
+  for (int j = 0; j < n; j += 4) {
+    const int nc = n - j < 4 ? n - j : 4;
     const double* c0 = A + static_cast<ptrdiff_t>(j) * lda;
-    const double *c1 = c0 + lda, *c2 = c1 + lda, *c3 = c2 + lda;
+    const double* c1 = nc > 1 ? c0 + lda : c0;
+    const double* c2 = nc > 2 ? c0 + 2 * static_cast<ptrdiff_t>(lda) : c0;
+    const double* c3 = nc > 3 ? c0 + 3 * static_cast<ptrdiff_t>(lda) : c0;
     __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
     for (int r = 0; r < m4; r += 4) {
       const __m256d xr = _mm256_loadu_pd(x + r);
@@ -477,29 +481,13 @@ void gemv_t(int m, int n, const double* A, int lda, const double* x, double* y) 
       a2 = _mm256_fmadd_pd(_mm256_maskload_pd(c2 + m4, mask), xt, a2);
       a3 = _mm256_fmadd_pd(_mm256_maskload_pd(c3 + m4, mask), xt, a3);
     }
-    _mm256_storeu_pd(y + j, _mm256_add_pd(_mm256_loadu_pd(y + j), hsum4(a0, a1, a2, a3)));
-  }
-  if (j < n) {  // the last 1-3 columns as one more block: absent columns repeat c0, unstored
-    const int nc = n - j;
-    const double* c0 = A + static_cast<ptrdiff_t>(j) * lda;
-    const double* c1 = nc > 1 ? c0 + lda : c0;
-    const double* c2 = nc > 2 ? c0 + 2 * static_cast<ptrdiff_t>(lda) : c0;
-    __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0;
-    for (int r = 0; r < m4; r += 4) {
-      const __m256d xr = _mm256_loadu_pd(x + r);
-      a0 = _mm256_fmadd_pd(_mm256_loadu_pd(c0 + r), xr, a0);
-      a1 = _mm256_fmadd_pd(_mm256_loadu_pd(c1 + r), xr, a1);
-      a2 = _mm256_fmadd_pd(_mm256_loadu_pd(c2 + r), xr, a2);
+    const __m256d sums = hsum4(a0, a1, a2, a3);
+    if (nc == 4) {
+      _mm256_storeu_pd(y + j, _mm256_add_pd(_mm256_loadu_pd(y + j), sums));
+    } else {
+      const __m256i ym = tail_mask(nc);
+      _mm256_maskstore_pd(y + j, ym, _mm256_add_pd(_mm256_maskload_pd(y + j, ym), sums));
     }
-    if (rem > 0) {
-      a0 = _mm256_fmadd_pd(_mm256_maskload_pd(c0 + m4, mask), xt, a0);
-      a1 = _mm256_fmadd_pd(_mm256_maskload_pd(c1 + m4, mask), xt, a1);
-      a2 = _mm256_fmadd_pd(_mm256_maskload_pd(c2 + m4, mask), xt, a2);
-    }
-    const __m256i ym = tail_mask(nc);
-    _mm256_maskstore_pd(y + j, ym,
-                        _mm256_add_pd(_mm256_maskload_pd(y + j, ym),
-                                      hsum4(a0, a1, a2, _mm256_setzero_pd())));
   }
 #else
   for (int j = 0; j < n; ++j) {
