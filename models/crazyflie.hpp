@@ -88,9 +88,7 @@ struct Crazyflie {
   void dynamics_tangent(const Eigen::Matrix<Dual<n>, nx, 1>& x,
                         const Eigen::Matrix<Dual<n>, nu, 1>& u,
                         Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
-    State xv, f;
-    Input uv;
-    values_and_dynamics(*this, x, u, xv, uv, f);
+    const auto [xv, uv, f] = values_and_dynamics(*this, x, u);
     const double qw = xv(3), qx = xv(4), qy = xv(5), qz = xv(6);
     const double vx = xv(7), vy = xv(8), vz = xv(9), wx = xv(10), wy = xv(11), wz = xv(12);
     const auto [r00, r01, r02, r10, r11, r12, r20, r21, r22] = rotation(qw, qx, qy, qz);

@@ -99,9 +99,7 @@ struct MikroKopter {
   void dynamics_tangent(const Eigen::Matrix<Dual<n>, nx, 1>& x,
                         const Eigen::Matrix<Dual<n>, nu, 1>& u,
                         Eigen::Matrix<Dual<n>, nx, 1>& xdot) const {
-    State xv, f;
-    Input uv;
-    values_and_dynamics(*this, x, u, xv, uv, f);
+    const auto [xv, uv, f] = values_and_dynamics(*this, x, u);
     const double vx = xv(6), vy = xv(7), vz = xv(8), wx = xv(9), wy = xv(10), wz = xv(11);
     const double cph = std::cos(xv(3)), sph = std::sin(xv(3));
     const double cth = std::cos(xv(4)), sth = std::sin(xv(4));

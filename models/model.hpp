@@ -51,13 +51,20 @@ void dynamics_dual(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
 
 // For a dynamics_tangent: the values of its dual arguments, and f at them by dynamics<double>
 // (the tangent's values; its derivatives come from the Jacobian's nonzeros).
+template <class M>
+struct TangentValues {
+  typename M::State x;  // nx
+  typename M::Input u;  // nu
+  typename M::State f;  // nx: f(x, u)
+};
 template <class M, int n>
-void values_and_dynamics(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
-                         const Eigen::Matrix<Dual<n>, M::nu, 1>& u, typename M::State& xv,
-                         typename M::Input& uv, typename M::State& f) {
-  for (int i = 0; i < M::nx; ++i) xv(i) = x(i).v;
-  for (int i = 0; i < M::nu; ++i) uv(i) = u(i).v;
-  model.dynamics(xv, uv, f);
+TangentValues<M> values_and_dynamics(const M& model, const Eigen::Matrix<Dual<n>, M::nx, 1>& x,
+                                     const Eigen::Matrix<Dual<n>, M::nu, 1>& u) {
+  TangentValues<M> v;
+  for (int i = 0; i < M::nx; ++i) v.x(i) = x(i).v;
+  for (int i = 0; i < M::nu; ++i) v.u(i) = u(i).v;
+  model.dynamics(v.x, v.u, v.f);
+  return v;
 }
 
 // Forward-mode AD scalar carrying derivatives with respect to n directions. Constructed and
