@@ -3,7 +3,7 @@
 // a + Σ_j ∂a/∂z_j ε_j with ε_i ε_j = 0.
 //
 // Why not Eigen's AutoDiffScalar: its expression templates leave nested temporaries that g++
-// does not flatten; a whole ERK4 step with it ran 3-6x slower than with this type
+// does not flatten; a whole ERK4 step with it ran several times slower than with this type
 // (core/numerics/integrator_erk4.hpp). Here every operation is eager: one pass over the derivatives,
 // stored as g++ vector-extension blocks of 4 doubles (one AVX2 register each, padded with
 // zero lanes, which every operation keeps zero), so the optimizer keeps the temporaries of

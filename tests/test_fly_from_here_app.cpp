@@ -172,7 +172,7 @@ class FlyFromHereApp : public test::AppWindowTest {
 
 };
 
-// The case: a novice's recording of mi_helix replayed in the window, taken over at
+// The motivating case: a novice's recording of mi_helix replayed in the window, taken over at
 // 10 s with the experienced pilot. The moment is made ready off the UI thread (frames go on
 // meanwhile); the window is READY at the moment, showing the novice's path that led there;
 // Space starts; the flight completes; its recording's first step is the novice's step at 10 s

@@ -171,7 +171,7 @@ struct Shown {
   std::string hud;
 };
 
-// The case: the experienced pilot's recording as the ghost of a novice flight. At
+// The motivating case: the experienced pilot's recording as the ghost of a novice flight. At
 // several t the snapshot's τ of each and their gap equal the test's own, found from the two
 // recordings' positions alone by brute force over the reference sampled every millisecond
 // (globally: a deviation under half the coil spacing keeps the global nearest point local).

@@ -1,6 +1,6 @@
 // OCP-QP solver (core/qp_riccati_ipm): agreement with a certified dense reference on random
 // feasible OCP-QPs, KKT residuals of the returned solution checked independently of the solver,
-// warm starts, and clear failure statuses without NaN output (SPEC §4, issue 3).
+// warm starts, and clear failure statuses without NaN output (SPEC §4).
 #include <gtest/gtest.h>
 
 #include <cmath>

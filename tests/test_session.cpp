@@ -1,4 +1,4 @@
-// Mixed-initiative sessions on the shipped mi_helix scenario (issue 5, SPEC §5.4): the thesis's
+// Mixed-initiative sessions on the shipped mi_helix scenario (SPEC §5.4): the thesis's
 // behaviour with the emulated pilots, the safety constraints against a reckless pilot, plant
 // bounds, determinism, and record → replay → identical telemetry and score.
 #include <gtest/gtest.h>

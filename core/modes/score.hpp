@@ -1,5 +1,5 @@
 #pragma once
-// Scoring of a session from its telemetry (issue 5). With K control steps of Δt, p_k the true
+// Scoring of a session from its telemetry (SPEC §8). With K control steps of Δt, p_k the true
 // position, η^r_k the planner reference, r the ball radius, r_v the vehicle radius:
 //   duration_s        K Δt
 //   progress          fraction of the reference waypoints η^r_k that the vehicle came within r

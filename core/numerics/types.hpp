@@ -56,9 +56,10 @@ inline constexpr double kRefineRatio = 0.1;
 // ... and only while μ < kRefineMuRatio · tol_comp: W = λ/t ≈ λ²/μ is only then large enough for
 // the rounding it amplifies to matter.
 inline constexpr double kRefineMuRatio = 1e3;
-// QpRiccatiIpmPairs: pair condensing applied this many times (blocks of 2^levels stages).
-// Cold solves, condensing included, levels 1/2/3/4: MI QP (nx 16, nu 4, N 50) 326/309/350/503 µs,
-// Crazyflie (nx 13, N 50) 413/357/359/438 µs, Pendubot (nx 4, nu 1, N 10) 45/37/35/33 µs.
+// QpRiccatiIpmPairs: pair condensing applied this many times (blocks of 2^levels stages). For
+// cold, many-iteration solves of the MI and Crazyflie QPs, condensing included, blocks of 4 beat
+// pairs and blocks of 8 (BM_QpSolve, tests/benchmarks/bench_qp.cpp): each level halves the
+// Riccati recursion's stages and grows the blocks it factors.
 inline constexpr int kPairLevels = 2;
 // ... and only while ε‖W‖∞‖Δv‖∞ · kRefineBoundSafety (an a-priori bound on the error, measured
 // 1–3 orders of magnitude above the actual one on the test and controller QPs) exceeds the
@@ -85,8 +86,8 @@ inline constexpr double kCurvatureStep = 1e-5;
 // Defaults of the RTI solver (core/nlp/rti.hpp).
 namespace rti_defaults {
 // Warm-start each QP (primal-dual) from the previous, shifted QP solution: its active set and
-// multipliers carry over between steps. Measured on mi_helix (experienced pilot): RTI median
-// 2.8 ms cold vs 0.64 ms warm, same trajectory.
+// multipliers carry over between steps, so a step takes a few IPM iterations instead of a cold
+// solve's many (BM_Rti, same trajectory).
 inline constexpr bool kQpWarmStart = true;
 }  // namespace rti_defaults
 
@@ -100,12 +101,12 @@ enum class QpSolverKind {
                          // horizons in closed loop, where the active set rarely changes
 };
 namespace rti_defaults {
-// Same iterates as riccati_ipm; measured (BM_Rti, median): crazyflie_tracking 224 vs 248 µs,
-// obstacles 228 vs 276 µs, mi 343 vs 351 µs, the QP feedback phase of mi 214 vs 266 µs (the
-// condensing moves into prepare()).
+// Same iterates as riccati_ipm, and faster per step on every quadrotor mode (BM_Rti,
+// BM_RtiStep): half the Riccati stages, and the condensing moves into prepare(), out of the
+// feedback phase.
 inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm_pairs;
-// One level of pairs in RTI: its warm-started QPs take ~2 iterations, too few to repay a second
-// condensing level (BM_Rti/mi 379 µs with two levels, 343 µs with one).
+// One level of pairs in RTI: its warm-started QPs take one or two iterations, too few to repay a
+// second condensing level (BM_Rti).
 inline constexpr int kQpPairLevels = 1;
 // SPEC §4's failure policy applies the previous plan's next input; after this many fallbacks in
 // a row (QP failures or overruns: 75 ms of the quadrotor modes' 15 ms steps, half the
@@ -156,7 +157,7 @@ inline constexpr double kClearance = 0.2;       // d_C [m]
 inline constexpr double kSlackL1Lower = 14.5e3;  // exact ℓ1 penalty, lower side (eq. 6.5)
 inline constexpr double kSlackL1Upper = 14.2e3;  // upper side (inert: the upper side is absent)
 // ℓ2² slack weight. SPEC §5.3 is pure ℓ1 (Z = 0): kept positive until the QP solver handles
-// Z = 0 with an absent upper side (issue 6). 100 as mi_defaults::kSlackL2: with Z = 1 the cold
+// Z = 0 with an absent upper side. 100 as mi_defaults::kSlackL2: with Z = 1 the cold
 // first QP of obstacles_thrown_balls (lcl) stops at min_step; the closed-loop minimum distances
 // are the same to 0.01 mm for Z = 1, 10, 100 (the ℓ1 term keeps the slacks at zero).
 inline constexpr double kSlackL2 = 100.0;

@@ -17,7 +17,8 @@
 // h_0 + M_0 x0. x0 enters only that gradient and the state rows' bounds (via ξ), so prepare()
 // condenses everything else before x0 is known (the RTI preparation phase), and solve() adds the
 // O(N nx² + nU nx) x0 part. When every stage has (nx, nu) = (4, 1) (the Pendubot), the backward
-// and Γ recursions run on compile-time-sized Eigen maps (40k -> 17.5k instructions per step). The multipliers are mapped back; the states are recovered by a forward
+// and Γ recursions run on compile-time-sized Eigen maps, whose small products the compiler
+// unrolls. The multipliers are mapped back; the states are recovered by a forward
 // simulation (dynamics exact) and π_i, λ_x0 by the backward pass of the x-stationarity
 //   π_{i−1} = Q_i x_i + S_iᵀu_i + q_i + A_iᵀπ_i + ∇_x d_iᵀ(λ_u,i − λ_l,i),
 // so the OcpQpSolution is complete and its KKT residuals equal those of the condensed QP.

@@ -1,5 +1,5 @@
 #pragma once
-// A scenario: everything a session needs besides its pilot-input source (SPEC §5.4, issue 5).
+// A scenario: everything a session needs besides its pilot-input source (SPEC §5.4).
 // Plain data with the defaults of SPEC Table 7.1; loaded from TOML by core/scenario/scenario_toml.hpp.
 // The controller and pilot settings it holds are core/control/mi_settings.hpp's.
 #include <cstdint>

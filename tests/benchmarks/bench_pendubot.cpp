@@ -4,7 +4,7 @@
 // mid-swing (t = 0.5 s: q̇1 near the reference's 7 rad/s peak) and rewinds every 20 steps. QP by
 // condensing + warm-started active set (the mode's default) and, for comparison, condensing +
 // dense IPM and the Riccati IPM.
-// Thesis figure: 98.6 µs (ACADO + qpOASES, i7-4770); issue 6 target ≤ 10 µs.
+// Thesis figure: 98.6 µs (ACADO + qpOASES, i7-4770).
 #include <benchmark/benchmark.h>
 
 #include <chrono>

@@ -1,6 +1,6 @@
 // BM_QpSolve/<problem>: one OCP-QP solve by the Riccati IPM behind partial condensing of stage
-// pairs, twice (QpRiccatiIpmPairs' default: blocks of 4 stages; issue 3, SPEC §4), on the QPs of
-// tests/qp_problems.hpp, at the issue's tolerances (complementarity 1e-8, stationarity 1e-6).
+// pairs, twice (QpRiccatiIpmPairs' default: blocks of 4 stages; SPEC §4), on the QPs of
+// tests/qp_problems.hpp, at the default tolerances (complementarity 1e-8, stationarity 1e-6).
 // The condensing and the expansion of the solution are part of every timed solve.
 //   mi         MikroKopter mixed-initiative (SPEC §5.4): nx 16, nu 4, N 50, 4 τ bounds per stage,
 //              4 Ω bounds on stages 1..N

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end checks of the mixpilot command line (issue 5): fly --record/--report, then score of
+# End-to-end checks of the mixpilot command line: fly --record/--report, then score of
 # that recording gives the identical score; corrupt recordings and bad arguments give clear
 # errors. Usage: test_cli.sh MIXPILOT SOURCE_DIR
 set -u
