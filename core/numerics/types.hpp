@@ -57,8 +57,8 @@ inline constexpr double kRefineRatio = 0.1;
 // the rounding it amplifies to matter.
 inline constexpr double kRefineMuRatio = 1e3;
 // QpRiccatiIpmPairs: pair condensing applied this many times (blocks of 2^levels stages). For
-// cold, many-iteration solves of the MI and Crazyflie QPs, condensing included, blocks of 4 beat
-// pairs and blocks of 8 (BM_QpSolve, tests/benchmarks/bench_qp.cpp): each level halves the
+// cold, many-iteration solves of the MI and Crazyflie QPs of tests/qp_problems.hpp, condensing
+// included, blocks of 4 measured faster than pairs and than blocks of 8: each level halves the
 // Riccati recursion's stages and grows the blocks it factors.
 inline constexpr int kPairLevels = 2;
 // ... and only while ε‖W‖∞‖Δv‖∞ · kRefineBoundSafety (an a-priori bound on the error, measured
@@ -87,7 +87,7 @@ inline constexpr double kCurvatureStep = 1e-5;
 namespace rti_defaults {
 // Warm-start each QP (primal-dual) from the previous, shifted QP solution: its active set and
 // multipliers carry over between steps, so a step takes a few IPM iterations instead of a cold
-// solve's many (BM_Rti, same trajectory).
+// solve's many (measured on mi_helix, same trajectory).
 inline constexpr bool kQpWarmStart = true;
 }  // namespace rti_defaults
 
@@ -101,12 +101,11 @@ enum class QpSolverKind {
                          // horizons in closed loop, where the active set rarely changes
 };
 namespace rti_defaults {
-// Same iterates as riccati_ipm, and faster per step on every quadrotor mode (BM_Rti,
-// BM_RtiStep): half the Riccati stages, and the condensing moves into prepare(), out of the
-// feedback phase.
+// Same iterates as riccati_ipm, and faster per step on every quadrotor mode (BM_Rti): half the
+// Riccati stages, and the condensing moves into prepare(), out of the feedback phase.
 inline constexpr QpSolverKind kQpSolver = QpSolverKind::riccati_ipm_pairs;
-// One level of pairs in RTI: its warm-started QPs take one or two iterations, too few to repay a
-// second condensing level (BM_Rti).
+// One level of pairs in RTI: its warm-started QPs mostly take one or two iterations, too few to
+// repay a second condensing level (BM_Rti/mi).
 inline constexpr int kQpPairLevels = 1;
 // SPEC §4's failure policy applies the previous plan's next input; after this many fallbacks in
 // a row (QP failures or overruns: 75 ms of the quadrotor modes' 15 ms steps, half the

@@ -12,7 +12,8 @@ namespace mixpilot {
 namespace {
 
 // C += A B and C = A B with the register-blocked kernel (Eigen's general GEMM packs its
-// operands first, which costs more than the product at these 4..24 sizes). Column-major operands (matrices or blocks).
+// operands first, which costs more than the product at these 4..24 sizes). Column-major
+// operands (matrices or blocks).
 template <class MA, class MB, class MC>
 void add_ab(const MA& A, const MB& B, MC&& C) {
   kernels::gemm_nn(int(A.rows()), int(B.cols()), int(A.cols()), A.data(), int(A.outerStride()),
